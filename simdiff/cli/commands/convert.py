@@ -1,0 +1,58 @@
+"""``simdiff convert IN OUT``: motion files to HumanML3D joints or features (.npy) or BVH."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from simdiff.errors import SimdiffError
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "convert",
+        help="convert a motion file (AMC, BVH, DeepMimic JSON, .npy) to .npy joints/features or .bvh",
+        description=(
+            "Convert a motion to the 22-joint HumanML3D skeleton (metres, Y-up, 20 fps). IN: AMC "
+            "(with its ASF), BVH, DeepMimic JSON, .npy joints (T,22,3) or un-normalised "
+            "HumanML3D features (T,263). OUT: .npy (joints or features, see --to) or .bvh."
+        ),
+    )
+    p.add_argument("input", type=Path, metavar="IN", help="motion file to read")
+    p.add_argument("output", type=Path, metavar="OUT", help="file to write: .npy or .bvh")
+    p.add_argument(
+        "--to",
+        choices=("joints", "features"),
+        default="joints",
+        help="for .npy output: joints (T,22,3) or HumanML3D features (T-1,263) (default: joints)",
+    )
+    p.add_argument("--asf", type=Path, default=None, help="ASF skeleton for an AMC input (default: SS.asf beside it or in ../asf/)")
+    p.add_argument("--fps", type=float, default=None, help="source frame rate when the file does not say (AMC: 120)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from simdiff.motion.features import joints_to_features
+    from simdiff.motion.io import load_joints, save_npy, write_bvh
+
+    suffix = args.output.suffix.lower()
+    if suffix not in (".npy", ".bvh"):
+        raise SimdiffError(f"unsupported output type {args.output.name!r}: use .npy or .bvh")
+    if suffix == ".bvh" and args.to == "features":
+        raise SimdiffError("--to features needs a .npy output, not .bvh")
+    joints = load_joints(args.input, asf=args.asf, fps=args.fps)
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".bvh":
+        write_bvh(args.output, joints)
+        what = f"BVH, {joints.shape[0]} frames"
+    elif args.to == "features":
+        feats = joints_to_features(joints)
+        np.save(args.output, feats.astype(np.float32))
+        what = f"features {feats.shape}"
+    else:
+        save_npy(args.output, joints)
+        what = f"joints {joints.shape}"
+    print(f"wrote {args.output} ({what})")
+    return 0
