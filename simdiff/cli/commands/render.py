@@ -1,0 +1,66 @@
+"""``simdiff render``: stick-figure GIF/MP4 animations and PNG filmstrips of joint files."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from simdiff.errors import SimdiffError
+
+
+def _load(path: Path):
+    """(T, 22, 3) joints from ``path`` via :func:`simdiff.motion.io.load_joints`, or a raw ``.npy``."""
+    if not path.is_file():
+        raise SimdiffError(f"motion file not found: {str(path)!r}")
+    try:
+        from simdiff.motion.io import load_joints
+    except ImportError:
+        load_joints = None
+    if load_joints is not None:
+        return load_joints(path)
+    if path.suffix.lower() != ".npy":
+        raise SimdiffError(f"cannot read {str(path)!r}: only .npy (T, 22, 3) joint files are supported here")
+    import numpy as np
+
+    try:
+        return np.load(path, allow_pickle=False)
+    except (ValueError, OSError) as exc:
+        raise SimdiffError(f"cannot read {str(path)!r}: {exc}") from None
+
+
+def _run(args: argparse.Namespace) -> int:
+    from simdiff.motion.skeleton import FPS
+    from simdiff.viz import render_animation, render_filmstrip
+
+    files = [Path(f) for f in args.files]
+    motions = [_load(f) for f in files]
+    for f, m in zip(files, motions):
+        if getattr(m, "ndim", 0) != 3 or tuple(m.shape[1:]) != (22, 3):
+            raise SimdiffError(f"{str(f)!r} has shape {tuple(getattr(m, 'shape', ()))}, expected (T, 22, 3) joints")
+    captions = args.caption if args.caption else [f.stem for f in files]
+    out = Path(args.out)
+    fps = args.fps if args.fps is not None else FPS
+    if args.filmstrip or out.suffix.lower() == ".png":
+        render_filmstrip(motions, out, captions=captions, n_frames=args.frames, fps=fps)
+    else:
+        render_animation(motions, out, captions=captions, fps=fps)
+    print(out)
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``simdiff render``."""
+    parser = subparsers.add_parser(
+        "render",
+        help="render joint motions as a stick-figure GIF/MP4 or a PNG filmstrip",
+        description="Render one or more (T, 22, 3) joint motions side by side. The output suffix picks the "
+        "format: .gif or .mp4 animation, .png filmstrip (also with --filmstrip).",
+    )
+    parser.add_argument("files", nargs="+", metavar="FILE", help="joint motion files (T, 22, 3)")
+    parser.add_argument("--out", required=True, metavar="PATH", help="output .gif, .mp4 or .png")
+    parser.add_argument("--caption", action="extend", nargs="+", metavar="TEXT",
+                        help="one caption per FILE (default: file names)")
+    parser.add_argument("--filmstrip", action="store_true", help="save a filmstrip image instead of an animation")
+    parser.add_argument("--frames", type=int, default=8, metavar="N", help="frames per filmstrip row (default 8)")
+    parser.add_argument("--fps", type=float, default=None, help="frames per second (default 20)")
+    parser.set_defaults(func=_run)

@@ -1,0 +1,166 @@
+"""Physics plausibility metrics on joint positions (CLoSD's joint-based protocol).
+
+Joints are HumanML3D positions in metres, Y-up, ground plane y = 0, 20 fps. With
+``h_t = min_j y_j(t)`` the lowest joint of frame t (all 22 joints, no mesh):
+
+* penetration (mm): ``max(0, -(h_t + 0.005)) * 1000``, per valid frame;
+* floating (mm): ``max(0, h_t - 0.005) * 1000``, per valid frame;
+* sliding (mm/frame): for t = 0..len-2 with ``c = argmin_j y_j(t)``, the xz displacement
+  ``|xz_c(t+1) - xz_c(t)| * 1000`` if ``y_c(t) <= 0.005`` and ``y_c(t+1) <= 0.005``, else 0;
+* skate_ratio (GMD): fraction of frame pairs in which foot joint 10 or 11 is below 0.05 m in
+  both frames and moves faster than 0.5 m/s in xz, both at that pair and in the 5-pair
+  centred moving average (zeros beyond the valid span, scipy ``uniform_filter1d`` mode
+  'constant').
+
+Aggregation as in CLoSD: penetration, floating and sliding are means over all valid frames
+(frame pairs for sliding) of all samples pooled; skate_ratio is the mean of per-sample ratios.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import torch
+from scipy.ndimage import uniform_filter1d
+
+from simdiff.errors import SimdiffError
+from simdiff.motion.skeleton import FPS, NUM_JOINTS
+
+GROUND_TOLERANCE: float = 0.005
+"""Metres of slack for penetration, floating and sliding contact (5 mm)."""
+SKATE_FEET: tuple[int, int] = (10, 11)
+"""Left and right foot (toe) joints used by the GMD skate ratio."""
+SKATE_HEIGHT: float = 0.05
+"""Metres: a foot below this in two consecutive frames is in contact."""
+SKATE_SPEED: float = 0.5
+"""Metres per second of xz foot speed above which a contact foot skates."""
+SKATE_WINDOW: int = 5
+"""Frame pairs in the centred moving average of the foot speed."""
+
+METRIC_NAMES: tuple[str, ...] = ("penetration", "floating", "sliding", "skate_ratio")
+
+
+def _prepare(
+    joints: np.ndarray | torch.Tensor, lengths: Sequence[int] | np.ndarray | torch.Tensor | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(B, T, 22, 3) float array and (B,) int64 lengths, validated."""
+    if isinstance(joints, torch.Tensor):
+        joints = joints.detach().cpu().numpy()
+    arr = np.asarray(joints)
+    if arr.ndim not in (3, 4) or arr.shape[-2:] != (NUM_JOINTS, 3):
+        raise SimdiffError(f"joints must have shape (B, T, 22, 3) or (T, 22, 3), got {arr.shape}")
+    if arr.ndim == 3:
+        arr = arr[None]
+    if not np.issubdtype(arr.dtype, np.floating) or arr.dtype == np.float16:
+        arr = arr.astype(np.float32)
+    batch, frames = arr.shape[:2]
+    if frames < 2:
+        raise SimdiffError(f"joints need at least 2 frames, got {frames}")
+    if lengths is None:
+        lens = np.full(batch, frames, dtype=np.int64)
+    else:
+        if isinstance(lengths, torch.Tensor):
+            lengths = lengths.detach().cpu().numpy()
+        lens = np.asarray(lengths).reshape(-1)
+        if lens.shape != (batch,):
+            raise SimdiffError(f"lengths must have {batch} entries, got {lens.shape[0]}")
+        if not np.issubdtype(lens.dtype, np.integer):
+            raise SimdiffError(f"lengths must be integers, got dtype {lens.dtype}")
+        lens = lens.astype(np.int64)
+        bad = np.flatnonzero((lens < 2) | (lens > frames))
+        if bad.size:
+            i = int(bad[0])
+            raise SimdiffError(f"lengths[{i}]={lens[i]} is outside [2, {frames}]")
+    return arr, lens
+
+
+def _per_sample(arr: np.ndarray, lens: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-sample sums and counts; see per_sample_physics_metrics."""
+    batch, frames = arr.shape[:2]
+    t = np.arange(frames)
+    frame_mask = t[None, :] < lens[:, None]  # (B, T)
+    pair_mask = t[None, :-1] < (lens[:, None] - 1)  # (B, T-1)
+
+    heights = arr[..., 1]  # (B, T, 22)
+    lowest_idx = heights.argmin(axis=-1)  # (B, T)
+    lowest = np.take_along_axis(heights, lowest_idx[..., None], axis=-1)[..., 0]  # (B, T)
+
+    penetration = np.maximum(0.0, -(lowest.astype(np.float64) + GROUND_TOLERANCE)) * 1000.0
+    floating = np.maximum(0.0, lowest.astype(np.float64) - GROUND_TOLERANCE) * 1000.0
+
+    # Sliding: the lowest joint at t, followed into t+1.
+    idx = lowest_idx[:, :-1, None, None]  # (B, T-1, 1, 1)
+    now = np.take_along_axis(arr[:, :-1], idx, axis=2)[:, :, 0]  # (B, T-1, 3)
+    nxt = np.take_along_axis(arr[:, 1:], idx, axis=2)[:, :, 0]
+    contact = (now[..., 1] <= GROUND_TOLERANCE) & (nxt[..., 1] <= GROUND_TOLERANCE) & pair_mask
+    step = np.hypot(
+        nxt[..., 0].astype(np.float64) - now[..., 0], nxt[..., 2].astype(np.float64) - now[..., 2]
+    )
+    sliding = np.where(contact, step * 1000.0, 0.0)
+
+    n_frames = lens.astype(np.float64)
+    n_pairs = n_frames - 1.0
+    return {
+        "penetration": np.where(frame_mask, penetration, 0.0).sum(axis=1) / n_frames,
+        "floating": np.where(frame_mask, floating, 0.0).sum(axis=1) / n_frames,
+        "sliding": sliding.sum(axis=1) / n_pairs,
+        "skate_ratio": _skating(arr, pair_mask).sum(axis=1) / n_pairs,
+    }
+
+
+def _skating(arr: np.ndarray, pair_mask: np.ndarray) -> np.ndarray:
+    """(B, T-1) bool: GMD skating of either foot between frames t and t+1."""
+    feet = arr[:, :, list(SKATE_FEET)].astype(np.float64)  # (B, T, 2, 3)
+    step = feet[:, 1:] - feet[:, :-1]
+    speed = np.hypot(step[..., 0], step[..., 2]) * FPS  # (B, T-1, 2) m/s
+    speed = np.where(pair_mask[..., None], speed, 0.0)
+    avg = uniform_filter1d(speed, size=SKATE_WINDOW, axis=1, mode="constant", cval=0.0)
+    low = feet[..., 1] < SKATE_HEIGHT  # (B, T, 2)
+    contact = low[:, :-1] & low[:, 1:]
+    skating = contact & (speed > SKATE_SPEED) & (avg > SKATE_SPEED) & pair_mask[..., None]
+    return skating.any(axis=-1)
+
+
+def per_sample_physics_metrics(
+    joints: np.ndarray | torch.Tensor,
+    lengths: Sequence[int] | np.ndarray | torch.Tensor | None = None,
+) -> dict[str, np.ndarray]:
+    """Physics metrics of each sample.
+
+    Args:
+        joints: (B, T, 22, 3) or (T, 22, 3) positions in metres, Y-up, ground y = 0.
+        lengths: (B,) valid frames per sample, each in [2, T]; None means all T.
+    Returns:
+        {"penetration", "floating" (mm, mean over the sample's frames), "sliding" (mm per
+        frame, mean over its len-1 frame pairs), "skate_ratio" (fraction of its pairs)},
+        each a (B,) float64 array.
+    """
+    arr, lens = _prepare(joints, lengths)
+    return _per_sample(arr, lens)
+
+
+def physics_metrics(
+    joints: np.ndarray | torch.Tensor,
+    lengths: Sequence[int] | np.ndarray | torch.Tensor | None = None,
+) -> dict[str, float]:
+    """Physics metrics of a batch, aggregated as CLoSD does.
+
+    Args:
+        joints: (B, T, 22, 3) or (T, 22, 3) positions in metres, Y-up, ground y = 0.
+        lengths: (B,) valid frames per sample, each in [2, T]; None means all T.
+    Returns:
+        {"penetration", "floating"} in mm averaged over all valid frames of all samples,
+        "sliding" in mm/frame averaged over all valid frame pairs, and "skate_ratio" as the
+        mean of the per-sample ratios.
+    """
+    arr, lens = _prepare(joints, lengths)
+    per = _per_sample(arr, lens)
+    n_frames = lens.astype(np.float64)
+    n_pairs = n_frames - 1.0
+    return {
+        "penetration": float((per["penetration"] * n_frames).sum() / n_frames.sum()),
+        "floating": float((per["floating"] * n_frames).sum() / n_frames.sum()),
+        "sliding": float((per["sliding"] * n_pairs).sum() / n_pairs.sum()),
+        "skate_ratio": float(per["skate_ratio"].mean()),
+    }

@@ -1,0 +1,111 @@
+"""Stick-figure rendering: files written with the right frame counts and sizes; bad input rejected."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import imageio.v2 as iio2
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from simdiff.errors import SimdiffError
+from simdiff.motion.synthetic import walk
+from simdiff.viz import animation_frames, render_animation, render_filmstrip
+from simdiff.viz.camera import choose_azim, clip_bounds, to_plot
+
+SMALL = dict(panel_size=(1.6, 1.6), dpi=50)  # 80 x 80 px panels
+
+
+@pytest.fixture(scope="module")
+def walks() -> list[np.ndarray]:
+    return [walk(12), walk(7, speed=0.5)]
+
+
+def test_synthetic_walk_is_upright_on_floor() -> None:
+    j = walk(40)
+    assert j.shape == (40, 22, 3) and j.dtype == np.float32
+    assert abs(j[..., 1].min()) < 1e-6 and j[:, [7, 8, 10, 11], 1].min(axis=1).max() < 0.05
+    assert (j[:, 15, 1] > 1.3).all()  # head well above the floor
+    assert j[-1, 0, 2] > j[0, 0, 2]  # walks towards +Z
+
+
+def test_gif_frames_and_size(tmp_path: Path, walks: list[np.ndarray]) -> None:
+    out = render_animation(walks, tmp_path / "a.gif", captions=["walk", "slow walk"], **SMALL)
+    frames = iio.imread(out, index=None)
+    assert frames.shape[0] == 12  # the longest clip; the shorter one holds its last frame
+    assert frames.shape[2] == 160 and frames.shape[1] > 80  # two 80-px panels side by side, captions on top
+    assert iio.immeta(out, index=0)["duration"] == 50  # 20 fps
+
+
+def test_mp4_frames_and_size(tmp_path: Path, walks: list[np.ndarray]) -> None:
+    out = render_animation(walks[1], tmp_path / "a.mp4", **SMALL)
+    with iio2.get_reader(out, format="FFMPEG") as reader:
+        meta = reader.get_meta_data()
+        n = reader.count_frames()
+    assert n == 7
+    assert meta["size"] == (80, 80)
+    assert meta["fps"] == pytest.approx(20)
+
+
+def test_animation_frames_match_video(walks: list[np.ndarray]) -> None:
+    frames = list(animation_frames(walks, **SMALL))  # no captions: no caption band
+    assert len(frames) == 12 and frames[0].shape == (80, 160, 3) and frames[0].dtype == np.uint8
+    assert not np.array_equal(frames[0], frames[-1])  # the figures move
+    assert (frames[0] < 250).any()  # something is drawn
+
+
+def test_filmstrip_png(tmp_path: Path, walks: list[np.ndarray]) -> None:
+    out = render_filmstrip(walks, tmp_path / "sub" / "f.png", n_frames=3, cell_size=(1.0, 1.0), dpi=50)
+    assert iio.imread(out).shape[:2] == (2 * 50, 3 * 50)  # 2 rows (motions) x 3 columns (frames)
+    out = render_filmstrip(walks, tmp_path / "g.png", captions=["a", "b"], n_frames=3, cell_size=(1.0, 1.0), dpi=50)
+    image = iio.imread(out)
+    assert image.shape[1] == 150 and image.shape[0] > 100  # captions add a band above each row
+
+
+def test_fixed_camera_covers_whole_clip() -> None:
+    j = walk(60)
+    lo, hi = clip_bounds(j)
+    pts = to_plot(j.reshape(-1, 3))
+    assert (pts >= lo - 1e-6).all() and (pts <= hi + 1e-6).all() and lo[2] <= 0.0
+    assert -180.0 <= choose_azim(j) <= 180.0
+
+
+@pytest.mark.parametrize(
+    "motions",
+    [[], [np.zeros((5, 21, 3))], [np.zeros((5, 22))], [np.zeros((0, 22, 3))], [np.full((3, 22, 3), np.nan)], "x"],
+)
+def test_bad_motions(tmp_path: Path, motions: object) -> None:
+    with pytest.raises(SimdiffError):
+        render_animation(motions, tmp_path / "a.gif", **SMALL)  # type: ignore[arg-type]
+    with pytest.raises(SimdiffError):
+        render_filmstrip(motions, tmp_path / "a.png")  # type: ignore[arg-type]
+
+
+def test_bad_options(tmp_path: Path, walks: list[np.ndarray]) -> None:
+    with pytest.raises(SimdiffError, match="avi"):
+        render_animation(walks, tmp_path / "a.avi")
+    with pytest.raises(SimdiffError, match="gif"):
+        render_filmstrip(walks, tmp_path / "a.gif")
+    with pytest.raises(SimdiffError, match="captions"):
+        render_animation(walks, tmp_path / "a.gif", captions=["only one"])
+    with pytest.raises(SimdiffError, match="n_frames"):
+        render_filmstrip(walks, tmp_path / "a.png", n_frames=0)
+    with pytest.raises(SimdiffError, match="fps"):
+        render_animation(walks, tmp_path / "a.gif", fps=-1)
+
+
+def test_cli_render(tmp_path: Path, walks: list[np.ndarray]) -> None:
+    from simdiff.cli.main import main
+
+    files = []
+    for i, w in enumerate(walks):
+        files.append(str(tmp_path / f"m{i}.npy"))
+        np.save(files[-1], w)
+    out = tmp_path / "f.png"
+    assert main(["render", *files, "--out", str(out), "--frames", "2", "--caption", "a", "b"]) == 0
+    assert out.is_file()
+    assert main(["render", files[0], "--out", str(tmp_path / "a.webm")]) == 2
+    assert main(["render", str(tmp_path / "missing.npy"), "--out", str(out)]) == 2
+    np.save(tmp_path / "bad.npy", np.zeros((4, 3)))
+    assert main(["render", str(tmp_path / "bad.npy"), "--out", str(out)]) == 2
