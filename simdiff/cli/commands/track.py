@@ -1,0 +1,131 @@
+"""``simdiff track FILE...``: replay motions in the physics simulator under φ (the projection P_φ)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+from pathlib import Path
+
+from simdiff.errors import SimdiffError
+
+DEFAULT_STATS = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "humanml3d"
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "track",
+        help="track motions with the MuJoCo humanoid under gravity and wind (physics projection)",
+        description=(
+            "Replay each motion (any file `simdiff convert` reads) with the simulated humanoid and "
+            "the default PD tracker under environment φ = (gravity, wind). Prints per motion: success, "
+            "fall frame, d_L2, mean tracking error (mm), residual force (fraction of m·g) and torque, "
+            "CPU seconds."
+        ),
+    )
+    p.add_argument("files", nargs="+", type=Path, metavar="FILE", help="motion files")
+    p.add_argument("--gravity", type=float, default=-9.81, help="vertical gravity g_z in m/s² (default -9.81)")
+    p.add_argument("--wind", type=float, nargs=2, default=(0.0, 0.0), metavar=("X", "Y"),
+                   help="wind force in N along HumanML3D +X (left) and +Z (forward) (default 0 0)")
+    p.add_argument("--residual", type=float, default=0.5, metavar="R",
+                   help="root residual bound as a fraction of m·g (torque bound 600·R N·m); 0 = strict (default 0.5)")
+    p.add_argument("--out", type=Path, default=None, metavar="DIR", help="write each rollout as DIR/<name>.npy joints")
+    p.add_argument("--json", action="store_true", help="print one JSON object per motion")
+    p.add_argument("--stats", type=Path, default=None, metavar="DIR",
+                   help="folder with Mean.npy/Std.npy for d_L2 (default: $SIMDIFF_STATS or ../shared/data/humanml3d if present)")
+    p.add_argument("--force", action="store_true", help="allow φ outside the validated ranges")
+    p.add_argument("--fps", type=float, default=None, help="source frame rate when the file does not say")
+    p.set_defaults(func=run)
+
+
+def load_motion(path: Path, fps: float | None = None):
+    """(T, 22, 3) HumanML3D joints from any motion file ``simdiff convert`` reads."""
+    import numpy as np
+
+    if not path.is_file():
+        raise SimdiffError(f"{path}: no such file")
+    try:
+        from simdiff.motion.io import load_joints
+    except ImportError:
+        load_joints = None
+    if load_joints is not None:
+        kwargs = {"fps": fps} if fps is not None else {}
+        return np.asarray(load_joints(path, **kwargs), dtype=np.float64)
+    if path.suffix.lower() == ".amc":  # until load_joints exists: the AMC reader + retargeting
+        from simdiff.motion.io.asf_amc import find_asf, read_amc
+        from simdiff.motion.io.retarget import retarget
+
+        asf = find_asf(path)
+        if asf is None:
+            raise SimdiffError(f"{path}: no ASF skeleton found beside it or in ../asf/")
+        rig = read_amc(path, asf, **({"fps": fps} if fps else {}))
+        return np.asarray(retarget(rig, canonical=True), dtype=np.float64)
+    if path.suffix.lower() != ".npy":
+        raise SimdiffError(f"{path}: only .npy and .amc can be read until the motion readers are installed")
+    arr = np.load(path)
+    if arr.ndim != 3 or arr.shape[1:] != (22, 3):
+        raise SimdiffError(f"{path}: expected joints (T, 22, 3), got {arr.shape}")
+    return arr.astype(np.float64)
+
+
+def _stats_dir(arg: Path | None) -> Path | None:
+    if arg is not None:
+        if not (arg / "Mean.npy").is_file() or not (arg / "Std.npy").is_file():
+            raise SimdiffError(f"{arg}: needs Mean.npy and Std.npy")
+        return arg
+    env = os.environ.get("SIMDIFF_STATS")
+    if env:
+        return Path(env)
+    return DEFAULT_STATS if (DEFAULT_STATS / "Mean.npy").is_file() else None
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from simdiff.sim.env import Environment
+    from simdiff.sim.project import project
+    from simdiff.sim.residual import ResidualConfig
+
+    if args.residual < 0:
+        raise SimdiffError(f"--residual must be ≥ 0, got {args.residual}")
+    env = Environment(args.gravity, float(args.wind[0]), float(args.wind[1])).validate(force=args.force)
+    stats = _stats_dir(args.stats)
+    normalizer = None
+    if stats is not None:
+        from simdiff.motion.normalize import Normalizer
+
+        normalizer = Normalizer.from_dir(stats)
+    if args.out is not None:
+        args.out.mkdir(parents=True, exist_ok=True)
+    n_ok = 0
+    for path in args.files:
+        joints = load_motion(path, args.fps)
+        out, info = project(joints, env, residual=ResidualConfig(max_force=args.residual), normalizer=normalizer,
+                            force=args.force)
+        n_ok += info.success
+        written = None
+        if args.out is not None:
+            written = args.out / f"{path.stem}.npy"
+            tmp = written.with_suffix(".tmp.npy")
+            np.save(tmp, out.astype(np.float32))
+            os.replace(tmp, written)
+        r = info.residual
+        if args.json:
+            d = info.to_dict()
+            d["file"] = str(path)
+            d["out"] = None if written is None else str(written)
+            print(json.dumps(d, default=lambda x: None if isinstance(x, float) and math.isnan(x) else x))
+        else:
+            fall = "-" if info.fall_frame is None else str(info.fall_frame)
+            print(
+                f"{path.name}: {'OK  ' if info.success else info.status.upper()} fall={fall} "
+                f"d_L2={info.d_l2:.3f} err={info.err_mm:.1f}mm (local {info.err_local_mm:.1f}) "
+                f"residual F={r['force_mean_mg']:.3f}/{r['force_peak_mg']:.3f}mg "
+                f"tau={r['torque_mean_nm']:.0f}/{r['torque_peak_nm']:.0f}Nm "
+                f"cpu={info.cpu_s:.2f}s ({info.cpu_s / max(info.duration_s, 1e-9):.2f}s/s)"
+            )
+    if not args.json:
+        print(f"tracked {n_ok}/{len(args.files)} under g={env.gravity} wind=({env.wind_x}, {env.wind_y}) N "
+              f"residual={args.residual}")
+    return 0

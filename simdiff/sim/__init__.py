@@ -1,0 +1,8 @@
+"""Physics projection P_φ,π: generated MuJoCo humanoid, environment φ, conversions, tracker, rollouts.
+
+Modules: ``humanoid`` (MJCF builder), ``env`` (φ and validation), ``convert`` (joints ⇄ states,
+reference building, ID screen), ``tracker`` (Tracker interface, default PD tracker),
+``residual`` (contact-gated root residual), ``rollout`` (one simulation + invariant audit),
+``project`` (``project(joints, env) -> (rollout, info)``), ``pool`` (process / Ray parallelism),
+``synthetic`` (test motions). MuJoCo is imported lazily.
+"""

@@ -1,0 +1,143 @@
+"""The projection operator P_φ,π(τ): track a kinematic motion under φ, return the rollout.
+
+``project(joints, env) -> (rollout_joints, info)``; ``rollout_joints`` is (T', 22, 3)
+float32 HumanML3D joints (Y-up, metres, 20 fps, same frame as the input) with T' = T on
+success and the frames up to the fall otherwise. ``info`` is a :class:`ProjectionInfo`.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from simdiff.sim.convert import RetargetConfig, make_reference, qpos_to_world
+from simdiff.sim.env import Environment
+from simdiff.sim.humanoid import HumanoidConfig, load_model, model_index, world_to_hml
+from simdiff.sim.residual import ResidualConfig
+from simdiff.sim.rollout import FallConfig, RolloutResult, rollout
+from simdiff.sim.tracker import Tracker
+
+
+@dataclass
+class ProjectionInfo:
+    """Per-motion result of :func:`project`.
+
+    Attributes:
+        success: tracked to the end without falling or instability.
+        status: ``ok`` / ``fell`` / ``unstable``.
+        fall_frame: 20-fps frame index of the fall (None on success).
+        n_frames: input frames; n_out: rollout frames returned.
+        d_l2: mean per-frame L2 distance between reference and rollout features in the
+            normalised HumanML3D representation (paper eq. 13); NaN without a normaliser.
+        err_mm: mean joint position error (mm, world, over the returned frames).
+        err_local_mm: same after removing the horizontal root offset per frame.
+        residual: mean/peak residual force (fraction of m·g) and torque (N·m), airborne share.
+        feasibility: ID screen of the reference (root residual it needs, fraction of m·g).
+        cpu_s: CPU seconds (retarget + rollout + metrics); sim_cpu_s: rollout only.
+        duration_s: motion length (s); env: (g_z, w_x, w_y).
+        violations: physics-invariant violations (only when audited).
+    """
+
+    success: bool
+    status: str
+    fall_frame: int | None
+    n_frames: int
+    n_out: int
+    d_l2: float
+    err_mm: float
+    err_local_mm: float
+    residual: dict[str, float]
+    feasibility: dict[str, float]
+    cpu_s: float
+    sim_cpu_s: float
+    duration_s: float
+    env: tuple[float, float, float]
+    violations: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def rollout_joints(model, result: RolloutResult, n_frames: int, fps: float = 20.0) -> np.ndarray:
+    """HumanML3D joints (T', 22, 3) float32 at ``fps`` from the per-step states of a rollout."""
+    dt = result.timestep
+    S = result.qpos.shape[0] - 1
+    t_end = S * dt
+    n = min(n_frames, int(np.floor(t_end * fps + 1e-6)) + 1)
+    idx = np.arange(n) / fps / dt
+    lo = np.clip(np.floor(idx + 1e-9).astype(int), 0, S)
+    hi = np.clip(lo + 1, 0, S)
+    a = np.clip(idx - lo, 0.0, 1.0)[:, None, None]
+    ix = model_index(model)
+    p_lo = qpos_to_world(model, result.qpos[lo], ix)
+    p_hi = qpos_to_world(model, result.qpos[hi], ix)
+    return world_to_hml((1 - a) * p_lo + a * p_hi).astype(np.float32)
+
+
+def d_l2(ref_joints: np.ndarray, out_joints: np.ndarray, normalizer) -> float:
+    """Paper eq. 13: mean over frames of ||norm(f_ref) − norm(f_out)||₂ (263-d features).
+
+    Both motions are cut to the common length; fewer than 2 frames gives NaN.
+    """
+    if normalizer is None:
+        return float("nan")
+    n = min(len(ref_joints), len(out_joints))
+    if n < 2:
+        return float("nan")
+    from simdiff.sim.convert import joints_to_features
+
+    fr = normalizer.normalize(joints_to_features(ref_joints[:n]))
+    fo = normalizer.normalize(joints_to_features(out_joints[:n]))
+    return float(np.linalg.norm(np.asarray(fr) - np.asarray(fo), axis=-1).mean())
+
+
+def project(
+    joints: np.ndarray,
+    env: Environment = Environment(),
+    *,
+    model=None,
+    tracker: Tracker | None = None,
+    residual: ResidualConfig = ResidualConfig(),
+    retarget: RetargetConfig = RetargetConfig(),
+    fall: FallConfig = FallConfig(),
+    normalizer=None,
+    force: bool = False,
+    audit: bool = False,
+) -> tuple[np.ndarray, ProjectionInfo]:
+    """P_φ,π(τ): replay ``joints`` in MuJoCo under ``env`` and return the rollout.
+
+    Args:
+        joints: (T, 22, 3) HumanML3D joints, metres, Y-up, 20 fps.
+        env: φ; validated (``force`` skips the range check).
+        model: humanoid model (default :func:`load_model`).
+        tracker: default :class:`simdiff.sim.tracker.PDTracker`.
+        residual: ``ResidualConfig(max_force=0)`` is the strict setting.
+        normalizer: a :class:`simdiff.motion.normalize.Normalizer` for d_L2 (NaN if None).
+        audit: check the physics invariants at every step (slower).
+    Returns:
+        (rollout joints (T', 22, 3) float32, :class:`ProjectionInfo`).
+    """
+    t0 = time.process_time()
+    env.validate(force=force)
+    model = model if model is not None else load_model(HumanoidConfig())
+    joints = np.asarray(joints, dtype=np.float64)
+    ref = make_reference(model, joints, retarget)
+    res = rollout(model, ref, env, tracker, residual, fall, audit=audit)
+    out = rollout_joints(model, res, joints.shape[0], retarget.fps)
+    ref_j = joints[: len(out)] + np.array([0.0, ref.ground_shift, 0.0])
+    diff = out - ref_j
+    err = float(np.linalg.norm(diff, axis=-1).mean() * 1e3)
+    local = diff - diff[:, :1] * np.array([1.0, 0.0, 1.0])
+    err_local = float(np.linalg.norm(local, axis=-1).mean() * 1e3)
+    fall_frame = None if res.fall_time is None else int(np.floor(res.fall_time * retarget.fps))
+    dl2 = d_l2(joints, out, normalizer)
+    ix = model_index(model)
+    info = ProjectionInfo(
+        success=res.success, status=res.status, fall_frame=fall_frame, n_frames=int(joints.shape[0]),
+        n_out=int(len(out)), d_l2=dl2, err_mm=err, err_local_mm=err_local, residual=res.residual_stats(),
+        feasibility=ref.feasibility(ix.mass, 9.81), cpu_s=time.process_time() - t0, sim_cpu_s=res.cpu_s,
+        duration_s=ref.duration, env=env.as_tuple(), violations=res.violations,
+    )
+    return out, info

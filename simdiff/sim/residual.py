@@ -1,0 +1,141 @@
+"""The contact-gated root residual wrench (the price of not having a learned tracker).
+
+At every physics step (after ``mj_step1``, i.e. with the current contacts) a wrench on the
+pelvis is computed:
+
+* **gate**: exactly zero unless a foot or hand geom touches the floor in the simulation *and*
+  the reference has a foot on the floor within ±``ref_window`` control frames (so flight
+  phases of runs and jumps, and any airborne instant, obey φ alone);
+* force, velocity-level in xy: ``F_xy = m·kv·(v_ref − v)`` on the whole-body COM velocity
+  (no position term, so wind can make the character drift: a constant wind w leaves a
+  steady velocity error w / (m·kv)); vertical ``F_z = m·(kp_z·Δz + kd_z·Δv_z)`` clipped to
+  ≥ 0 (push-only); then ``|F| ≤ max_force·m·|g_z|``;
+* torque: ``τ = kp_rot·e_rot + kd_rot·Δω`` on the pelvis orientation, ``|τ| ≤ max_torque``.
+
+It is written to ``data.xfrc_applied[pelvis]`` (applied at the pelvis COM), logged per step
+and summarised per rollout. ``max_force = 0`` gives the strict (paper) setting: no residual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class ResidualConfig:
+    """Gains and bounds of the root residual.
+
+    Attributes:
+        max_force: force bound as a fraction of m·|g_z| (0 disables the residual entirely).
+        max_torque: torque bound in N·m; default ``None`` means 600·max_force N·m
+            (300 N·m at 0.5).
+        kv_xy: horizontal COM velocity gain (1/s).
+        kp_z, kd_z: vertical COM gains (1/s², 1/s).
+        kp_rot, kd_rot: pelvis orientation gains (N·m/rad, N·m·s/rad).
+        ref_window: control frames around now in which the reference must touch the floor.
+    """
+
+    max_force: float = 0.5
+    max_torque: float | None = None
+    kv_xy: float = 5.0
+    kp_z: float = 100.0
+    kd_z: float = 20.0
+    kp_rot: float = 1500.0
+    kd_rot: float = 150.0
+    ref_window: int = 2
+
+    @property
+    def torque_bound(self) -> float:
+        return 600.0 * self.max_force if self.max_torque is None else float(self.max_torque)
+
+    @property
+    def enabled(self) -> bool:
+        return self.max_force > 0 or self.torque_bound > 0
+
+
+def _quat_err(q_ref: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Rotation vector (world) taking unit quaternion q to q_ref, both (4,) wxyz."""
+    w1, x1, y1, z1 = q_ref
+    w2, x2, y2, z2 = q[0], -q[1], -q[2], -q[3]
+    e = np.array([
+        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+    ])
+    if e[0] < 0:
+        e = -e
+    s = np.linalg.norm(e[1:])
+    if s < 1e-12:
+        return np.zeros(3)
+    return e[1:] / s * 2.0 * np.arctan2(s, e[0])
+
+
+class RootResidual:
+    """Computes the gated residual wrench at each physics step (see module docstring)."""
+
+    def __init__(self, config: ResidualConfig, model, reference, index, gravity: float) -> None:
+        import mujoco
+
+        self.mj = mujoco
+        self.cfg = config
+        self.m = model
+        self.ref = reference
+        self.ix = index
+        self.mass = index.mass
+        self.fmax = config.max_force * index.mass * abs(gravity)
+        self.tmax = config.torque_bound
+        self.support = np.zeros(model.ngeom, dtype=bool)
+        self.support[index.support_geoms] = True
+        K = reference.num_frames
+        w = config.ref_window
+        c = reference.contact.any(axis=1)
+        self.ref_support = np.array([c[max(0, k - w) : k + w + 1].any() for k in range(K)])
+        # reference pelvis world angular velocity
+        from scipy.spatial.transform import Rotation
+
+        quat = reference.qpos[:, 3:7]
+        R = Rotation.from_quat(quat[:, [1, 2, 3, 0]])
+        self.ref_omega = R.apply(reference.qvel[:, 3:6])
+
+    def sim_support(self, data) -> bool:
+        """True when a foot or hand geom touches the floor (contacts of the current step)."""
+        n = data.ncon
+        if n == 0:
+            return False
+        return bool(self.support[data.contact.geom[:n]].any())
+
+    def wrench(self, data, t: float) -> np.ndarray:
+        """(6,) world force (N) and torque (N·m) for the physics step starting at time t (s)."""
+        if not self.cfg.enabled:
+            return np.zeros(6)
+        ref = self.ref
+        x = t / ref.dt
+        k = int(np.clip(np.floor(x), 0, ref.num_frames - 1))
+        if not self.ref_support[min(int(round(x)), ref.num_frames - 1)] or not self.sim_support(data):
+            return np.zeros(6)
+        k1 = min(k + 1, ref.num_frames - 1)
+        a = float(np.clip(x - k, 0.0, 1.0))
+        com_ref = (1 - a) * ref.com[k] + a * ref.com[k1]
+        vel_ref = (1 - a) * ref.com_vel[k] + a * ref.com_vel[k1]
+        self.mj.mj_subtreeVel(self.m, data)
+        p = self.ix.pelvis
+        com = data.subtree_com[p]
+        vel = data.subtree_linvel[p]
+        c = self.cfg
+        f = np.empty(3)
+        f[:2] = self.mass * c.kv_xy * (vel_ref[:2] - vel[:2])
+        f[2] = max(0.0, self.mass * (c.kp_z * (com_ref[2] - com[2]) + c.kd_z * (vel_ref[2] - vel[2])))
+        n = np.linalg.norm(f)
+        if n > self.fmax:
+            f *= self.fmax / max(n, 1e-12)
+        q_ref = ref.qpos[k, 3:7] if a < 0.5 else ref.qpos[k1, 3:7]
+        e = _quat_err(q_ref, data.xquat[p])
+        omega = data.cvel[p, :3]
+        tau = c.kp_rot * e + c.kd_rot * (self.ref_omega[k] - omega)
+        n = np.linalg.norm(tau)
+        if n > self.tmax:
+            tau *= self.tmax / max(n, 1e-12)
+        return np.concatenate([f, tau])

@@ -1,0 +1,216 @@
+"""One physics rollout: a tracker follows a reference under φ, with the gated root residual.
+
+Physics at 450 Hz (``model.opt.timestep``), control at the reference rate (30 Hz: 15 physics
+steps per control step). Each physics step is ``mj_step1`` (positions, contacts), residual
+wrench from the current contacts, ``mj_step2`` (forces, integration).
+
+Failure: a fall (head below ``head_ratio`` of the reference head height, or the mean joint
+error after removing the horizontal COM offset above ``max_error`` m), or MuJoCo
+instability (a warning or a non-finite state), in which case the rollout is marked failed
+and must not be used as data.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from simdiff.sim.convert import Reference
+from simdiff.sim.env import Environment
+from simdiff.sim.humanoid import ModelIndex, model_index
+from simdiff.sim.residual import ResidualConfig, RootResidual
+from simdiff.sim.tracker import PDTracker, Tracker
+
+
+@dataclass(frozen=True)
+class FallConfig:
+    """Fall detection.
+
+    Attributes:
+        head_ratio: fall when head height < head_ratio × reference head height ...
+        min_ref_head: ... and the reference head is above this (m) (lying motions excepted).
+        max_error: fall when the mean joint error, horizontal COM offset removed, exceeds this (m).
+    """
+
+    head_ratio: float = 0.5
+    min_ref_head: float = 0.6
+    max_error: float = 0.35
+
+
+@dataclass
+class RolloutResult:
+    """What one rollout produced.
+
+    Attributes:
+        status: ``"ok"``, ``"fell"`` or ``"unstable"``.
+        fall_time: time of the fall / instability (s) or None.
+        qpos: (S+1, nq) state at every physics step (S steps simulated).
+        residual: (S, 6) applied residual wrench (world force N, torque N·m) per physics step.
+        support: (S,) a foot/hand touched the floor at that step; airborne: (S,) no floor contact at all.
+        violations: physics-invariant violations found by the audit (empty = none).
+        cpu_s: CPU seconds of the stepping loop.
+        timestep: physics step (s); mass: kg; gravity: |g_z|.
+    """
+
+    status: str
+    fall_time: float | None
+    qpos: np.ndarray
+    residual: np.ndarray
+    support: np.ndarray
+    airborne: np.ndarray
+    violations: list[str] = field(default_factory=list)
+    cpu_s: float = 0.0
+    timestep: float = 1.0 / 450.0
+    mass: float = 72.0
+    gravity: float = 9.81
+
+    @property
+    def success(self) -> bool:
+        return self.status == "ok"
+
+    def residual_stats(self) -> dict[str, float]:
+        """Mean/peak residual force as a fraction of m·g, and torque in N·m (over all steps)."""
+        if self.residual.shape[0] == 0:
+            return {"force_mean_mg": 0.0, "force_peak_mg": 0.0, "torque_mean_nm": 0.0, "torque_peak_nm": 0.0,
+                    "airborne_frac": 0.0, "airborne_force_max_n": 0.0}
+        f = np.linalg.norm(self.residual[:, :3], axis=1) / (self.mass * self.gravity)
+        t = np.linalg.norm(self.residual[:, 3:], axis=1)
+        air = self.airborne
+        return {
+            "force_mean_mg": float(f.mean()),
+            "force_peak_mg": float(f.max()),
+            "torque_mean_nm": float(t.mean()),
+            "torque_peak_nm": float(t.max()),
+            "airborne_frac": float(air.mean()),
+            "airborne_force_max_n": float(np.abs(self.residual[air]).max()) if air.any() else 0.0,
+        }
+
+
+def _unstable(mujoco, data) -> bool:
+    w = data.warning
+    bad = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL, mujoco.mjtWarning.mjWARN_BADQPOS)
+    if any(w[int(b)].number > 0 for b in bad):
+        return True
+    return not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel)))
+
+
+def rollout(
+    model,
+    reference: Reference,
+    env: Environment = Environment(),
+    tracker: Tracker | None = None,
+    residual: ResidualConfig = ResidualConfig(),
+    fall: FallConfig = FallConfig(),
+    *,
+    stop_on_fall: bool = True,
+    audit: bool = False,
+) -> RolloutResult:
+    """Simulate the reference under ``env`` with ``tracker`` and the gated residual.
+
+    Args:
+        model: the humanoid; it is copied, the caller's model is not modified.
+        reference: from :func:`simdiff.sim.convert.make_reference`.
+        env: φ (validated by the caller).
+        tracker: default :class:`PDTracker`.
+        residual: residual config (``max_force=0`` is strict).
+        stop_on_fall: stop at the first fall (otherwise simulate to the end).
+        audit: check the physics invariants at every step (see :func:`_audit`).
+    Returns:
+        A :class:`RolloutResult`.
+    """
+    import mujoco
+
+    m = copy.copy(model)
+    ix: ModelIndex = model_index(m)
+    env.apply(m, ix.mass)
+    d = mujoco.MjData(m)
+    d.qpos[:] = reference.qpos[0]
+    d.qvel[:] = reference.qvel[0]
+    mujoco.mj_forward(m, d)
+    tracker = tracker or PDTracker()
+    tracker.reset(m, d, reference, ix)
+    res = RootResidual(residual, m, reference, ix, env.gravity)
+    n_sub = int(round(reference.dt / m.opt.timestep))
+    K = reference.num_frames
+    S = (K - 1) * n_sub
+    qpos = np.zeros((S + 1, m.nq))
+    qpos[0] = d.qpos
+    wrench = np.zeros((S, 6))
+    support = np.zeros(S, dtype=bool)
+    airborne = np.zeros(S, dtype=bool)
+    violations: list[str] = []
+    status, fall_time = "ok", None
+    ref_head = reference.body_pos[:, 15, 2]
+    hml = ix.hml_bodies
+    p = ix.pelvis
+    step = 0
+    t0 = time.process_time()
+    for k in range(K - 1):
+        d.ctrl[:] = tracker.act(d, k)
+        for _ in range(n_sub):
+            mujoco.mj_step1(m, d)
+            w = res.wrench(d, d.time)
+            d.xfrc_applied[p] = w
+            wrench[step] = w
+            airborne[step] = d.ncon == 0
+            support[step] = res.sim_support(d)
+            mujoco.mj_step2(m, d)
+            if audit:
+                violations.extend(_audit(m, d, ix, env, w, airborne[step], step))
+            step += 1
+            qpos[step] = d.qpos
+        if _unstable(mujoco, d):
+            status, fall_time = "unstable", d.time
+            break
+        # fall detection at the control rate
+        kk = k + 1
+        head = d.xpos[ix.head, 2]
+        if ref_head[kk] > fall.min_ref_head and head < fall.head_ratio * ref_head[kk]:
+            status, fall_time = "fell", d.time
+        else:
+            off = d.subtree_com[p] - reference.com[kk]
+            off[2] = 0.0
+            err = np.linalg.norm(d.xpos[hml] - off - reference.body_pos[kk], axis=1).mean()
+            if err > fall.max_error:
+                status, fall_time = "fell", d.time
+        if status != "ok" and stop_on_fall:
+            break
+    cpu = time.process_time() - t0
+    if status == "fell" and not stop_on_fall:
+        pass
+    return RolloutResult(
+        status=status, fall_time=fall_time, qpos=qpos[: step + 1], residual=wrench[:step], support=support[:step],
+        airborne=airborne[:step], violations=violations, cpu_s=cpu, timestep=float(m.opt.timestep), mass=ix.mass,
+        gravity=abs(env.gravity),
+    )
+
+
+def _audit(m, d, ix: ModelIndex, env: Environment, w: np.ndarray, airborne: bool, step: int) -> list[str]:
+    """Physics invariants of one step; returns messages for the violated ones.
+
+    * no generalised applied force (``qfrc_applied`` = 0);
+    * no Cartesian force on any body but the pelvis, whose wrench equals the logged residual;
+    * the residual is exactly zero when no geom touches the floor (airborne);
+    * gravity vector equals φ (g_z and the mass-distributed wind), no fluid/wind options;
+    * no actuator or passive force on the 6 root dofs.
+    """
+    out = []
+    if np.any(d.qfrc_applied != 0):
+        out.append(f"step {step}: qfrc_applied non-zero")
+    others = np.delete(d.xfrc_applied, ix.pelvis, axis=0)
+    if np.any(others != 0):
+        out.append(f"step {step}: xfrc_applied on a body other than the pelvis")
+    if not np.array_equal(d.xfrc_applied[ix.pelvis], w):
+        out.append(f"step {step}: pelvis wrench differs from the logged residual")
+    if airborne and np.any(w != 0):
+        out.append(f"step {step}: residual non-zero while airborne")
+    if not np.allclose(m.opt.gravity, env.gravity_vector(ix.mass), rtol=0, atol=1e-12):
+        out.append(f"step {step}: gravity differs from φ")
+    if m.opt.density != 0 or m.opt.viscosity != 0 or np.any(m.opt.wind != 0):
+        out.append(f"step {step}: fluid/wind options set")
+    if np.any(d.qfrc_actuator[:6] != 0) or np.any(d.qfrc_passive[:6] != 0):
+        out.append(f"step {step}: actuator/passive force on the root")
+    return out

@@ -1,0 +1,90 @@
+"""Joints ⇄ humanoid conversions: IK round trip, stance pass, filtering, features, ID screen."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from simdiff.errors import SimdiffError  # noqa: E402
+from simdiff.sim import synthetic  # noqa: E402
+from simdiff.sim.convert import (  # noqa: E402
+    RetargetConfig,
+    _smooth,
+    make_reference,
+    qpos_to_joints,
+    resample_qpos,
+)
+from simdiff.sim.humanoid import load_model, model_index  # noqa: E402
+
+
+def test_roundtrip_synthetic_squat():
+    m = load_model()
+    joints = synthetic.squat(40)
+    ref = make_reference(m, joints)
+    assert ref.qpos.shape == (int(np.ceil(39 * 1.5)) + 1, 76)
+    back = qpos_to_joints(m, ref.qpos)  # 30 Hz; every 3rd frame is an even 20-fps frame
+    assert back.dtype == np.float32
+    err = np.linalg.norm(back[::3] - joints[::2][: len(back[::3])] - [0, ref.ground_shift, 0], axis=-1)
+    assert err.mean() < 0.02
+    assert abs(ref.ground_shift) < 0.01
+    assert ref.contact.all()  # both feet flat on the floor throughout
+    feas = ref.feasibility(model_index(m).mass)
+    assert feas["force_p90_mg"] < 0.05  # a slow squat is dynamically feasible
+
+
+def test_stance_feet_held_flat_on_floor():
+    m = load_model()
+    ref = make_reference(m, synthetic.walk_in_place(40))
+    from simdiff.sim.convert import foot_heights
+
+    h, _ = foot_heights(m, ref.qpos)
+    stance = h[ref.contact]
+    assert np.percentile(np.abs(stance), 90) < 0.01
+
+
+def test_smoothing_keeps_boundary_velocity():
+    t = np.arange(20, dtype=float)[:, None]
+    x = 0.3 * t  # a ramp: odd-reflection padding leaves it unchanged
+    assert np.allclose(_smooth(x, 1.5), x)
+
+
+def test_resample_lengths():
+    q = np.zeros((21, 76))
+    q[:, 3] = 1.0
+    q[:, 0] = np.arange(21) / 20.0  # 1 m/s for 1 s
+    r = resample_qpos(q, 20.0, 30.0)
+    assert r.shape[0] == 31
+    assert np.allclose(r[:, 0], np.arange(31) / 30.0)
+
+
+def test_bad_input():
+    m = load_model()
+    with pytest.raises(SimdiffError):
+        make_reference(m, np.zeros((10, 21, 3)))
+    with pytest.raises(SimdiffError):
+        make_reference(m, np.zeros((2, 22, 3)))
+    bad = synthetic.standing(10).astype(float)
+    bad[3, 4, 1] = np.nan
+    with pytest.raises(SimdiffError):
+        make_reference(m, bad)
+
+
+def test_features_roundtrip_shape():
+    pytest.importorskip("simdiff.motion.features")
+    from simdiff.sim.convert import joints_to_features
+
+    m = load_model()
+    joints = synthetic.squat(30)
+    ref = make_reference(m, joints, RetargetConfig(stance_pass=False))
+    back = qpos_to_joints(m, ref.qpos[::3])
+    f = joints_to_features(back)
+    assert f.shape == (back.shape[0] - 1, 263)
+
+
+def test_real_clip_ik_error(shared_data):
+    m = load_model()
+    joints = np.load(shared_data / "humanml3d" / "samples" / "new_joints" / "012314.npy")[:60]
+    ref = make_reference(m, joints)
+    assert np.median(ref.ik_error) < 0.03  # metres; arms above the head are the worst frames

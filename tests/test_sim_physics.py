@@ -1,0 +1,103 @@
+"""Physics validity of rollouts: force invariants, the airborne-zero residual, instability, a short tracked clip."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from simdiff.sim import synthetic  # noqa: E402
+from simdiff.sim.convert import make_reference  # noqa: E402
+from simdiff.sim.env import Environment  # noqa: E402
+from simdiff.sim.humanoid import load_model  # noqa: E402
+from simdiff.sim.project import project  # noqa: E402
+from simdiff.sim.residual import ResidualConfig  # noqa: E402
+from simdiff.sim.rollout import rollout  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def squat_ref():
+    return make_reference(load_model(), synthetic.squat(30))
+
+
+def test_invariants_hold_every_step(squat_ref):
+    for env in (Environment(), Environment(-3.0, 10.0, 0.0), Environment(-15.0, 0.0, -10.0)):
+        res = rollout(load_model(), squat_ref, env, audit=True)
+        assert res.violations == []
+        assert res.success
+        assert res.residual.shape[0] == res.qpos.shape[0] - 1
+
+
+def test_residual_zero_while_airborne_and_on_after_landing(squat_ref):
+    ref = copy.deepcopy(squat_ref)
+    ref.qpos[:, 2] += 0.25  # start 25 cm above the floor: ~0.23 s of free fall
+    res = rollout(load_model(), ref, Environment(), audit=True)
+    assert res.violations == []
+    assert res.airborne[:50].all()
+    assert np.all(res.residual[res.airborne] == 0.0)
+    assert np.any(res.residual[~res.airborne] != 0.0)  # the gate does open on contact
+    # free fall: the COM's vertical motion over the airborne steps is ballistic
+    import mujoco
+
+    m = load_model()
+    d = mujoco.MjData(m)
+    n = int(np.argmin(res.airborne))
+
+    def com_z(q):
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        return d.subtree_com[1, 2]
+
+    vz0 = 0.0
+    t = n * res.timestep
+    assert com_z(res.qpos[0]) - com_z(res.qpos[n]) == pytest.approx(0.5 * 9.81 * t**2 - vz0 * t, rel=0.03)
+
+
+def test_strict_has_no_residual(squat_ref):
+    res = rollout(load_model(), squat_ref, Environment(), residual=ResidualConfig(max_force=0.0), audit=True)
+    assert np.all(res.residual == 0.0)
+    assert res.violations == []
+
+
+def test_residual_bounds(squat_ref):
+    cfg = ResidualConfig(max_force=0.1)
+    ref = copy.deepcopy(squat_ref)
+    ref.com[:, 2] += 0.3  # an unreachable COM height: the residual saturates
+    res = rollout(load_model(), ref, Environment(), residual=cfg, audit=True)
+    f = np.linalg.norm(res.residual[:, :3], axis=1)
+    assert f.max() <= 0.1 * res.mass * 9.81 + 1e-6
+    assert f.max() > 0.09 * res.mass * 9.81
+    assert np.all(res.residual[:, 2] >= 0.0)  # vertical part push-only
+    assert np.linalg.norm(res.residual[:, 3:], axis=1).max() <= 60.0 + 1e-6
+
+
+def test_instability_is_a_failure(squat_ref):
+    ref = copy.deepcopy(squat_ref)
+    ref.qvel[0, :] = 1e9  # absurd initial velocity
+    res = rollout(load_model(), ref, Environment())
+    assert res.status in ("unstable", "fell")
+    assert not res.success
+
+
+def test_short_tracked_clip():
+    out, info = project(synthetic.squat(40), Environment(), audit=True)
+    assert info.success and info.fall_frame is None
+    assert out.shape == (40, 22, 3) and out.dtype == np.float32
+    assert info.err_mm < 60
+    assert info.residual["force_mean_mg"] < 0.1
+    assert info.residual["airborne_force_max_n"] == 0.0
+    assert info.violations == []
+
+
+def test_real_clip_tracked(shared_data):
+    from simdiff.motion.normalize import Normalizer
+
+    joints = np.load(shared_data / "humanml3d" / "samples" / "new_joints" / "012314.npy")[:60]
+    out, info = project(joints, Environment(), normalizer=Normalizer.from_dir(shared_data / "humanml3d"), audit=True)
+    assert info.violations == []
+    assert info.success
+    assert np.isfinite(info.d_l2) and info.d_l2 < 10
