@@ -1,0 +1,153 @@
+"""``simdiff train backbone|adapters``: train the MDM backbone, or SimDiff's adapters on a frozen one.
+
+Multi-process: ``torchrun --nproc_per_node N -m simdiff train backbone ...`` (gloo on CPU,
+nccl on CUDA); ``--batch-size`` is the global batch.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from simdiff.cli.main import command_group
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    data = p.add_mutually_exclusive_group(required=True)
+    data.add_argument("--data", type=Path, help="HumanML3D-layout directory (new_joint_vecs/, texts/, Mean.npy, Std.npy, <split>.txt)")
+    data.add_argument("--synthetic", type=int, metavar="N", help="train on N synthetic clips (smoke tests only)")
+    p.add_argument("--split", default="train", help="split file name under --data (default: train)")
+    p.add_argument("--out", type=Path, required=True, help="run folder: checkpoints/, model/ (resumes if it has checkpoints)")
+    p.add_argument("--config", type=Path, help="a run config JSON (see configs/); flags below override it")
+    p.add_argument("--steps", type=int, help="total optimiser steps")
+    p.add_argument("--batch-size", type=int, help="global batch size")
+    p.add_argument("--lr", type=float, help="AdamW learning rate (default 1e-4)")
+    p.add_argument("--seed", type=int, help="seed for init, data order, noise, dropout (default 10)")
+    p.add_argument("--ema", action=argparse.BooleanOptionalAction, default=None, help="keep and export an EMA of the weights")
+    p.add_argument("--ema-decay", type=float, help="EMA decay (default 0.9999)")
+    p.add_argument("--save-every", type=int, help="checkpoint period in steps")
+    p.add_argument("--device", default="cpu", help="torch device, e.g. cpu, cuda, cuda:1 (default: cpu)")
+    p.add_argument("--clip-weights", help="local CLIP ViT-B/32 weights file (with --text-encoder clip)")
+    p.add_argument("--no-resume", action="store_true", help="refuse to continue an existing run folder")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    group = command_group(subparsers, "train", "train the diffusion backbone or SimDiff's adapters")
+    b = group.add_parser("backbone", help="train the MDM-style backbone from scratch",
+                         description="Train the text-to-motion backbone (x0-prediction, cosine schedule, T=1000).")
+    _common(b)
+    b.add_argument("--size", choices=["mdm", "small", "tiny"], help="network size (default small; mdm = the paper's)")
+    b.add_argument("--text-encoder", choices=["minilm", "clip"], help="text encoder (default minilm)")
+    b.add_argument("--mask-frames", action=argparse.BooleanOptionalAction, default=None,
+                   help="mask padded frames in attention (off reproduces MDM)")
+    b.set_defaults(func=run, mode="backbone")
+    a = group.add_parser("adapters", help="train the Sim Encoder and Motion Adapters on a frozen backbone",
+                         description="Train SimDiff's Sim Encoder + Motion Adapters; the backbone stays frozen. "
+                                     "Dataset items must carry φ ('env' (3,) or 'env_index').")
+    _common(a)
+    a.add_argument("--init", type=Path, help="backbone model folder (model.safetensors + config.json)")
+    a.add_argument("--sim-mode", choices=["continuous", "categorical"], help="φ as (g_z, w_x, w_y) floats or a category")
+    a.add_argument("--num-categories", type=int, help="number of environment categories (categorical)")
+    a.set_defaults(func=run, mode="adapters")
+
+
+def _run_config(args: argparse.Namespace):
+    import json
+
+    from simdiff.errors import SimdiffError
+    from simdiff.model.checkpoint import read_config
+    from simdiff.model.config import PRESETS, SimConfig, backbone_preset, config_from_dict
+    from simdiff.text.base import text_dim
+    from simdiff.train.config import RunConfig
+
+    if args.config is not None:
+        if not args.config.is_file():
+            raise SimdiffError(f"{args.config}: no such config file")
+        try:
+            config = config_from_dict(json.loads(args.config.read_text()), RunConfig)
+        except json.JSONDecodeError as exc:
+            raise SimdiffError(f"{args.config}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+    elif (args.out / "train_config.json").is_file():  # continuing a run: start from its config
+        config = config_from_dict(json.loads((args.out / "train_config.json").read_text()), RunConfig)
+    else:
+        config = RunConfig()
+    tc = config.train
+    tc.mode = args.mode
+    for flag, field in (("steps", "steps"), ("batch_size", "batch_size"), ("seed", "seed"), ("ema", "ema"),
+                        ("ema_decay", "ema_decay"), ("save_every", "save_every")):
+        if getattr(args, flag) is not None:
+            setattr(tc, field, getattr(args, flag))
+    if args.lr is not None:
+        tc.optim.lr = args.lr
+    if tc.steps < 1 or tc.batch_size < 1:
+        raise SimdiffError("--steps and --batch-size must be positive")
+    if args.mode == "backbone":
+        model = config.model
+        if args.size is not None:
+            model.backbone = backbone_preset(args.size, mask_frames=model.backbone.mask_frames)
+        assert args.size is None or args.size in PRESETS
+        if args.text_encoder is not None:
+            model.text_encoder = args.text_encoder
+        if args.mask_frames is not None:
+            model.backbone.mask_frames = args.mask_frames
+        model.backbone.text_dim = text_dim(model.text_encoder)
+        model.sim = None
+    else:
+        if args.init is not None:
+            init = read_config(args.init)
+            config.model.backbone, config.model.text_encoder = init.backbone, init.text_encoder
+        sim = config.model.sim or SimConfig()
+        if args.sim_mode is not None:
+            sim.mode = args.sim_mode
+        if args.num_categories is not None:
+            sim.num_categories = args.num_categories
+        config.model.sim = sim
+    return config
+
+
+def _dataset(args: argparse.Namespace, seed: int):
+    from simdiff.errors import SimdiffError
+    from simdiff.train.data import synthetic_dataset
+
+    if args.synthetic is not None:
+        if args.synthetic < 1:
+            raise SimdiffError("--synthetic needs at least one clip")
+        return synthetic_dataset(args.synthetic, frames=60, seed=seed, with_env=args.mode == "adapters")
+    from simdiff.data.humanml3d import HumanML3D
+
+    return HumanML3D(args.data, split=args.split, seed=seed)
+
+
+def run(args: argparse.Namespace) -> int:
+    import torch
+
+    from simdiff.errors import SimdiffError
+    from simdiff.text.base import load_text_encoder
+    from simdiff.train.distributed import init_from_env, shutdown
+    from simdiff.train.state import latest_checkpoint
+    from simdiff.train.trainer import Trainer
+
+    config = _run_config(args)
+    if args.no_resume and latest_checkpoint(args.out) is not None:
+        raise SimdiffError(f"{args.out} already holds checkpoints (drop --no-resume to continue it)")
+    try:
+        device = torch.device(args.device)
+    except RuntimeError:
+        raise SimdiffError(f"unknown device {args.device!r}") from None
+    dist = init_from_env(device)
+    if device.type == "cuda" and dist.world_size > 1:
+        device = torch.device("cuda", dist.local_rank)
+    try:
+        encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
+        dataset = _dataset(args, config.train.seed)
+        trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
+                          init_model=getattr(args, "init", None), rank=dist.rank, world_size=dist.world_size)
+        losses = trainer.train(progress=not args.no_progress)
+        if dist.is_main:
+            tail = losses[-10:]
+            final = f", final loss {sum(tail) / len(tail):.4f}" if tail else ""
+            print(f"trained {config.train.mode} to step {trainer.step}{final}; model: {args.out / 'model'}")
+    finally:
+        shutdown()
+    return 0

@@ -1,0 +1,55 @@
+"""Training configs (nested dataclasses; saved as ``train_config.json`` in the run folder)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from simdiff.model.config import ModelConfig
+
+
+@dataclass
+class OptimConfig:
+    """AdamW settings (MDM: lr 1e-4, no weight decay, no clipping)."""
+
+    lr: float = 1e-4
+    weight_decay: float = 0.0
+    betas: tuple[float, float] = (0.9, 0.999)
+    grad_clip: float = 0.0
+
+
+@dataclass
+class TrainConfig:
+    """One training run.
+
+    Attributes:
+        mode: ``"backbone"`` (train everything) or ``"adapters"`` (frozen backbone; Sim Encoder + adapters).
+        steps: optimiser steps in total (a resumed run continues up to this).
+        batch_size: global batch (split evenly across DDP processes).
+        seed: seeds data order, caption/crop choices, t, ε, text dropout and dropout, per step.
+        cond_mask_prob: probability of dropping the text of a sample (CFG training; 0.1).
+        ema: keep an exponential moving average of the trained weights (exported if on).
+        ema_decay: EMA β.
+        save_every: checkpoint period in steps (0: only at the end).
+        keep_checkpoints: how many step folders to keep.
+        log_every: loss averaging window for the progress bar.
+    """
+
+    mode: str = "backbone"
+    steps: int = 1000
+    batch_size: int = 32
+    seed: int = 10
+    cond_mask_prob: float = 0.1
+    ema: bool = False
+    ema_decay: float = 0.9999
+    save_every: int = 500
+    keep_checkpoints: int = 2
+    log_every: int = 10
+    optim: OptimConfig = field(default_factory=OptimConfig)
+
+
+@dataclass
+class RunConfig:
+    """What a run folder's ``train_config.json`` holds."""
+
+    model: ModelConfig = field(default_factory=ModelConfig)
+    train: TrainConfig = field(default_factory=TrainConfig)

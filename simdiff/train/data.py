@@ -1,0 +1,137 @@
+"""The dataset protocol the trainer needs, deterministic batching, and a synthetic dataset for tests.
+
+Any ``Sequence``-like object with ``__len__`` and ``__getitem__`` (optionally
+``get(index, rng)``) returning ``dict(motion (196, 263) float32 normalised zero-padded,
+length int, caption str, ...)`` works; ``simdiff.data.humanml3d.HumanML3D`` is one. Simulator-
+augmented items add ``env`` (3,) float32 φ = (g_z, w_x, w_y) and/or ``env_index`` int.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol, Sequence
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from simdiff.errors import SimdiffError
+
+
+class MotionDataset(Protocol):
+    """What the trainer reads: items as described in the module docstring."""
+
+    def __len__(self) -> int: ...
+
+    def __getitem__(self, index: int) -> dict[str, Any]: ...
+
+
+def fetch(dataset: MotionDataset, index: int, rng: np.random.Generator) -> dict[str, Any]:
+    """Item ``index``, drawn with ``rng`` when the dataset supports it (so runs are reproducible)."""
+    get = getattr(dataset, "get", None)
+    return get(index, rng) if callable(get) else dataset[index]
+
+
+def collate(items: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """Stack items: motion (B, T, 263), lengths (B,), mask (B, T) bool, captions, and env / env_index when present."""
+    if not items:
+        raise SimdiffError("cannot collate an empty batch")
+    motion = torch.stack([torch.as_tensor(np.asarray(it["motion"]), dtype=torch.float32) for it in items])
+    lengths = torch.tensor([int(it["length"]) for it in items], dtype=torch.long)
+    batch: dict[str, Any] = {
+        "motion": motion,
+        "lengths": lengths,
+        "mask": torch.arange(motion.shape[1])[None, :] < lengths[:, None],
+        "captions": [str(it["caption"]) for it in items],
+    }
+    if all("env" in it for it in items):
+        batch["env"] = torch.stack([torch.as_tensor(np.asarray(it["env"]), dtype=torch.float32).reshape(3) for it in items])
+    if all("env_index" in it for it in items):
+        batch["env_index"] = torch.tensor([int(it["env_index"]) for it in items], dtype=torch.long)
+    return batch
+
+
+class StepBatcher:
+    """Which dataset indices step k uses: a fresh seeded permutation per epoch, sliced per process.
+
+    Depends only on ``(seed, step, rank)``, so an interrupted run resumes on the same batches.
+    """
+
+    def __init__(self, size: int, batch_size: int, seed: int, world_size: int = 1, rank: int = 0) -> None:
+        if size <= 0:
+            raise SimdiffError("the training dataset is empty")
+        if batch_size % world_size:
+            raise SimdiffError(f"batch size {batch_size} is not divisible by {world_size} processes")
+        self.size = size
+        self.global_batch = batch_size
+        self.local_batch = batch_size // world_size
+        self.seed = seed
+        self.rank = rank
+        self._perms: dict[int, Tensor] = {}
+
+    def _perm(self, epoch: int) -> Tensor:
+        if epoch not in self._perms:
+            if len(self._perms) > 4:
+                self._perms.pop(min(self._perms))
+            g = torch.Generator().manual_seed(self.seed * 1_000_003 + epoch)
+            self._perms[epoch] = torch.randperm(self.size, generator=g)
+        return self._perms[epoch]
+
+    def indices(self, step: int) -> list[int]:
+        """This process's dataset indices for step ``step``."""
+        start = step * self.global_batch + self.rank * self.local_batch
+        return [int(self._perm(p // self.size)[p % self.size]) for p in range(start, start + self.local_batch)]
+
+
+class TensorMotionDataset:
+    """Items from in-memory normalised clips, for tests, demos and overfitting checks.
+
+    Args:
+        motions: list of (L_i, 263) float32 normalised features (L_i ≤ max_frames).
+        captions: one caption per clip.
+        envs: optional (3,) φ per clip; env_indices: optional int per clip.
+        max_frames: padded length (196).
+    """
+
+    def __init__(self, motions: Sequence[np.ndarray | Tensor], captions: Sequence[str],
+                 envs: Sequence[Sequence[float]] | None = None, env_indices: Sequence[int] | None = None,
+                 max_frames: int = 196) -> None:
+        if len(motions) != len(captions):
+            raise SimdiffError("need one caption per motion")
+        self.motions = [np.asarray(m, dtype=np.float32) for m in motions]
+        self.captions = list(captions)
+        self.envs = None if envs is None else [np.asarray(e, dtype=np.float32) for e in envs]
+        self.env_indices = None if env_indices is None else [int(i) for i in env_indices]
+        self.max_frames = max_frames
+
+    def __len__(self) -> int:
+        return len(self.motions)
+
+    def __getitem__(self, index: int) -> dict[str, Any]:
+        m = self.motions[index][: self.max_frames]
+        out = np.zeros((self.max_frames, m.shape[1]), dtype=np.float32)
+        out[: len(m)] = m
+        item: dict[str, Any] = {"motion": out, "length": len(m), "caption": self.captions[index],
+                                "tokens": self.captions[index].split(), "id": f"{index:06d}"}
+        if self.envs is not None:
+            item["env"] = self.envs[index]
+        if self.env_indices is not None:
+            item["env_index"] = self.env_indices[index]
+        return item
+
+
+def synthetic_dataset(num_clips: int = 8, frames: int = 60, max_frames: int = 196, seed: int = 0,
+                      with_env: bool = False) -> TensorMotionDataset:
+    """Smooth random normalised clips (low-frequency sinusoids) with distinct captions.
+
+    No motion semantics: for smoke tests of the training machinery only.
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(frames, dtype=np.float32)[:, None] / 20.0
+    motions, captions, envs = [], [], []
+    for i in range(num_clips):
+        freq = rng.uniform(0.2, 1.5, size=(1, 263)).astype(np.float32)
+        phase = rng.uniform(0, 2 * np.pi, size=(1, 263)).astype(np.float32)
+        motions.append(np.sin(2 * np.pi * freq * t + phase).astype(np.float32))
+        captions.append(f"synthetic motion number {i}")
+        envs.append([float(rng.uniform(-15, -3)), float(rng.uniform(-10, 10)), float(rng.uniform(-10, 10))])
+    return TensorMotionDataset(motions, captions, envs if with_env else None, max_frames=max_frames)

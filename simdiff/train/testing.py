@@ -1,0 +1,36 @@
+"""Small helpers for tests and smoke runs: a deterministic stand-in text encoder and tiny configs."""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import torch
+
+from simdiff.model.config import ModelConfig, SimConfig, backbone_preset
+from simdiff.train.config import OptimConfig, RunConfig, TrainConfig
+
+
+class HashTextEncoder:
+    """Deterministic pseudo-embeddings (unit-variance Gaussian per caption), independent of PYTHONHASHSEED.
+
+    Stands in for MiniLM (``name`` ``minilm``, 384-d) where real text semantics do not matter.
+    """
+
+    name = "minilm"
+
+    def __init__(self, dim: int = 384) -> None:
+        self.dim = dim
+
+    def encode(self, texts: Sequence[str]) -> torch.Tensor:
+        """(B,) captions → (B, dim) float32."""
+        seeds = [sum((i + 1) * ord(c) for i, c in enumerate(t)) for t in texts]
+        return torch.stack([torch.randn(self.dim, generator=torch.Generator().manual_seed(s)) for s in seeds])
+
+
+def tiny_run_config(steps: int = 10, mode: str = "backbone", sim: bool = False, dropout: float = 0.1,
+                    lr: float = 1e-3, **train: Any) -> RunConfig:
+    """A ``tiny``-preset run config (batch 4, no periodic checkpoints unless ``save_every`` is given)."""
+    model = ModelConfig(backbone=backbone_preset("tiny", dropout=dropout), sim=SimConfig() if sim else None)
+    train.setdefault("batch_size", 4)
+    train.setdefault("save_every", 0)
+    return RunConfig(model=model, train=TrainConfig(mode=mode, steps=steps, optim=OptimConfig(lr=lr), **train))

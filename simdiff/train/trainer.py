@@ -1,0 +1,274 @@
+"""The trainer: optimiser, EMA, deterministic batches, checkpoints, resume, DDP.
+
+Backbone mode trains an ``MDMBackbone``; adapters mode loads a backbone checkpoint into a
+``SimDiffNet``, freezes it, and trains only the Sim Encoder and the Motion Adapters.
+
+Every random choice of step k (batch indices, caption/crop, t, ε, text dropout, dropout
+masks) is seeded from ``(seed, k, rank)``, so a run stopped after any checkpoint and resumed
+ends with bit-identical weights.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import torch
+from torch import Tensor, nn
+
+from simdiff.diffusion.ddpm import DDPMScheduler
+from simdiff.diffusion.losses import diffusion_loss
+from simdiff.errors import SimdiffError
+from simdiff.model.checkpoint import build_network, load_pretrained, save_pretrained
+from simdiff.model.condition import Condition
+from simdiff.model.simdiff_net import SimDiffNet
+from simdiff.text.cache import CachedTextEncoder
+from simdiff.train.config import RunConfig
+from simdiff.train.data import MotionDataset, StepBatcher, collate, fetch
+from simdiff.train.ema import EMA
+from simdiff.train.state import latest_checkpoint, read_checkpoint, write_checkpoint
+
+
+TEXT_CACHE = "text_cache.safetensors"
+
+
+def _seeds(*key: int) -> tuple[int, int]:
+    """Two independent 63-bit seeds derived from ``key``."""
+    a, b = np.random.SeedSequence([int(k) & 0xFFFFFFFF for k in key]).generate_state(2, dtype=np.uint64)
+    return int(a) >> 1, int(b) >> 1
+
+
+class Trainer:
+    """Train a backbone or SimDiff adapters into ``run_dir``.
+
+    Args:
+        run_dir: the run folder (``checkpoints/``, ``model/``, ``train_config.json``).
+        config: model + training config. For ``adapters``, ``config.model.sim`` must be set
+            and the backbone part is taken from ``init_model``.
+        dataset: items ``dict(motion (196, 263), length, caption[, env][, env_index])``.
+        text_encoder: anything with ``name``, ``dim`` and ``encode(list[str]) -> (B, dim)``;
+            default: the encoder named in the model config.
+        device: where to train (passed explicitly; float32).
+        init_model: a backbone model folder (``model.safetensors`` + ``config.json``), adapters mode.
+        mean, std: (263,) normaliser saved with the model (default: ``dataset.normalizer`` or init model's).
+        resume: continue from ``run_dir``'s latest checkpoint when there is one.
+        rank, world_size: DDP process (``torch.distributed`` must already be initialised when > 1).
+    """
+
+    def __init__(self, run_dir: str | Path, config: RunConfig, dataset: MotionDataset, *, text_encoder: Any = None,
+                 device: torch.device | str = "cpu", init_model: str | Path | None = None,
+                 mean: Tensor | None = None, std: Tensor | None = None, resume: bool = True,
+                 rank: int = 0, world_size: int = 1) -> None:
+        self.run_dir = Path(run_dir)
+        self.config = config
+        self.dataset = dataset
+        self.device = torch.device(device)
+        self.rank, self.world_size = rank, world_size
+        tc = config.train
+        if tc.mode not in ("backbone", "adapters"):
+            raise SimdiffError(f"training mode must be backbone or adapters, got {tc.mode!r}")
+        with torch.random.fork_rng(devices=[]):
+            torch.manual_seed(tc.seed)  # the initial weights depend on the seed only
+            self.network = build_network(config.model)
+        init_mean, init_std = None, None
+        if tc.mode == "adapters":
+            if config.model.sim is None or not isinstance(self.network, SimDiffNet):
+                raise SimdiffError("adapter training needs a sim config (the SimDiff part)")
+            if init_model is None and latest_checkpoint(self.run_dir) is None:
+                raise SimdiffError("adapter training needs a backbone checkpoint (--init MODEL_DIR)")
+            if init_model is not None:
+                init_mean, init_std = self._load_backbone(Path(init_model))
+            self.network.backbone.requires_grad_(False)
+        elif config.model.sim is not None:
+            raise SimdiffError("backbone training takes no sim config; train adapters afterwards")
+        self.mean, self.std = self._normalizer(mean, std, init_mean, init_std)
+        self.network.to(self.device)
+        self.trainable = {n: p for n, p in self.network.named_parameters() if p.requires_grad}
+        o = tc.optim
+        self.optimizer = torch.optim.AdamW(list(self.trainable.values()), lr=o.lr, weight_decay=o.weight_decay,
+                                           betas=tuple(o.betas))
+        self.scheduler = DDPMScheduler()
+        if text_encoder is None:
+            from simdiff.text.base import load_text_encoder
+
+            text_encoder = load_text_encoder(config.model.text_encoder, self.device)
+        if text_encoder.dim != config.model.backbone.text_dim:
+            raise SimdiffError(f"text encoder gives {text_encoder.dim}-d vectors, the model expects {config.model.backbone.text_dim}")
+        self.text = text_encoder if isinstance(text_encoder, CachedTextEncoder) else CachedTextEncoder(text_encoder, self.device)
+        if resume:  # embeddings as of the last checkpoint, so a resumed run sees bit-identical text vectors
+            self.text.load(self.run_dir / TEXT_CACHE)
+        self.batcher = StepBatcher(len(dataset), tc.batch_size, tc.seed, world_size, rank)
+        self.step = 0
+        ema_state = None
+        checkpoint = latest_checkpoint(self.run_dir) if resume else None
+        if checkpoint is not None:
+            ema_state = self._restore(checkpoint)
+        self.model: nn.Module = self.network
+        if world_size > 1:
+            from torch.nn.parallel import DistributedDataParallel
+
+            self.model = DistributedDataParallel(self.network, device_ids=None if self.device.type == "cpu" else [self.device])
+        self.ema = EMA(self.trainable, tc.ema_decay) if tc.ema else None
+        if self.ema is not None and ema_state is not None:
+            self.ema.load_state_dict(ema_state)
+        self.history: list[float] = []
+        self._saved_step = self.step if checkpoint is not None else -1
+
+    # --- setup ----------------------------------------------------------------------------
+
+    def _load_backbone(self, folder: Path) -> tuple[Tensor | None, Tensor | None]:
+        network, init_config, extra = load_pretrained(folder, "cpu")
+        backbone = network.backbone if isinstance(network, SimDiffNet) else network
+        if dataclasses.asdict(init_config.backbone) != dataclasses.asdict(self.config.model.backbone):
+            raise SimdiffError(f"{folder}: backbone config differs from this run's model config")
+        assert isinstance(self.network, SimDiffNet)
+        self.network.backbone.load_state_dict(backbone.state_dict())
+        return extra.get("normalizer.mean"), extra.get("normalizer.std")
+
+    def _normalizer(self, mean: Tensor | None, std: Tensor | None, init_mean: Tensor | None,
+                    init_std: Tensor | None) -> tuple[Tensor, Tensor]:
+        norm = getattr(self.dataset, "normalizer", None)
+        n = self.config.model.backbone.nfeats
+        if mean is None:
+            mean = torch.as_tensor(np.asarray(norm.mean)) if norm is not None else init_mean
+        if std is None:
+            std = torch.as_tensor(np.asarray(norm.std)) if norm is not None else init_std
+        mean = torch.zeros(n) if mean is None else mean
+        std = torch.ones(n) if std is None else std
+        return mean.float().cpu(), std.float().cpu()
+
+    def _restore(self, folder: Path) -> dict[str, Tensor] | None:
+        step, model_tensors, optim_state, ema_state, run = read_checkpoint(folder)
+        if run.get("model") != dataclasses.asdict(self.config.model):
+            raise SimdiffError(f"{folder}: checkpoint was trained with another model config; use a new run folder")
+        own = set(self.network.state_dict())
+        self.network.load_state_dict({k: v for k, v in model_tensors.items() if k in own}, strict=True)
+        self.mean = model_tensors.get("normalizer.mean", self.mean)
+        self.std = model_tensors.get("normalizer.std", self.std)
+        self.optimizer.load_state_dict(optim_state)
+        self.step = step
+        return ema_state
+
+    # --- training ---------------------------------------------------------------------------
+
+    def batch(self, step: int) -> dict[str, Any]:
+        """The collated batch of step ``step`` for this process."""
+        rng = np.random.default_rng([self.config.train.seed, step, self.rank])
+        return collate([fetch(self.dataset, i, rng) for i in self.batcher.indices(step)])
+
+    def condition(self, batch: dict[str, Any], generator: torch.Generator) -> Condition:
+        """Text vectors with per-sample dropout (p = ``cond_mask_prob``) and φ (never dropped)."""
+        b = len(batch["captions"])
+        uncond = torch.rand(b, generator=generator) < self.config.train.cond_mask_prob
+        env = env_index = None
+        sim = self.config.model.sim
+        if sim is not None:
+            key = "env" if sim.mode == "continuous" else "env_index"
+            if key not in batch:
+                raise SimdiffError(f"adapter training needs an {key!r} entry in every dataset item")
+            env = batch.get("env") if sim.mode == "continuous" else None
+            env_index = batch.get("env_index") if sim.mode == "categorical" else None
+        mv = lambda v: None if v is None else v.to(self.device)  # noqa: E731
+        return Condition(text=self.text.encode(batch["captions"]), uncond=uncond.to(self.device),
+                         frame_mask=batch["mask"].to(self.device), env=mv(env), env_index=mv(env_index), alpha=1.0)
+
+    def train_step(self) -> float:
+        """One optimiser step; returns the (local) loss."""
+        tc = self.config.train
+        self.model.train()
+        batch = self.batch(self.step)
+        data_seed, dropout_seed = _seeds(tc.seed, self.step, self.rank)
+        generator = torch.Generator().manual_seed(data_seed)
+        cond = self.condition(batch, generator)
+        torch.manual_seed(dropout_seed)
+        x0 = batch["motion"].to(self.device)
+        mask = batch["mask"].to(self.device)
+        loss = diffusion_loss(self.model, self.scheduler, x0, cond, mask, generator=generator)
+        self.optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        if tc.optim.grad_clip > 0:
+            nn.utils.clip_grad_norm_(list(self.trainable.values()), tc.optim.grad_clip)
+        self.optimizer.step()
+        if self.ema is not None:
+            self.ema.update()
+        self.step += 1
+        value = float(loss.detach())
+        if not math.isfinite(value):
+            raise SimdiffError(f"loss became {value} at step {self.step}")
+        return value
+
+    def train(self, until: int | None = None, progress: bool = True,
+              on_step: Callable[[int, float], None] | None = None) -> list[float]:
+        """Train up to ``until`` (default ``config.train.steps``) steps, checkpointing on the way.
+
+        Returns the losses of the steps run in this call.
+        """
+        tc = self.config.train
+        end = min(tc.steps, until) if until is not None else tc.steps
+        bar = None
+        if progress and self.rank == 0:
+            from tqdm.auto import tqdm
+
+            bar = tqdm(total=tc.steps, initial=self.step, desc=f"train {tc.mode}", unit="step", dynamic_ncols=True)
+        losses: list[float] = []
+        window: list[float] = []
+        while self.step < end:
+            value = self.train_step()
+            losses.append(value)
+            window = (window + [value])[-max(1, tc.log_every):]
+            if bar is not None:
+                bar.update(1)
+                bar.set_postfix(loss=f"{sum(window) / len(window):.4f}")
+            if self.rank == 0 and (self.step % max(1, tc.log_every) == 0 or self.step == end):
+                self._log(sum(window) / len(window))
+            if on_step is not None:
+                on_step(self.step, value)
+            if tc.save_every and self.step % tc.save_every == 0:
+                self.save()
+        if bar is not None:
+            bar.close()
+        if self._saved_step != self.step:
+            self.save()
+        self.history.extend(losses)
+        return losses
+
+    # --- output -----------------------------------------------------------------------------
+
+    def _log(self, loss: float) -> None:
+        """Append ``{"step", "loss"}`` (loss averaged over the last ``log_every`` steps) to ``train_log.jsonl``."""
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        with open(self.run_dir / "train_log.jsonl", "a", encoding="utf-8") as f:
+            f.write(json.dumps({"step": self.step, "loss": round(loss, 6)}) + "\n")
+
+    def extra_tensors(self) -> dict[str, Tensor]:
+        return {"normalizer.mean": self.mean, "normalizer.std": self.std}
+
+    def export_state(self) -> dict[str, Tensor]:
+        """Weights for inference: the EMA average when EMA is on, else the raw weights."""
+        state = self.network.state_dict()
+        return self.ema.averaged_state(state) if self.ema is not None else dict(state)
+
+    def save(self) -> None:
+        """Checkpoint (resumable) and export ``run_dir/model`` (inference). Rank 0 writes; all wait."""
+        self._saved_step = self.step
+        if self.rank == 0:
+            run = dataclasses.asdict(self.config)
+            write_checkpoint(self.run_dir, self.step, {**self.network.state_dict(), **self.extra_tensors()},
+                             dataclasses.asdict(self.config.model), self.optimizer.state_dict(),
+                             self.ema.state_dict() if self.ema is not None else None, run,
+                             keep=self.config.train.keep_checkpoints)
+            exported = build_network(self.config.model)
+            exported.load_state_dict(self.export_state())
+            save_pretrained(self.run_dir / "model", exported, self.config.model, self.extra_tensors())
+            from simdiff.model.checkpoint import atomic_write_json
+
+            atomic_write_json(run, self.run_dir / "train_config.json")
+            self.text.save(self.run_dir / TEXT_CACHE)
+        if self.world_size > 1:
+            import torch.distributed as dist
+
+            dist.barrier()

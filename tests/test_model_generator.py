@@ -1,0 +1,65 @@
+"""Weights I/O (model.safetensors + config.json) and the inference-only MotionGenerator."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import torch
+
+from simdiff.errors import SimdiffError
+from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network, load_pretrained
+
+
+class HashText:
+    name = "minilm"
+    dim = 384
+
+    def encode(self, texts: list[str]) -> torch.Tensor:
+        return torch.stack([torch.randn(384, generator=torch.Generator().manual_seed(len(t) * 7919 + ord(t[0]))) for t in texts])
+
+
+def tiny(sim: bool = False) -> ModelConfig:
+    return ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig() if sim else None)
+
+
+def test_save_load_round_trip(tmp_path) -> None:
+    config = tiny(sim=True)
+    gen = MotionGenerator(build_network(config), config, HashText(), torch.full((263,), 2.0), torch.full((263,), 3.0))
+    gen.save(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["config.json", "model.safetensors"]
+    assert json.loads((tmp_path / "config.json").read_text())["sim"]["mode"] == "continuous"
+    net, cfg, extra = load_pretrained(tmp_path)
+    assert cfg == config
+    for key, value in gen.network.state_dict().items():
+        assert torch.equal(net.state_dict()[key], value)
+    assert torch.equal(extra["normalizer.std"], torch.full((263,), 3.0))
+
+
+def test_generate_shapes_lengths_and_seed(tmp_path) -> None:
+    config = tiny()
+    gen = MotionGenerator(build_network(config), config, HashText(), torch.full((263,), 1.0), torch.full((263,), 2.0))
+    out = gen.generate(["a person walks", "a person jumps"], [30, 20], sampler="ddim", steps=5, seed=3)
+    assert out.features.shape == (2, 30, 263)
+    assert torch.all(out.features[1, 20:] == 0)
+    assert torch.allclose(out.features[0], out.normalized[0] * 2 + 1)
+    again = gen.generate(["a person walks", "a person jumps"], [30, 20], sampler="ddim", steps=5, seed=3)
+    assert torch.equal(out.features, again.features)
+    assert [c.shape[0] for c in out.clips()] == [30, 20]
+
+
+def test_generate_rejects_bad_input() -> None:
+    gen = MotionGenerator(build_network(tiny()), tiny(), HashText())
+    with pytest.raises(SimdiffError, match="196"):
+        gen.generate(["walk"], 197, steps=2)
+    with pytest.raises(SimdiffError, match="backbone-only"):
+        gen.generate(["walk"], 20, env=(-9.81, 0, 0), steps=2)
+    sim = MotionGenerator(build_network(tiny(True)), tiny(True), HashText())
+    with pytest.raises(SimdiffError, match="env must be"):
+        sim.generate(["walk"] * 2, 20, env=[1.0, 2.0], steps=2)
+    assert sim.generate(["walk"] * 2, 20, env=(-3.0, 5.0, 0.0), alpha=0.5, steps=2).features.shape == (2, 20, 263)
+
+
+def test_load_pretrained_missing_folder(tmp_path) -> None:
+    with pytest.raises(SimdiffError, match="config.json"):
+        load_pretrained(tmp_path / "nope")

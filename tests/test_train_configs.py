@@ -1,0 +1,33 @@
+"""The shipped run configs parse, and unknown keys are rejected."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from simdiff.errors import SimdiffError
+from simdiff.model.config import config_from_dict
+from simdiff.train.config import RunConfig
+
+CONFIGS = sorted((Path(__file__).resolve().parents[1] / "configs").glob("*.json"))
+
+
+@pytest.mark.parametrize("path", CONFIGS, ids=[p.stem for p in CONFIGS])
+def test_config_parses(path: Path) -> None:
+    config = config_from_dict(json.loads(path.read_text()), RunConfig)
+    assert config.train.mode in ("backbone", "adapters")
+    assert (config.model.sim is not None) == (config.train.mode == "adapters")
+
+
+def test_unknown_key_rejected() -> None:
+    with pytest.raises(SimdiffError, match="lr_typo"):
+        config_from_dict({"train": {"optim": {"lr_typo": 1}}}, RunConfig)
+
+
+def test_mdm_config_is_the_papers() -> None:
+    config = config_from_dict(json.loads((CONFIGS[0].parent / "backbone_mdm.json").read_text()), RunConfig)
+    b = config.model.backbone
+    assert (b.latent_dim, b.num_layers, b.num_heads, b.ff_size, b.dropout, b.text_dim) == (512, 8, 4, 1024, 0.1, 512)
+    assert (config.train.batch_size, config.train.optim.lr, config.train.seed) == (64, 1e-4, 10)

@@ -1,0 +1,148 @@
+"""Trainer: loss falls, checkpoints are atomic and resumable bit-exactly, adapters train alone."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import torch
+from safetensors.torch import load_file
+
+from simdiff.errors import SimdiffError
+from simdiff.model import Condition, MotionGenerator, load_pretrained
+from simdiff.train import StepBatcher, Trainer, synthetic_dataset
+from simdiff.train.testing import HashTextEncoder as HashText
+from simdiff.train.testing import tiny_run_config as run_config
+from simdiff.train.state import latest_checkpoint
+
+
+@pytest.fixture(autouse=True)
+def _one_thread():
+    """The test machine's 2 cores are shared: one intra-op thread is faster and steadier here."""
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+
+def test_step_batcher_is_a_seeded_epoch_permutation() -> None:
+    b = StepBatcher(10, 4, seed=1)
+    first = [i for s in range(5) for i in b.indices(s)]
+    assert sorted(first[:10]) == list(range(10)) and sorted(first[10:20]) == list(range(10))
+    r0, r1 = StepBatcher(10, 4, 1, world_size=2, rank=0), StepBatcher(10, 4, 1, world_size=2, rank=1)
+    assert r0.indices(3) + r1.indices(3) == b.indices(3)
+    with pytest.raises(SimdiffError):
+        StepBatcher(10, 3, 1, world_size=2)
+
+
+def test_loss_falls_and_outputs_written(tmp_path) -> None:
+    ds = synthetic_dataset(4, 30, max_frames=30)
+    trainer = Trainer(tmp_path, run_config(60, save_every=25, dropout=0.0), ds, text_encoder=HashText())
+    losses = trainer.train(progress=False)
+    assert len(losses) == 60 and sum(losses[-10:]) < 0.8 * sum(losses[:10])
+    assert sorted(p.name for p in (tmp_path / "model").iterdir()) == ["config.json", "model.safetensors"]
+    assert latest_checkpoint(tmp_path).name == "step_000000060"
+    steps = sorted(p.name for p in (tmp_path / "checkpoints").glob("step_*"))
+    assert steps == ["step_000000050", "step_000000060"]  # keep_checkpoints = 2
+    assert not list((tmp_path / "checkpoints").glob(".tmp*"))
+    assert json.loads((tmp_path / "train_config.json").read_text())["train"]["steps"] == 60
+
+
+def _weights(folder: Path) -> dict[str, torch.Tensor]:
+    return load_file(str(folder / "model.safetensors"))
+
+
+class Interrupt(Exception):
+    pass
+
+
+@pytest.mark.parametrize("ema", [False, True])
+def test_resume_after_interruption_is_bit_exact(tmp_path, ema: bool) -> None:
+    ds = synthetic_dataset(6, 24, max_frames=24)
+    cfg = run_config(10, save_every=4, ema=ema, ema_decay=0.9)
+    Trainer(tmp_path / "a", cfg, ds, text_encoder=HashText()).train(progress=False)
+
+    def crash(step: int, loss: float) -> None:
+        if step == 6:
+            raise Interrupt
+
+    with pytest.raises(Interrupt):
+        Trainer(tmp_path / "b", cfg, ds, text_encoder=HashText()).train(progress=False, on_step=crash)
+    assert latest_checkpoint(tmp_path / "b").name == "step_000000004"
+    resumed = Trainer(tmp_path / "b", cfg, ds, text_encoder=HashText())
+    assert resumed.step == 4
+    resumed.train(progress=False)
+    for sub in ("model", "checkpoints/step_000000010"):
+        a, b = _weights(tmp_path / "a" / sub), _weights(tmp_path / "b" / sub)
+        assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a), sub
+    sa = load_file(str(tmp_path / "a/checkpoints/step_000000010/state.safetensors"))
+    sb = load_file(str(tmp_path / "b/checkpoints/step_000000010/state.safetensors"))
+    assert sa.keys() == sb.keys() and all(torch.equal(sa[k], sb[k]) for k in sa)
+    assert any(k.startswith("ema.") for k in sa) == ema
+
+
+def test_ema_export_differs_from_raw(tmp_path) -> None:
+    ds = synthetic_dataset(4, 20, max_frames=20)
+    trainer = Trainer(tmp_path, run_config(5, ema=True, ema_decay=0.5), ds, text_encoder=HashText())
+    trainer.train(progress=False)
+    exported = _weights(tmp_path / "model")
+    raw = trainer.network.state_dict()
+    name = "embed_text.weight"
+    assert not torch.equal(exported[name], raw[name])
+    assert torch.equal(exported[name], trainer.ema.shadow[name])
+
+
+def test_adapter_training_freezes_the_backbone(tmp_path) -> None:
+    ds = synthetic_dataset(4, 20, max_frames=20)
+    Trainer(tmp_path / "bb", run_config(3), ds, text_encoder=HashText()).train(progress=False)
+    backbone, _, _ = load_pretrained(tmp_path / "bb" / "model")
+    env_ds = synthetic_dataset(4, 20, max_frames=20, with_env=True)
+    cfg = run_config(4, mode="adapters", sim=True)
+    trainer = Trainer(tmp_path / "ad", cfg, env_ds, text_encoder=HashText(), init_model=tmp_path / "bb" / "model")
+    assert set(trainer.trainable) == {n for n, _ in trainer.network.named_parameters()
+                                      if n.startswith(("sim_encoder.", "adapters."))}
+    before = {k: v.clone() for k, v in trainer.network.state_dict().items()}
+    trainer.train(progress=False)
+    after = trainer.network.state_dict()
+    for key, value in before.items():
+        if key.startswith("backbone."):
+            assert torch.equal(after[key], value), key  # bit-identical
+            assert torch.equal(after[key], backbone.state_dict()[key[len("backbone."):]])
+    assert not torch.equal(after["adapters.0.up.weight"], before["adapters.0.up.weight"])
+    assert not torch.equal(after["sim_encoder.proj.weight"], before["sim_encoder.proj.weight"])
+    # With α = 0 the trained SimDiff equals the backbone exactly.
+    net = trainer.network.eval()
+    x, t = torch.randn(2, 20, 263), torch.tensor([3, 700])
+    c = Condition(text=torch.randn(2, 384), env=torch.tensor([[-3.0, 5.0, 0.0], [-15.0, 0.0, -8.0]]), alpha=0.0)
+    with torch.no_grad():
+        assert torch.equal(net(x, t, c), backbone.eval()(x, t, Condition(text=c.text)))
+        c.alpha = 1.0
+        assert not torch.allclose(net(x, t, c), backbone(x, t, Condition(text=c.text)))
+    gen = MotionGenerator.load(tmp_path / "ad" / "model", load_text=False)
+    assert gen.is_simdiff
+
+
+def test_adapter_training_needs_env_and_backbone(tmp_path) -> None:
+    ds = synthetic_dataset(4, 20, max_frames=20)
+    with pytest.raises(SimdiffError, match="backbone checkpoint"):
+        Trainer(tmp_path / "x", run_config(2, mode="adapters", sim=True), ds, text_encoder=HashText())
+    Trainer(tmp_path / "bb", run_config(1), ds, text_encoder=HashText()).train(progress=False)
+    trainer = Trainer(tmp_path / "ad", run_config(2, mode="adapters", sim=True), ds, text_encoder=HashText(),
+                      init_model=tmp_path / "bb" / "model")
+    with pytest.raises(SimdiffError, match="'env'"):
+        trainer.train(progress=False)
+
+
+def test_categorical_env_index(tmp_path) -> None:
+    from simdiff.train import TensorMotionDataset
+
+    base = synthetic_dataset(4, 20, max_frames=20)
+    ds = TensorMotionDataset([m[:20] for m in base.motions], base.captions, env_indices=[0, 1, 2, 3], max_frames=20)
+    Trainer(tmp_path / "bb", run_config(1), ds, text_encoder=HashText()).train(progress=False)
+    cfg = run_config(2, mode="adapters", sim=True)
+    cfg.model.sim.mode = "categorical"
+    cfg.model.sim.num_categories = 4
+    losses = Trainer(tmp_path / "ad", cfg, ds, text_encoder=HashText(), init_model=tmp_path / "bb" / "model").train(progress=False)
+    assert len(losses) == 2
