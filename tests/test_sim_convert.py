@@ -41,7 +41,11 @@ def test_stance_feet_held_flat_on_floor():
 
     h, _ = foot_heights(m, ref.qpos)
     stance = h[ref.contact]
-    assert np.percentile(np.abs(stance), 90) < 0.01
+    # flat stance frames are held on the floor; at heel rise the pitched box is released
+    # (not forced flat), so its toe end may dip a little
+    assert np.median(np.abs(stance)) < 0.002
+    assert np.percentile(np.abs(stance), 75) < 0.015
+    assert stance.min() > -0.03
 
 
 def test_smoothing_keeps_boundary_velocity():
@@ -88,3 +92,53 @@ def test_real_clip_ik_error(shared_data):
     joints = np.load(shared_data / "humanml3d" / "samples" / "new_joints" / "012314.npy")[:60]
     ref = make_reference(m, joints)
     assert np.median(ref.ik_error) < 0.03  # metres; arms above the head are the worst frames
+
+
+def test_analytic_ik_recovers_in_range_poses():
+    from simdiff.sim.convert import qpos_to_world
+    from simdiff.sim.ik import analytic_ik
+
+    m = load_model()
+    rng = np.random.default_rng(0)
+    q = np.tile(m.qpos0, (8, 1))
+    lo, hi = m.jnt_range[1:, 0], m.jnt_range[1:, 1]
+    q[:, 7:] = rng.uniform(0.7 * lo, 0.7 * hi, size=(8, 69))
+    q[:, :3] = [0.3, -0.2, 1.0]
+    q[:, 3:7] = [np.cos(0.4), 0.0, 0.0, np.sin(0.4)]  # 46° yaw
+    target = qpos_to_world(m, q)
+    got = qpos_to_world(m, analytic_ik(m, target))
+    err = np.linalg.norm(got - target, axis=-1)
+    assert err.mean() < 0.02 and np.median(err) < 0.005  # exact up to twist / range corner cases
+
+
+def test_analytic_ik_continuous_on_synthetic_walk():
+    from simdiff.sim.humanoid import hml_to_world
+    from simdiff.sim.ik import analytic_ik
+
+    m = load_model()
+    q = analytic_ik(m, hml_to_world(synthetic.walk_in_place(40).astype(float)))
+    assert np.abs(np.diff(q[:, 7:], axis=0)).max() < 1.0  # no Euler-branch / twist flips (≈ π)
+
+
+def test_despike_replaces_isolated_glitch_only():
+    from simdiff.sim.convert import _despike
+
+    j = synthetic.walk_in_place(30).astype(float)
+    bad = j.copy()
+    bad[0, 20] += [0.0, 0.0, 0.7]  # first frame wrist glitch (seen in CMU 16_15)
+    bad[12, 7] += [0.4, 0.0, 0.0]
+    out = _despike(bad, 0.25)
+    assert np.linalg.norm(out[0, 20] - j[0, 20]) < 0.05
+    assert np.linalg.norm(out[12, 7] - j[12, 7]) < 0.05
+    assert np.array_equal(_despike(j, 0.25), j)  # clean motion untouched
+
+
+def test_ground_level_uses_planted_feet():
+    from simdiff.sim.convert import ground_level
+
+    T = 60
+    h = np.full((T, 4), 0.12)  # feet planted 12 cm above the capture's zero ...
+    h[30:33, 3] = -0.02  # ... except a brief toe dip while sliding fast
+    xy = np.zeros((T, 4, 2))
+    xy[29:34, 3, 0] = np.linspace(0, 0.5, 5)
+    assert ground_level(h, xy, 20.0) == pytest.approx(0.12)

@@ -101,3 +101,29 @@ def test_real_clip_tracked(shared_data):
     assert info.violations == []
     assert info.success
     assert np.isfinite(info.d_l2) and info.d_l2 < 10
+
+
+def test_balance_layer_quiet_on_reference_and_pushes_back(squat_ref):
+    """On the reference state the balance layer adds (almost) nothing; with the COM pushed
+    forward it asks the stance legs for a backward ground force (ankles plantarflex)."""
+    import mujoco
+
+    from simdiff.sim.humanoid import model_index
+    from simdiff.sim.tracker import PDTracker, PDTrackerConfig
+
+    m = load_model()
+    d = mujoco.MjData(m)
+    d.qpos[:] = squat_ref.qpos[0]
+    d.qpos[2] -= 0.002  # soles 2 mm into the floor: the feet register as touching
+    d.qvel[:] = squat_ref.qvel[0]
+    mujoco.mj_forward(m, d)
+    assert d.ncon > 0
+    on, off = PDTracker(), PDTracker(PDTrackerConfig(balance=None))
+    for tr in (on, off):
+        tr.reset(m, d, squat_ref, model_index(m))
+    assert np.abs(on.act(d, 0) - off.act(d, 0)).max() < 0.01
+    d.qvel[0] = 0.5  # COM moving forward (+x) relative to the reference
+    mujoco.mj_forward(m, d)
+    delta = on.act(d, 0) - off.act(d, 0)
+    ankles = [on.leg[s][2] for s in ("L", "R")]
+    assert np.all(delta[ankles] > 0)  # +y at the ankle = toes down: the CoP moves forward

@@ -1,6 +1,6 @@
 """Physics projection P_φ,π: generated MuJoCo humanoid, environment φ, conversions, tracker, rollouts.
 
-Modules: ``humanoid`` (MJCF builder), ``env`` (φ and validation), ``convert`` (joints ⇄ states,
+Modules: ``humanoid`` (MJCF builder), ``env`` (φ and validation), ``ik`` (closed-form IK), ``convert`` (joints ⇄ states,
 reference building, ID screen), ``tracker`` (Tracker interface, default PD tracker),
 ``residual`` (contact-gated root residual), ``rollout`` (one simulation + invariant audit),
 ``project`` (``project(joints, env) -> (rollout, info)``), ``pool`` (process / Ray parallelism),

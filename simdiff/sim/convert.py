@@ -2,8 +2,8 @@
 
 Forward (:func:`make_reference`), as the probes found necessary:
 
-1. per-frame damped-least-squares IK of the 22 joint positions onto the humanoid
-   (warm-started, joint ranges clamped, a small posture prior);
+1. closed-form IK (:mod:`simdiff.sim.ik`) of the 22 joint positions, polished by a few
+   damped Gauss-Newton iterations per frame (joint ranges clamped, a small posture prior);
 2. ground alignment and a contact schedule per foot (heel box / toe box low and slow);
 3. a second IK pass that holds every stance foot (or toe, at toe-off) flat, at a fixed xy
    and on the floor;
@@ -47,29 +47,31 @@ class RetargetConfig:
     Attributes:
         fps: frame rate of the input joints (HumanML3D: 20).
         control_hz: rate of the produced reference (the tracker's rate, 30).
-        ik_iters_first, ik_iters: Gauss-Newton iterations for frame 0 / later frames.
+        ik_polish_iters: Gauss-Newton iterations polishing the closed-form IK (pass 1).
+        ik_iters: Gauss-Newton iterations of the stance pass (pass 2), from pass 1.
         ik_damping: Levenberg damping (m²).
         posture_weight: pull of the hinges toward 0 (the upright rest pose).
         contact_height: a foot box is in contact below this sole height (m).
         contact_speed: ... and below this horizontal speed (m/s).
         smooth_sigma: Gaussian filter σ in input frames (0 = off).
         stance_pass: run the second, stance-holding IK pass.
-        restart_error: a frame whose mean joint error exceeds this (m) is re-solved from rest.
         friction: friction coefficient of the pyramid in the ID screen.
+        spike_distance: isolated joint samples this far (m) from their neighbours are
+            mocap glitches and get replaced (0 = off).
     """
 
     fps: float = HML_FPS
     control_hz: float = CONTROL_HZ
-    ik_iters_first: int = 80
-    ik_iters: int = 10
+    ik_polish_iters: int = 3
+    ik_iters: int = 4
     ik_damping: float = 1e-4
     posture_weight: float = 2e-3
     contact_height: float = 0.04
     contact_speed: float = 0.6
     smooth_sigma: float = 1.0
     stance_pass: bool = True
-    restart_error: float = 0.025
     friction: float = 0.8
+    spike_distance: float = 0.25
 
 
 @dataclass
@@ -186,53 +188,79 @@ class _IK:
         self.lo = model.jnt_range[1:, 0]
         self.hi = model.jnt_range[1:, 1]
         self.posture = _posture_weights(model)
+        # dof d moves HumanML3D joint i iff the dof's body is the joint's body or an ancestor
+        self.mask = np.zeros((22, model.nv))
+        for i, b in enumerate(self.ix.hml_bodies):
+            chain = set()
+            while b > 0:
+                chain.add(b)
+                b = model.body_parentid[b]
+            self.mask[i] = [model.dof_bodyid[v] in chain for v in range(model.nv)]
+        self.hinge_jnt = np.arange(1, model.njnt)
+        self.w = np.repeat(_IK_WEIGHTS, 3)
+
+    def _joint_jacobian(self) -> np.ndarray:
+        """(66, nv) position Jacobian of the 22 HumanML3D joints at the current kinematics.
+
+        Hinge column: axis × (p − anchor); free-joint columns: identity (translation) and the
+        body-frame rotation axes × (p − root); zero where the dof is not an ancestor.
+        """
+        d = self.d
+        p = d.xpos[self.ix.hml_bodies]  # (22, 3)
+        axes = np.empty((self.nv, 3))
+        anchors = np.empty((self.nv, 3))
+        root = self.ix.pelvis
+        axes[3:6] = d.xmat[root].reshape(3, 3).T
+        anchors[3:6] = d.xpos[root]
+        axes[6:] = d.xaxis[self.hinge_jnt]
+        anchors[6:] = d.xanchor[self.hinge_jnt]
+        J = np.cross(axes[None, 3:], p[:, None, :] - anchors[None, 3:])  # (22, nv-3, 3)
+        out = np.zeros((22, 3, self.nv))
+        out[:, :, 3:] = np.swapaxes(J, 1, 2) * self.mask[:, None, 3:]
+        out[:, [0, 1, 2], [0, 1, 2]] = 1.0
+        return out.reshape(66, self.nv)
 
     def solve(self, q: np.ndarray, target: np.ndarray, iters: int, tasks: list[_Task] = ()) -> tuple[np.ndarray, float]:
-        """Gauss-Newton on the 22 joint positions ``target`` (22, 3) world + extra tasks."""
+        """Gauss-Newton on the 22 joint positions ``target`` (22, 3) world + extra tasks.
+
+        Returns the solution and its mean joint error (m).
+        """
         mj, m, d = self.mj, self.m, self.d
         nv = self.nv
-        w = np.repeat(_IK_WEIGHTS, 3)
         lam = self.cfg.ik_damping
-        mu = self.cfg.posture_weight
+        pw = self.cfg.posture_weight * self.posture
         q = q.copy()
-        err = 0.0
+        diag = np.arange(nv)
         for _ in range(iters):
             d.qpos[:] = q
             mj.mj_kinematics(m, d)
-            mj.mj_comPos(m, d)
-            rows = []
-            resid = []
-            weights = []
-            for i, b in enumerate(self.ix.hml_bodies):
-                mj.mj_jacBody(m, d, self.jacp, None, b)
-                rows.append(self.jacp.copy())
-                resid.append(target[i] - d.xpos[b])
-            weights.append(w)
+            J = self._joint_jacobian()
+            if tasks:
+                mj.mj_comPos(m, d)  # cdof for mj_jacBody
+            e = (target - d.xpos[self.ix.hml_bodies]).ravel()
+            H = J.T @ (J * self.w[:, None])
+            g = J.T @ (self.w * e)
             for task in tasks:
                 mj.mj_jacBody(m, d, self.jacp, self.jacr, task.body)
-                rows.append(self.jacp.copy())
-                resid.append(task.pos - d.xpos[task.body])
-                weights.append(np.full(3, task.weight))
+                H += task.weight * (self.jacp.T @ self.jacp)
+                g += task.weight * (self.jacp.T @ (task.pos - d.xpos[task.body]))
                 if task.rot is not None:
-                    rows.append(self.jacr.copy())
                     cur = d.xmat[task.body].reshape(3, 3)
-                    resid.append(Rotation.from_matrix(task.rot @ cur.T).as_rotvec())
-                    weights.append(np.full(3, task.weight * 0.3))
-            J = np.concatenate(rows, 0)
-            e = np.concatenate(resid, 0)
-            W = np.concatenate(weights)
-            err = float(np.mean(np.linalg.norm(np.stack(resid[:22]), axis=1)))
-            H = J.T @ (J * W[:, None])
-            g = J.T @ (W * e)
-            H[np.diag_indices(nv)] += lam
-            pw = mu * self.posture
-            H[np.arange(6, nv), np.arange(6, nv)] += pw
+                    H += 0.3 * task.weight * (self.jacr.T @ self.jacr)
+                    E = task.rot @ cur.T  # small-angle rotation error: vee(E - Eᵀ) / 2
+                    rv = 0.5 * np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
+                    g += 0.3 * task.weight * (self.jacr.T @ rv)
+            H[diag, diag] += lam
+            H[diag[6:], diag[6:]] += pw
             g[6:] -= pw * q[7:]
             dq = np.linalg.solve(H, g)
             mj.mj_integratePos(m, q, dq, 1.0)
             q[7:] = np.clip(q[7:], self.lo, self.hi)
             if np.max(np.abs(dq)) < 1e-5:
                 break
+        d.qpos[:] = q
+        mj.mj_kinematics(m, d)
+        err = float(np.linalg.norm(target - d.xpos[self.ix.hml_bodies], axis=1).mean())
         return q, err
 
 
@@ -251,48 +279,30 @@ def _posture_weights(model) -> np.ndarray:
     return w
 
 
-def _facing_yaw(p: np.ndarray) -> float:
-    """Yaw (rad, about world z) of the character from its hips and shoulders, world (22, 3)."""
-    across = (p[1] - p[2]) + (p[16] - p[17])
-    fwd = np.cross(across, [0.0, 0.0, 1.0])
-    return float(np.arctan2(fwd[1], fwd[0]))
-
-
-def _yaw_quat(yaw: float) -> np.ndarray:
-    return np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
-
-
 def ik_sequence(model, target: np.ndarray, cfg: RetargetConfig, tasks: list[list[_Task]] | None = None,
                 init: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Per-frame IK.
+    """Per-frame IK: closed-form, then Gauss-Newton polishing.
 
     Args:
         target: (T, 22, 3) world joint positions.
         tasks: optional per-frame extra tasks.
-        init: optional (T, nq) initial guesses (default: warm start from the previous frame).
+        init: optional (T, nq) starting solution; default the closed-form IK of ``target``
+            (:func:`simdiff.sim.ik.analytic_ik`).
     Returns:
         qpos (T, nq) and the mean joint error per frame (T,) in metres.
     """
+    from simdiff.sim.ik import analytic_ik
+
     ik = _IK(model, cfg)
+    if init is None:
+        init, iters = analytic_ik(model, target), cfg.ik_polish_iters
+    else:
+        iters = cfg.ik_iters
     T = target.shape[0]
     qs = np.zeros((T, model.nq))
     errs = np.zeros(T)
-    q = model.qpos0.copy()
-    q[:3] = target[0, 0]
-    q[3:7] = _yaw_quat(_facing_yaw(target[0]))
     for t in range(T):
-        if init is not None:
-            q = init[t].copy()
-        iters = cfg.ik_iters_first if (t == 0 and init is None) else cfg.ik_iters
-        task = tasks[t] if tasks is not None else []
-        q, errs[t] = ik.solve(q, target[t], iters, task)
-        if errs[t] > cfg.restart_error:  # a local minimum (usually an arm): restart the limbs from rest
-            q2 = q.copy()
-            q2[7:] = model.qpos0[7:]
-            q2, e2 = ik.solve(q2, target[t], cfg.ik_iters_first, task)
-            if e2 < errs[t]:
-                q, errs[t] = q2, e2
-        qs[t] = q
+        qs[t], errs[t] = ik.solve(init[t], target[t], iters, tasks[t] if tasks is not None else [])
     return qs, errs
 
 
@@ -353,6 +363,23 @@ def contact_schedule(height: np.ndarray, xy: np.ndarray, fps: float, cfg: Retarg
     return c
 
 
+def ground_level(height: np.ndarray, xy: np.ndarray, fps: float, still_speed: float = 0.3) -> float:
+    """Floor height (m) of a motion from its foot-box sole heights (T, 4) and centres (T, 4, 2).
+
+    The median sole height of the lowest box over the frames where that box is still
+    (horizontal speed below ``still_speed``): a planted foot is on the floor, whatever the
+    capture's own zero. Falls back to the 10th percentile of the lowest sole when fewer than
+    5 frames are still (a motion that never plants a foot).
+    """
+    low_box = height.argmin(axis=1)
+    low = height[np.arange(len(height)), low_box]
+    speed = np.linalg.norm(np.gradient(xy, axis=0) * fps, axis=-1)[np.arange(len(height)), low_box]
+    still = speed < still_speed
+    if still.sum() >= 5:
+        return float(np.median(low[still]))
+    return float(np.percentile(low, 10))
+
+
 def _intervals(mask: np.ndarray) -> list[tuple[int, int]]:
     """Half-open [start, end) runs of True."""
     out, start = [], None
@@ -367,8 +394,15 @@ def _intervals(mask: np.ndarray) -> list[tuple[int, int]]:
     return out
 
 
-def _stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 20.0) -> list[list[_Task]]:
-    """Per-frame tasks that hold each touching foot box flat, on the floor, at a fixed xy."""
+def _stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 20.0,
+                  max_tilt: float = np.deg2rad(12.0)) -> list[list[_Task]]:
+    """Per-frame tasks that hold each touching foot box flat, on the floor, at a fixed xy.
+
+    Only frames where the box is nearly flat already (tilt below ``max_tilt``) are held: a
+    heel rising at toe-off or a toe coming down at heel strike keeps its own pitch (forcing
+    it flat would pull the whole body out of shape). The hold's weight ramps over the first
+    and last 2 frames of an interval.
+    """
     import mujoco
 
     d = mujoco.MjData(model)
@@ -381,28 +415,58 @@ def _stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 
     rest_h = [d.xpos[b][2] - _box_bottom_corners(model, d, g)[:, 2].min() for b, g in zip(bodies, geoms)]
     pos = np.zeros((qpos.shape[0], 4, 3))
     yaw = np.zeros((qpos.shape[0], 4))
+    flat = np.zeros((qpos.shape[0], 4), dtype=bool)
     for t in range(qpos.shape[0]):
         d.qpos[:] = qpos[t]
         mujoco.mj_kinematics(model, d)
         for k, b in enumerate(bodies):
             pos[t, k] = d.xpos[b]
-            x_axis = d.xmat[b].reshape(3, 3)[:, 0]
-            yaw[t, k] = np.arctan2(x_axis[1], x_axis[0])
+            R = d.xmat[b].reshape(3, 3)
+            yaw[t, k] = np.arctan2(R[1, 0], R[0, 0])
+            flat[t, k] = R[2, 2] > np.cos(max_tilt)
     tasks: list[list[_Task]] = [[] for _ in range(qpos.shape[0])]
     for k, b in enumerate(bodies):
-        for s, e in _intervals(contact[:, k]):
+        for s, e in _intervals(contact[:, k] & flat[:, k]):
             p = np.median(pos[s:e, k], axis=0)
             p[2] = rest_h[k]
             y = float(np.angle(np.mean(np.exp(1j * yaw[s:e, k]))))
             R = Rotation.from_euler("z", y).as_matrix()
-            for t in range(s, e):
-                tasks[t].append(_Task(b, p, R, weight))
+            for t in range(s, e):  # ramp in and out over 2 frames: no jump when a hold starts
+                ramp = min(1.0, (t - s + 1) / 2, (e - t) / 2)
+                tasks[t].append(_Task(b, p, R, weight * ramp))
     return tasks
 
 
 # --------------------------------------------------------------------------------------
 # filtering and resampling
 # --------------------------------------------------------------------------------------
+
+
+def _despike(joints: np.ndarray, distance: float) -> np.ndarray:
+    """Replace isolated outlier samples (mocap glitches) by their neighbours' mean.
+
+    A joint sample farther than ``distance`` (m) from the median of its ±2-frame
+    neighbourhood (itself excluded) while those neighbours agree with each other is an
+    outlier; it becomes the mean of the adjacent samples (or the nearest one at the ends).
+    """
+    T = joints.shape[0]
+    if distance <= 0 or T < 5:
+        return joints
+    out = joints.copy()
+    pad = np.concatenate([joints[2:0:-1], joints, joints[-2:-4:-1]], 0)  # mirror 2 frames
+    nb = np.stack([pad[i : i + T] for i in (0, 1, 3, 4)], 0)  # (4, T, 22, 3)
+    med = np.median(nb, axis=0)
+    far = np.linalg.norm(joints - med, axis=-1) > distance
+    spread = np.linalg.norm(nb - med, axis=-1).max(0) < distance
+    for t, j in zip(*np.nonzero(far & spread)):
+        lo, hi = t - 1, t + 1
+        if lo < 0:
+            out[t, j] = joints[hi, j]
+        elif hi >= T:
+            out[t, j] = joints[lo, j]
+        else:
+            out[t, j] = 0.5 * (joints[lo, j] + joints[hi, j])
+    return out
 
 
 def _smooth(x: np.ndarray, sigma: float) -> np.ndarray:
@@ -544,15 +608,14 @@ def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConf
         raise SimdiffError(f"motion too short to track: {joints.shape[0]} frames (need ≥ 4)")
     if not np.all(np.isfinite(joints)):
         raise SimdiffError("motion contains non-finite joint positions")
-    target = hml_to_world(joints)
+    target = hml_to_world(_despike(joints, cfg.spike_distance))
     fps = cfg.fps
 
     # 1. per-frame IK
     q1, err = ik_sequence(model, target, cfg)
     # 2. ground alignment + contact schedule
     h, xy = foot_heights(model, q1)
-    low = h.min(axis=1)
-    shift = -float(np.percentile(low, 10))  # the lowest decile of frames puts a sole on the floor
+    shift = -ground_level(h, xy, fps)
     q1[:, 2] += shift
     h += shift
     contact = contact_schedule(h, xy, fps, cfg)

@@ -29,6 +29,43 @@ class Tracker(Protocol):
 
 
 @dataclass(frozen=True)
+class BalanceConfig:
+    """Whole-body balance: a desired wrench about the COM realised by the stance legs.
+
+    The wrench is ``F = m·(kp ⊙ Δc + kd ⊙ Δċ)`` on the COM and ``τ = kp_rot·e_R + kd_rot·Δω``
+    on the pelvis orientation (errors reference − simulation, world frame). It is split
+    between the legs whose feet touch the floor and turned into joint torques with the
+    stance-leg Jacobian transpose, ``τ_leg = −J_legᵀ [F_i; M_i]``, i.e. the legs push on the
+    floor so that the floor pushes the body back: no external force is involved. The
+    horizontal part of each foot moment is clipped to what the foot's support can carry
+    (centre of pressure inside the sole), the yaw part to a fraction of the normal load.
+
+    Attributes:
+        kp_xy, kd_xy: horizontal COM gains (1/s², 1/s).
+        kp_z, kd_z: vertical COM gains (1/s², 1/s).
+        kp_rot, kd_rot: pelvis orientation gains (N·m/rad, N·m·s/rad).
+        cop_x, cop_y: half length / half width of the usable support of one foot (m).
+        yaw_ratio: yaw moment bound per newton of normal load (m).
+        step_gain: foot placement: a swing foot is moved by step_gain × the capture-point
+            error (simulation − reference, both relative to the stance foot), through the
+            swing leg's Jacobian (0: off).
+        step_max: bound of that displacement (m).
+    """
+
+    kp_xy: float = 20.0
+    kd_xy: float = 6.0
+    kp_z: float = 100.0
+    kd_z: float = 20.0
+    kp_rot: float = 600.0
+    kd_rot: float = 60.0
+    cop_x: float = 0.08
+    cop_y: float = 0.04
+    yaw_ratio: float = 0.03
+    step_gain: float = 1.0
+    step_max: float = 0.25
+
+
+@dataclass(frozen=True)
 class PDTrackerConfig:
     """Options of :class:`PDTracker`.
 
@@ -39,9 +76,7 @@ class PDTrackerConfig:
         clearance: extra hip/knee flexion (rad) for a leg whose reference foot is in swing
             while the simulated foot still touches the floor (toe-off / swing clearance).
         target_margin: targets are clipped to the joint range widened by this (rad).
-        balance_kp, balance_kd: ankle strategy: stance-ankle pitch/roll offsets (rad per m,
-            rad per m/s) from the COM position/velocity error in the heading frame, shared
-            between the stance legs.
+        balance: the stance-leg balance layer (None: off).
     """
 
     lead: float = 0.5
@@ -49,17 +84,34 @@ class PDTrackerConfig:
     velocity_ff: bool = True
     clearance: float = 0.25
     target_margin: float = 0.3
-    balance_kp: float = 1.5
-    balance_kd: float = 0.4
+    balance: BalanceConfig | None = BalanceConfig()
+
+
+def _quat_err(q_ref: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Rotation vector (world) taking unit quaternion q to q_ref, both (4,) wxyz."""
+    w1, x1, y1, z1 = q_ref
+    w2, x2, y2, z2 = q[0], -q[1], -q[2], -q[3]
+    e = np.array([
+        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+    ])
+    if e[0] < 0:
+        e = -e
+    s = np.linalg.norm(e[1:])
+    if s < 1e-12:
+        return np.zeros(3)
+    return e[1:] / s * 2.0 * np.arctan2(s, e[0])
 
 
 class PDTracker:
-    """The default tracker: PD targets from the reference with ID feed-forward.
+    """The default tracker: PD targets from the reference with ID feed-forward and balance.
 
-    target = q_ref(k + lead) + (τ_ff + kd q̇_ref) / kp, plus a swing-clearance bias that
-    flexes hip, knee and ankle of a leg whose reference foot is airborne but whose simulated
-    foot is still on the floor (the trailing foot sticking at toe-off was the main failure of
-    the probes' walks).
+    target = q_ref(k + lead) + (τ_ff + kd q̇_ref + τ_bal) / kp, plus a swing-clearance bias
+    that flexes hip, knee and ankle of a leg whose reference foot is airborne but whose
+    simulated foot is still on the floor. τ_bal is the stance-leg balance torque
+    (:class:`BalanceConfig`).
     """
 
     def __init__(self, config: PDTrackerConfig = PDTrackerConfig()) -> None:
@@ -67,19 +119,27 @@ class PDTracker:
 
     def reset(self, model, data, reference: Reference, index: ModelIndex) -> None:
         import mujoco
+        from scipy.spatial.transform import Rotation
 
+        self.mj = mujoco
         self.ref = reference
         self.ix = index
+        self.model = model
         self.lo = index.jnt_lo - self.cfg.target_margin
         self.hi = index.jnt_hi + self.cfg.target_margin
         self.foot_geoms = _foot_geoms(model)
+        self.geom_side = np.full(model.ngeom, -1)
+        for k, g in enumerate(self.foot_geoms):
+            self.geom_side[g] = k // 2
         names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, i) for i in range(1, model.njnt)]
         self.leg = {
             side: (names.index(f"{side}_Hip_y"), names.index(f"{side}_Knee_y"), names.index(f"{side}_Ankle_y"))
             for side in ("L", "R")
         }
-        self.ankle_x = {side: names.index(f"{side}_Ankle_x") for side in ("L", "R")}
-        self.model = model
+        self.leg_dofs = [
+            np.array([names.index(f"{side}_{b}_{a}") for b in ("Hip", "Knee", "Ankle") for a in "xyz"])
+            for side in ("L", "R")
+        ]
         K = reference.num_frames
         t = np.clip(np.arange(K) + self.cfg.lead, 0, K - 1)
         i0 = np.floor(t).astype(int)
@@ -93,12 +153,29 @@ class PDTracker:
         if self.cfg.velocity_ff:
             off += index.kd * reference.qvel[:, 6:]
         self.base = self.q_target + off / index.kp
+        R = Rotation.from_quat(reference.qpos[:, [4, 5, 6, 3]])
+        self.ref_omega = R.apply(reference.qvel[:, 3:6])
+        self.foot_body = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"{s}_Ankle") for s in ("L", "R")]
+        self.jacp = np.zeros((3, model.nv))
+        self.jacr = np.zeros((3, model.nv))
+        d = mujoco.MjData(model)
+        self.ref_box = np.zeros((K, 4, 3))
+        for t in range(K):
+            d.qpos[:] = reference.qpos[t]
+            mujoco.mj_kinematics(model, d)
+            self.ref_box[t] = d.geom_xpos[self.foot_geoms]
+        self.ref_box[:, :, 2] = 0.0
+        self.swing_dofs = [
+            np.array([names.index(f"{side}_Hip_{a}") for a in "xyz"] + [names.index(f"{side}_Knee_y")])
+            for side in ("L", "R")
+        ]
 
-    def _foot_on_floor(self, data) -> np.ndarray:
+    def _contacts(self, data) -> np.ndarray:
         """(4,) whether each foot box (LF, LT, RF, RT) touches the floor now."""
         out = np.zeros(4, dtype=bool)
-        if data.ncon:
-            g = data.contact.geom[: data.ncon].ravel()
+        n = data.ncon
+        if n:
+            g = data.contact.geom[:n].ravel()
             for k, fg in enumerate(self.foot_geoms):
                 out[k] = bool(np.any(g == fg))
         return out
@@ -106,9 +183,9 @@ class PDTracker:
     def act(self, data, k: int) -> np.ndarray:
         k = min(k, self.ref.num_frames - 1)
         target = self.base[k].copy()
+        on = self._contacts(data)
         c = self.cfg.clearance
         if c > 0:
-            on = self._foot_on_floor(data)
             kn = min(k + 1, self.ref.num_frames - 1)
             for side, cols in (("L", (0, 1)), ("R", (2, 3))):
                 ref_swing = not self.ref.contact[kn, cols[0]] and not self.ref.contact[kn, cols[1]]
@@ -117,28 +194,77 @@ class PDTracker:
                     target[hip] -= c
                     target[knee] += 2 * c
                     target[ankle] -= c
-        if self.cfg.balance_kp > 0 or self.cfg.balance_kd > 0:
-            self._balance(data, k, target)
+        if self.cfg.balance is not None:
+            self._balance(data, k, on, target)
         return np.clip(target, self.lo, self.hi)
 
-    def _balance(self, data, k: int, target: np.ndarray) -> None:
-        """Ankle strategy on the legs whose foot touches the floor."""
-        import mujoco
-
-        on = self._foot_on_floor(data)
-        stance = [side for side, cols in (("L", (0, 1)), ("R", (2, 3))) if on[cols[0]] or on[cols[1]]]
-        if not stance:
+    def _balance(self, data, k: int, on: np.ndarray, target: np.ndarray) -> None:
+        """Add the stance-leg balance torques and the swing-foot placement to ``target``."""
+        mj, b, ix = self.mj, self.cfg.balance, self.ix
+        legs = [s for s in (0, 1) if on[2 * s] or on[2 * s + 1]]
+        if not legs:
             return
-        mujoco.mj_subtreeVel(self.model, data)
-        p = self.ix.pelvis
-        e = data.subtree_com[p] - self.ref.com[k]
-        v = data.subtree_linvel[p] - self.ref.com_vel[k]
-        x_axis = data.xmat[p].reshape(3, 3)[:, 0]
-        fwd = np.array([x_axis[0], x_axis[1], 0.0])
-        fwd /= max(np.linalg.norm(fwd), 1e-9)
-        left = np.array([-fwd[1], fwd[0], 0.0])
-        u = self.cfg.balance_kp * e + self.cfg.balance_kd * v
-        share = 1.0 / len(stance)
-        for side in stance:
-            target[self.leg[side][2]] += share * float(u @ fwd)  # plantarflex when ahead
-            target[self.ankle_x[side]] -= share * float(u @ left)  # press the left edge when left
+        mj.mj_subtreeVel(self.model, data)
+        p = ix.pelvis
+        com = data.subtree_com[p].copy()
+        vel = data.subtree_linvel[p]
+        boxes = [g for s in legs for g in (2 * s, 2 * s + 1) if on[g]]
+        foot = data.geom_xpos[[self.foot_geoms[g] for g in boxes]].mean(axis=0)
+        foot_ref = self.ref_box[k, boxes].mean(axis=0)
+        # horizontal COM error relative to the support (absolute drift is not corrected)
+        e = (self.ref.com[k] - foot_ref) - (com - foot)
+        e[2] = self.ref.com[k, 2] - com[2]
+        ev = self.ref.com_vel[k] - vel
+        F = ix.mass * np.array([
+            b.kp_xy * e[0] + b.kd_xy * ev[0],
+            b.kp_xy * e[1] + b.kd_xy * ev[1],
+            b.kp_z * e[2] + b.kd_z * ev[2],
+        ])
+        tau = b.kp_rot * _quat_err(self.ref.qpos[k, 3:7], data.xquat[p]) + b.kd_rot * (
+            self.ref_omega[k] - data.cvel[p, :3])
+        pts = []
+        for s in legs:
+            gs = [g for j, g in enumerate(self.foot_geoms[2 * s: 2 * s + 2]) if on[2 * s + j]]
+            pt = np.mean([data.geom_xpos[g] for g in gs], axis=0)
+            pt[2] = 0.0
+            pts.append(pt)
+        d = np.array([np.linalg.norm(pt[:2] - com[:2]) for pt in pts])
+        share = 1.0 / (d + 0.05)
+        share /= share.sum()
+        fz_total = max(ix.mass * abs(self.model.opt.gravity[2]) + F[2], 0.0)
+        for s, pt, w in zip(legs, pts, share):
+            Fi = w * F
+            Mi = w * (tau - np.cross(pt - com, F))
+            # the foot can only carry moments that keep its centre of pressure on the sole
+            x_axis = data.xmat[self.foot_body[s]].reshape(3, 3)[:, 0]
+            fwd = np.array([x_axis[0], x_axis[1], 0.0])
+            fwd /= max(np.linalg.norm(fwd), 1e-9)
+            lat = np.array([-fwd[1], fwd[0], 0.0])
+            fz = w * fz_total
+            m_lat = np.clip(Mi @ lat, -b.cop_x * fz, b.cop_x * fz)  # pitch: CoP along the foot
+            m_fwd = np.clip(Mi @ fwd, -b.cop_y * fz, b.cop_y * fz)  # roll: CoP across the foot
+            m_z = np.clip(Mi[2], -b.yaw_ratio * fz, b.yaw_ratio * fz)
+            Mi = m_lat * lat + m_fwd * fwd + np.array([0.0, 0.0, m_z])
+            mj.mj_jac(self.model, data, self.jacp, self.jacr, pt, self.foot_body[s])
+            dofs = self.leg_dofs[s]
+            tq = -(self.jacp[:, 6 + dofs].T @ Fi + self.jacr[:, 6 + dofs].T @ Mi)
+            target[dofs] += tq / ix.kp[dofs]
+        if b.step_gain > 0 and len(legs) == 1:
+            self._place_swing_foot(data, k, 1 - legs[0], e, ev, com[2] - foot[2], target)
+
+    def _place_swing_foot(self, data, k: int, s: int, e: np.ndarray, ev: np.ndarray, h: float,
+                          target: np.ndarray) -> None:
+        """Shift the swing foot of leg ``s`` by the capture-point error (capture-point stepping)."""
+        b = self.cfg.balance
+        kn = min(k + 1, self.ref.num_frames - 1)
+        if self.ref.contact[kn, 2 * s] or self.ref.contact[kn, 2 * s + 1]:
+            return  # the reference has this foot down: nothing to place
+        w0 = np.sqrt(abs(self.model.opt.gravity[2]) / max(h, 0.3))
+        delta = -b.step_gain * (e[:2] + ev[:2] / w0)
+        n = np.linalg.norm(delta)
+        if n > b.step_max:
+            delta *= b.step_max / n
+        self.mj.mj_jacBody(self.model, data, self.jacp, None, self.foot_body[s])
+        dofs = self.swing_dofs[s]
+        J = self.jacp[:2, 6 + dofs]
+        target[dofs] += J.T @ np.linalg.solve(J @ J.T + 1e-3 * np.eye(2), delta)
