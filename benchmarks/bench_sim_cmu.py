@@ -38,7 +38,7 @@ def cmu_fps() -> dict[str, float]:
 
 def load_clip(name: str, fps_table: dict[str, float], max_frames: int) -> np.ndarray:
     from simdiff.motion.io.asf_amc import find_asf, read_amc
-    from simdiff.motion.io.retarget import retarget
+    from simdiff.motion.io.retarget import retarget_rig as retarget
 
     path = CMU / "amc" / f"{name}.amc"
     rig = read_amc(path, find_asf(path), fps=fps_table.get(name, 120.0))

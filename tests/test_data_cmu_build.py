@@ -295,3 +295,12 @@ def test_real_cmu_trials(shared_data: Path, tmp_path: Path) -> None:
     walk = np.load(tmp_path / "c" / "new_joints" / "02_01_00.npy")
     assert 2.0 < walk[-1, 0, 2] < 4.5  # walks ~3 m forward (+Z) in ~3 s
     assert np.median(walk[:, [7, 8, 10, 11], 1].min(axis=1)) < 0.05  # a foot on the floor
+
+
+def test_manifest_support_flag(corpus: tuple[Path, object]) -> None:
+    out, _ = corpus
+    clips = json.loads((out / "manifest.json").read_text())["clips"]
+    assert clips and all(c["support"] in ("floor", "props") for c in clips)
+    assert all(0.0 <= c["ground_contact"] <= 1.0 for c in clips)
+    # the synthetic walks stay on the ground
+    assert {c["support"] for c in clips if c["rig"] == "amc"} == {"floor"}

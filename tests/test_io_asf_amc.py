@@ -203,7 +203,7 @@ def test_real_cmu_walk(shared_data: Path) -> None:
     start = time.perf_counter()
     rig = read_amc(cmu / "amc" / "02_01.amc", cmu / "asf" / "02.asf")
     elapsed = time.perf_counter() - start
-    assert rig.positions.shape == (343, 31, 3)
+    assert rig.positions.shape == (343, 34, 3)  # 31 bones + 3 sites
     assert elapsed < 2.0
     pos = rig.positions.astype(np.float64)
     # Y-up, metres: feet near the floor, top of the head-bone ~1.55-1.65 m
@@ -217,3 +217,58 @@ def test_real_cmu_walk(shared_data: Path) -> None:
     # bone lengths are constant
     femur = np.linalg.norm(pos[:, rig.index("lfemur")] - pos[:, rig.index("lhipjoint")], axis=-1)
     assert femur.std() < 1e-5 and 0.38 < femur.mean() < 0.48
+
+
+HEAD_ASF = """:version 1.10
+:name HEAD
+:units
+  length 0.45
+  angle deg
+:root
+   order TX TY TZ RX RY RZ
+   axis XYZ
+   position 0 0 0
+   orientation 0 0 0
+:bonedata
+  begin
+     id 1
+     name head
+     direction 0 1 0
+     length 10
+     axis 0 0 0  XYZ
+    dof rx
+  end
+:hierarchy
+  begin
+    root head
+  end
+"""
+
+HEAD_AMC = """:FULLY-SPECIFIED
+:DEGREES
+1
+root 0 0 0 0 0 0
+head 0
+2
+root 0 0 0 0 0 0
+head 90
+"""
+
+
+def test_head_centre_site_moves_with_the_head(tmp_path: Path) -> None:
+    from simdiff.motion.io.asf_amc import ASF_SITES
+
+    asf_path, amc_path = _write(tmp_path, HEAD_ASF, HEAD_AMC)
+    rig = read_amc(amc_path, asf_path)
+    assert rig.names == ("root", "head", "head_centre")  # clavicle sites skipped: no such bones
+    assert rig.parents == (-1, 0, 1)
+    length = 10 * UNIT
+    left, up, forward = dict((s[0], s[2]) for s in ASF_SITES)["head_centre"]
+    # no hip bones: rest frame left +X, up +Y, forward +Z; offset from the bone's end
+    rest = np.array([0.0, length, 0.0]) + length * np.array([left, up, forward])
+    np.testing.assert_allclose(rig.positions[0, 2], rest, atol=1e-6)
+    # rx 90: the head (and the site) rotate about X: (x, y, z) -> (x, -z, y)
+    rot = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+    np.testing.assert_allclose(rig.positions[1, 2], rot @ rest, atol=1e-6)
+    # the site is below the top of the head and in front of the head bone
+    assert up < 0 < forward

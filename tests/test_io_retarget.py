@@ -12,15 +12,23 @@ import pytest
 
 from simdiff.errors import MotionFormatError
 from simdiff.motion.io import RigMotion, load_joints, write_bvh
-from simdiff.motion.io.retarget import CMU_ASF_MAP, map_joints, retarget, to_canonical_lengths
+from simdiff.motion.io.retarget import (
+    CC_BVH_MAP,
+    CMU_ASF_MAP,
+    DEEPMIMIC_MAP,
+    map_joints,
+    retarget_rig,
+    to_canonical_lengths,
+)
 from simdiff.motion.skeleton import BONE_LENGTHS, CANONICAL_OFFSETS, JOINT_NAMES, PARENTS
 
 CMU_BONES = (
     "root", "lhipjoint", "rhipjoint", "lowerback", "lfemur", "rfemur", "upperback", "ltibia",
     "rtibia", "thorax", "lfoot", "rfoot", "lowerneck", "lclavicle", "rclavicle", "ltoes",
     "rtoes", "upperneck", "lhumerus", "rhumerus", "head", "lradius", "rradius", "lwrist",
-    "rwrist",
+    "rwrist", "head_centre", "lshoulder_centre", "rshoulder_centre",
 )
+"""CMU ASF bone ends plus the AMC reader's derived sites."""
 
 
 def _cmu_rig(num_frames: int, fps: float) -> RigMotion:
@@ -32,19 +40,56 @@ def _cmu_rig(num_frames: int, fps: float) -> RigMotion:
 def test_cmu_map_picks_and_interpolates() -> None:
     rig = _cmu_rig(4, 120.0)
     out = map_joints(rig)
-    p = rig.positions.astype(np.float64)
-    np.testing.assert_allclose(out[:, 0], p[:, CMU_BONES.index("root")], atol=1e-7)
-    np.testing.assert_allclose(out[:, 7], p[:, CMU_BONES.index("ltibia")], atol=1e-7)
-    mid = 0.5 * (p[:, CMU_BONES.index("upperback")] + p[:, CMU_BONES.index("thorax")])
-    np.testing.assert_allclose(out[:, JOINT_NAMES.index("spine3")], mid, atol=1e-7)
-    collar = 0.55 * p[:, CMU_BONES.index("thorax")] + 0.45 * p[:, CMU_BONES.index("lclavicle")]
-    np.testing.assert_allclose(out[:, JOINT_NAMES.index("left_collar")], collar, atol=1e-7)
+    p = {name: rig.positions[:, i].astype(np.float64) for i, name in enumerate(CMU_BONES)}
+    np.testing.assert_allclose(out[:, 7], p["ltibia"], atol=1e-6)
+    # pelvis 15 % of the way from the hip centre to the neck base
+    hips = 0.5 * (p["lhipjoint"] + p["rhipjoint"])
+    np.testing.assert_allclose(out[:, 0], 0.85 * hips + 0.15 * p["lowerneck"], atol=1e-6)
+    np.testing.assert_allclose(out[:, JOINT_NAMES.index("spine3")], 0.8 * p["upperback"] + 0.2 * p["thorax"], atol=1e-6)
+    collar = 0.55 * p["thorax"] + 0.45 * p["lshoulder_centre"]
+    np.testing.assert_allclose(out[:, JOINT_NAMES.index("left_collar")], collar, atol=1e-6)
+    np.testing.assert_allclose(out[:, JOINT_NAMES.index("head")], p["head_centre"], atol=1e-6)
     assert set(CMU_ASF_MAP) == set(JOINT_NAMES)
+
+
+def test_map_weights_sum_to_one() -> None:
+    """Every map entry is an affine combination: it moves rigidly with the body."""
+    from simdiff.motion.io.retarget import _terms
+
+    for joint_map in (CMU_ASF_MAP, CC_BVH_MAP, DEEPMIMIC_MAP):
+        for name, src in joint_map.items():
+            assert sum(w for _, w in _terms(src)) == pytest.approx(1.0, abs=1e-9), name
+
+
+def test_cc_map_is_translation_and_rotation_equivariant() -> None:
+    names = sorted({n for src in CC_BVH_MAP.values() for n, _ in __import__(
+        "simdiff.motion.io.retarget", fromlist=["_terms"])._terms(src)})
+    rng = np.random.default_rng(3)
+    pos = rng.normal(size=(3, len(names), 3))
+    rig = RigMotion(tuple(names), (-1,) + (0,) * (len(names) - 1), pos, 60.0)
+    c, s_ = np.cos(0.7), np.sin(0.7)
+    rot = np.array([[c, 0, s_], [0, 1, 0], [-s_, 0, c]])
+    moved = RigMotion(rig.names, rig.parents, pos @ rot.T + np.array([1.0, 2.0, 3.0]), 60.0)
+    np.testing.assert_allclose(map_joints(moved), map_joints(rig) @ rot.T + np.array([1.0, 2.0, 3.0]), atol=1e-5)
+
+
+def test_package_names_are_modules() -> None:
+    """``simdiff.motion.io.retarget`` / ``.resample`` are the modules, never the functions."""
+    import types
+
+    import simdiff.motion.io as io_pkg
+    import simdiff.motion.io.resample  # noqa: F401
+    import simdiff.motion.io.retarget  # noqa: F401
+
+    assert isinstance(io_pkg.retarget, types.ModuleType)
+    assert isinstance(io_pkg.resample, types.ModuleType)
+    assert callable(io_pkg.retarget_rig) and io_pkg.retarget.retarget_rig is io_pkg.retarget_rig
+    assert callable(io_pkg.resample.resample)
 
 
 def test_retarget_resamples_and_floors() -> None:
     rig = _cmu_rig(240, 120.0)
-    out = retarget(rig)
+    out = retarget_rig(rig)
     assert out.shape == (40, 22, 3) and out.dtype == np.float32
     assert out[..., 1].min() == pytest.approx(0.0, abs=1e-6)
 
@@ -52,7 +97,7 @@ def test_retarget_resamples_and_floors() -> None:
 def test_unknown_rig_is_a_format_error() -> None:
     rig = RigMotion(("a", "b"), (-1, 0), np.zeros((3, 2, 3)), 30.0, Path("odd.bvh"))
     with pytest.raises(MotionFormatError, match=r"odd\.bvh: no HumanML3D joint map"):
-        retarget(rig)
+        retarget_rig(rig)
 
 
 def test_biped_names(tmp_path: Path) -> None:

@@ -54,7 +54,7 @@ def load_motion(path: Path, fps: float | None = None):
         return np.asarray(load_joints(path, **kwargs), dtype=np.float64)
     if path.suffix.lower() == ".amc":  # until load_joints exists: the AMC reader + retargeting
         from simdiff.motion.io.asf_amc import find_asf, read_amc
-        from simdiff.motion.io.retarget import retarget
+        from simdiff.motion.io.retarget import retarget_rig as retarget
 
         asf = find_asf(path)
         if asf is None:

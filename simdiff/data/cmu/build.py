@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from simdiff.data.cmu import captions as cap
-from simdiff.data.cmu.load import load_rig_joints, source_frame
+from simdiff.data.cmu.load import load_source, source_frame
 from simdiff.data.cmu.sources import RIGS, Trial, discover
 from simdiff.data.cmu.splits import SPLIT_NAMES, assign_splits
 from simdiff.data.cmu.windows import MAX_WINDOW, MIN_WINDOW, Window, plan_windows
@@ -33,7 +33,7 @@ from simdiff.data.cmu.writer import write_json, write_lines, write_npy, write_te
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 
-PIPELINE_VERSION: int = 2
+PIPELINE_VERSION: int = 3
 """Bump when the output of a trial changes for the same inputs (invalidates the cache)."""
 
 BUILD_DIR: str = ".build"
@@ -105,6 +105,25 @@ def _trial_key(trial: Trial, rig: str, cfg: BuildConfig) -> str:
     return hashlib.sha1(blob.encode()).hexdigest()
 
 
+CONTACT_HEIGHT: float = 0.15
+"""A frame touches the ground when its lowest joint is within this height (m) of the trial's floor."""
+MIN_GROUND_FRACTION: float = 0.5
+"""Clips whose fraction of ground-touching frames is below this are marked ``support: props``."""
+
+
+def ground_contact(joints: np.ndarray, floor: float = 0.0) -> float:
+    """Fraction of frames of (T, 22, 3) joints whose lowest joint is within
+    :data:`CONTACT_HEIGHT` of ``floor`` (the trial's floor, not the clip's own lowest joint)."""
+    lowest = np.asarray(joints, dtype=np.float64)[..., 1].min(axis=-1)
+    return float(np.mean(lowest - floor <= CONTACT_HEIGHT)) if lowest.size else 0.0
+
+
+def support_of(contact: float) -> str:
+    """"floor" when the body stands on the ground most of the clip, else "props" (hanging
+    from bars or playground equipment, sitting on a prop): physics augmentation skips those."""
+    return "floor" if contact >= MIN_GROUND_FRACTION else "props"
+
+
 def _kit_for_window(trial: Trial, window: Window) -> list[str]:
     """KIT-ML sentences whose time span covers at least half of the window."""
     start, stop = window.start / FPS, window.stop / FPS
@@ -156,7 +175,7 @@ def process_trial(trial: Trial, rig: str, cfg: BuildConfig) -> list[dict[str, An
     """Retarget, window, mirror and write every clip of a trial; returns clip records."""
     from simdiff.motion.mirror import mirror_caption, mirror_joints
 
-    joints = load_rig_joints(trial, rig)
+    joints, skipped = load_source(trial, rig)
     windows = plan_windows(joints.shape[0], trial.segments)
     if not windows:
         raise SimdiffError(
@@ -175,12 +194,15 @@ def process_trial(trial: Trial, rig: str, cfg: BuildConfig) -> list[dict[str, An
             "source": _relative(trial.files[rig], cfg.src),
             "start20": window.start,
             "stop20": window.stop,
-            "source_frames": [source_frame(trial, rig, window.start), source_frame(trial, rig, window.stop)],
+            "source_frames": [source_frame(trial, rig, window.start, skipped), source_frame(trial, rig, window.stop, skipped)],
             "window": window.origin,
             "motion_type": kind,
             "caption_origin": origin,
             "description": trial.description,
         }
+        contact = ground_contact(piece)  # trial joints have the trial's floor at y = 0
+        base["ground_contact"] = round(contact, 3)
+        base["support"] = support_of(contact)
         variants = [(clip_id, piece, texts, None)]
         if cfg.mirror:
             variants.append((f"M{clip_id}", mirror_joints(piece), [mirror_caption(t) for t in texts], clip_id))

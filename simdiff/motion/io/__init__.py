@@ -4,9 +4,9 @@ HumanML3D 22-joint skeleton, and writers (BVH, .npy).
 :func:`load_joints` reads any supported file into (T, 22, 3) float32 joint positions in
 metres, Y-up, at 20 fps.
 
-Note: the package attributes ``retarget`` and ``resample`` are the functions (they shadow
-the modules of the same name); import module contents with
-``from simdiff.motion.io.retarget import CMU_ASF_MAP``.
+``simdiff.motion.io.retarget`` and ``simdiff.motion.io.resample`` are always the modules;
+the functions are :func:`retarget_rig` (also exported here) and
+``simdiff.motion.io.resample.resample``.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from simdiff.motion.io.bvh import read_bvh, starts_with_tpose
 from simdiff.motion.io.bvh_writer import write_bvh
 from simdiff.motion.io.deepmimic import read_deepmimic
 from simdiff.motion.io.npy import read_npy, save_npy
-from simdiff.motion.io.resample import resample
-from simdiff.motion.io.retarget import retarget, to_canonical_lengths
+from simdiff.motion.io.resample import resample as _resample
+from simdiff.motion.io.retarget import retarget_rig, to_canonical_lengths
 from simdiff.motion.io.rig import RigMotion
 from simdiff.motion.skeleton import FPS
 
@@ -38,8 +38,7 @@ __all__ = [
     "read_bvh",
     "read_deepmimic",
     "read_npy",
-    "resample",
-    "retarget",
+    "retarget_rig",
     "save_npy",
     "to_canonical_lengths",
     "write_bvh",
@@ -102,7 +101,7 @@ def load_joints(
     Dispatches on the extension: ``.amc`` (+ ASF), ``.bvh``, DeepMimic ``.txt``/``.json``,
     ``.npy`` joints (T, 22, 3) or un-normalised HumanML3D features (T, 263) (via
     ``simdiff.motion.features.features_to_joints``). Source rigs are retargeted
-    (:func:`retarget`), resampled to 20 fps with an anti-alias filter and put on the floor.
+    (:func:`retarget_rig`), resampled to 20 fps with an anti-alias filter and put on the floor.
 
     Args:
         path: the motion file.
@@ -129,9 +128,9 @@ def load_joints(
             except (ValueError, SimdiffError) as exc:
                 raise MotionFormatError(path, f"bad HumanML3D features: {exc}") from None
         if fps is not None and fps != FPS:
-            array = resample(array, fps, FPS)
+            array = _resample(array, fps, FPS)
         if canonical:
             array = to_canonical_lengths(array, floor=False)
         return np.ascontiguousarray(array, dtype=np.float32)
     rig = load_rig(path, asf=asf, fps=fps, drop_first=drop_first)
-    return retarget(rig, fps=FPS, canonical=canonical)
+    return retarget_rig(rig, fps=FPS, canonical=canonical)

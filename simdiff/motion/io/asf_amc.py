@@ -437,8 +437,8 @@ def read_amc(
         asf: its ``.asf`` file (or an already parsed :class:`AsfSkeleton`).
         fps: capture rate of the trial (CMU: 120, a few trials 60).
     Returns:
-        RigMotion with joints "root" and every ASF bone (its end point), (T, J, 3) metres,
-        Y-up.
+        RigMotion with joints "root", every ASF bone (its end point) and then the derived
+        :data:`ASF_SITES` (``head_centre``), (T, J, 3) metres, Y-up.
     Raises:
         MotionFormatError: naming the file and line of a malformed or truncated input.
     """
@@ -485,6 +485,7 @@ def read_amc(
         offset = bone.direction * bone.length
         positions[:, i] = positions[:, parent] + rotations[:, i] @ offset
     parents = tuple(-1 if parent_of[n] is None else index[parent_of[n]] for n in names)  # type: ignore[index]
+    names, parents, positions = _add_sites(skeleton, list(names), parents, positions, rotations)
     return RigMotion(
         names=tuple(names),
         parents=parents,
@@ -493,6 +494,63 @@ def read_amc(
         source=path,
         meta={"asf": skeleton.path},
     )
+
+
+ASF_SITES: tuple[tuple[str, str, tuple[float, float, float]], ...] = (
+    ("head_centre", "head", (0.0, -1.26, 0.77)),
+    ("lshoulder_centre", "lclavicle", (0.0, -0.11, -0.14)),
+    ("rshoulder_centre", "rclavicle", (0.0, -0.11, -0.14)),
+)
+"""Derived points: (name, bone, (left, up, forward) offset from the bone's end point, in
+units of that bone's length, along the skeleton's rest-pose axes); each moves rigidly with
+its bone. Added only when the skeleton has the bone.
+
+- ``head_centre``: SMPL's head joint (centre-low of the skull, about 5-6 cm in front of
+  and 6-8 cm above the neck base). CMU's ``upperneck``/``head`` bones run up the back of
+  the neck and skull (in the rest pose the ``upperneck`` end is 3-4 cm *behind* the neck
+  base), so the site lies 1.26 head-bone lengths below the head bone's end (the top of the
+  skull) and 0.77 in front of it.
+- ``l/rshoulder_centre``: the glenohumeral centre. The clavicle bone ends at the top front
+  of the shoulder, 2-3 cm higher and further forward than SMPL's shoulder joint.
+"""
+
+
+def rest_frame(skeleton: AsfSkeleton) -> np.ndarray:
+    """(3, 3) rows: the rest pose's left, up (+Y) and forward axes in ASF global coordinates.
+
+    Left is the horizontal direction from ``rhipjoint`` to ``lhipjoint`` (the CMU rest pose
+    faces +Z with its left towards +X, the fallback when the hips are missing).
+    """
+    up = np.array([0.0, 1.0, 0.0])
+    left = np.array([1.0, 0.0, 0.0])
+    bones = skeleton.bones
+    if "lhipjoint" in bones and "rhipjoint" in bones:
+        d = bones["lhipjoint"].direction - bones["rhipjoint"].direction
+        d = d - d[1] * up
+        if np.linalg.norm(d) > 1e-6:
+            left = d / np.linalg.norm(d)
+    return np.stack([left, up, np.cross(left, up)])
+
+
+def _add_sites(
+    skeleton: AsfSkeleton, names: list[str], parents: tuple[int, ...], positions: np.ndarray,
+    rotations: np.ndarray,
+) -> tuple[list[str], tuple[int, ...], np.ndarray]:
+    """Append :data:`ASF_SITES` whose bone exists (end of the bone + rotated rest offset)."""
+    frame = rest_frame(skeleton)
+    extra, extra_parents, extra_names = [], [], []
+    for site, bone, (left, up, forward) in ASF_SITES:
+        if bone not in skeleton.bones or site in names:
+            continue
+        i = names.index(bone)
+        offset = skeleton.bones[bone].length * (left * frame[0] + up * frame[1] + forward * frame[2])
+        extra.append(positions[:, i] + rotations[:, i] @ offset)
+        extra_parents.append(i)
+        extra_names.append(site)
+    if not extra:
+        return names, parents, positions
+    return (names + extra_names, parents + tuple(extra_parents),
+            np.concatenate([positions, np.stack(extra, axis=1)], axis=1))
 
 
 def find_asf(amc_path: str | Path) -> Path | None:

@@ -25,53 +25,79 @@ Source = str | tuple[str, str, float] | tuple[tuple[str, float], ...]
 a weighted mean of joints (weights summing to 1)."""
 
 CMU_ASF_MAP: dict[str, Source] = {
-    "pelvis": "root",
+    # pelvis: on the hip-centre -> neck-base line, 15 % of the way up (SMPL: ~9 cm above the
+    # hip centres, in line with the trunk). CMU's root sits 2-4 cm behind the hip joints.
+    "pelvis": (("lhipjoint", 0.425), ("rhipjoint", 0.425), ("lowerneck", 0.15)),
     "left_hip": "lhipjoint",
     "right_hip": "rhipjoint",
-    "spine1": "lowerback",
+    # spine1/2/3 at 33 / 56 / 64 % of the hip-centre -> neck height (SMPL proportions)
+    "spine1": (("lowerback", 0.825), ("lhipjoint", 0.0875), ("rhipjoint", 0.0875)),
     "left_knee": "lfemur",
     "right_knee": "rfemur",
-    "spine2": "upperback",
+    "spine2": ("upperback", "lowerback", 0.2),
     "left_ankle": "ltibia",
     "right_ankle": "rtibia",
-    "spine3": ("upperback", "thorax", 0.5),
+    "spine3": ("upperback", "thorax", 0.2),
     "left_foot": "lfoot",
     "right_foot": "rfoot",
     "neck": "lowerneck",
-    "left_collar": ("thorax", "lclavicle", 0.45),
-    "right_collar": ("thorax", "rclavicle", 0.45),
-    "head": "upperneck",
-    "left_shoulder": "lclavicle",
-    "right_shoulder": "rclavicle",
+    "left_collar": ("thorax", "lshoulder_centre", 0.45),
+    "right_collar": ("thorax", "rshoulder_centre", 0.45),
+    "head": "head_centre",
+    "left_shoulder": "lshoulder_centre",
+    "right_shoulder": "rshoulder_centre",
     "left_elbow": "lhumerus",
     "right_elbow": "rhumerus",
     "left_wrist": "lradius",
     "right_wrist": "rradius",
 }
-"""CMU ASF bone ends -> HumanML3D joints (a bone's joint is the end of the bone)."""
+"""CMU ASF bone ends (a bone's joint is its end) and the reader's derived sites
+(``head_centre``, ``l/rshoulder_centre``: :data:`simdiff.motion.io.asf_amc.ASF_SITES`)
+-> HumanML3D joints.
+
+Placement (pipeline v3) follows SMPL anatomy, measured in the trunk frame (hip centre ->
+neck base = 1, upright frames): pelvis 0.15 up on that line; spine1/2/3 at 0.33/0.56/0.64
+up and within 0.02-0.03 of the line (joints just in front of the vertebrae); head 0.12 above
+and 0.095 in front of the neck base; shoulders level with the line. See
+``reports/corpus/NOTES.md``."""
 
 _CC_S2, _CC_NECK = "CC_Base_Spine02", "CC_Base_NeckTwist01"
 _CC_LT, _CC_RT = "CC_Base_L_Thigh", "CC_Base_R_Thigh"
+_CC_HEAD, _CC_JAW, _CC_LEYE, _CC_REYE = "CC_Base_Head", "CC_Base_JawRoot", "CC_Base_L_Eye", "CC_Base_R_Eye"
+
+
+def _chest_forward(weight: float) -> tuple[tuple[str, float], ...]:
+    """``weight`` x the CC chest's forward vector (breast minus ribs joint, ~3 cm, both sides):
+    terms summing to 0, to add to a map entry."""
+    h = weight / 2
+    return (("CC_Base_L_Breast", h), ("CC_Base_L_RibsTwist", -h),
+            ("CC_Base_R_Breast", h), ("CC_Base_R_RibsTwist", -h))
+
+
 CC_BVH_MAP: dict[str, Source] = {
-    # pelvis 18 % of the way from the hip centre to the neck (where CMU's root sits)
-    "pelvis": ((_CC_LT, 0.41), (_CC_RT, 0.41), (_CC_NECK, 0.18)),
+    # pelvis 15 % of the way from the hip centre to the neck (as CMU_ASF_MAP)
+    "pelvis": ((_CC_LT, 0.425), (_CC_RT, 0.425), (_CC_NECK, 0.15)),
     "left_hip": _CC_LT,
     "right_hip": _CC_RT,
-    # spine1 62 % of the way from that pelvis point to Spine02
-    "spine1": ((_CC_LT, 0.1558), (_CC_RT, 0.1558), (_CC_NECK, 0.0684), (_CC_S2, 0.62)),
+    # the CC spine joints run 4-6 cm in front of the hip-neck line (belly side); spine1/2/3
+    # are moved back along the chest's forward vector to SMPL's place (see CMU_ASF_MAP)
+    "spine1": ((_CC_S2, 0.646), (_CC_LT, 0.177), (_CC_RT, 0.177), *_chest_forward(-1.08)),
     "left_knee": "CC_Base_L_Calf",
     "right_knee": "CC_Base_R_Calf",
-    "spine2": (_CC_S2, _CC_NECK, 0.17),
+    "spine2": ((_CC_S2, 0.9), (_CC_NECK, 0.1), *_chest_forward(-0.99)),
     "left_ankle": "CC_Base_L_Foot",
     "right_ankle": "CC_Base_R_Foot",
-    "spine3": (_CC_S2, _CC_NECK, 0.385),
+    "spine3": ((_CC_S2, 0.736), (_CC_NECK, 0.264), *_chest_forward(-0.26)),
     "left_foot": "CC_Base_L_ToeBase",
     "right_foot": "CC_Base_R_ToeBase",
     "neck": _CC_NECK,
     # collar: 0.45 of the way from the chest top (0.6 of Spine02 -> neck) to the shoulder
     "left_collar": ((_CC_S2, 0.22), (_CC_NECK, 0.33), ("CC_Base_L_Upperarm", 0.45)),
     "right_collar": ((_CC_S2, 0.22), (_CC_NECK, 0.33), ("CC_Base_R_Upperarm", 0.45)),
-    "head": "CC_Base_Head",
+    # SMPL head joint (skull centre, low): a rigid point of the CC head given by its
+    # landmarks (head joint, eyes, jaw root); CC_Base_Head alone sits at the top of the
+    # neck, 3 cm too far back
+    "head": ((_CC_HEAD, -1.69), (_CC_LEYE, -0.325), (_CC_REYE, -0.325), (_CC_JAW, 3.34)),
     "left_shoulder": "CC_Base_L_Upperarm",
     "right_shoulder": "CC_Base_R_Upperarm",
     "left_elbow": "CC_Base_L_Forearm",
@@ -79,11 +105,9 @@ CC_BVH_MAP: dict[str, Source] = {
     "left_wrist": "CC_Base_L_Hand",
     "right_wrist": "CC_Base_R_Hand",
 }
-"""Reallusion Character-Creator rig (the CMU BVH set) -> HumanML3D joints.
-
-The CC pelvis bone sits only ~2 cm above the thighs and its lumbar joints lie forward of
-the hips, so the pelvis and spine points are placed where the CMU ASF landmarks they stand
-for lie relative to the hips and neck (measured on trials present in both formats)."""
+"""Reallusion Character-Creator rig (the CMU BVH set) -> HumanML3D joints, placed at the
+same anatomical (SMPL) points as :data:`CMU_ASF_MAP`, measured on BVH trials that have no
+AMC version (so the 22 AMC/BVH trials stay a cross-check)."""
 
 DEEPMIMIC_MAP: dict[str, Source] = {
     "pelvis": "root",
@@ -279,7 +303,7 @@ def to_canonical_lengths(joints: np.ndarray, *, floor: bool = True) -> np.ndarra
     return put_on_floor(out) if floor else out
 
 
-def retarget(
+def retarget_rig(
     rig: RigMotion,
     *,
     fps: float = FPS,
