@@ -104,3 +104,13 @@ def test_clear_errors(tmp_path: Path) -> None:
         Normalizer(np.zeros(263), np.where(np.arange(263) == 5, 0.0, 1.0))
     with pytest.raises(SimdiffError, match="263 channels"):
         _normalizer().normalize(np.zeros((4, 251)))
+
+
+def test_shipped_default_statistics_are_grouped_and_plausible():
+    from simdiff.motion.normalize import default_normalizer
+
+    norm = default_normalizer()
+    assert norm.mean.shape == norm.std.shape == (263,)
+    assert 0.8 < norm.mean[3] < 1.0  # root height of standing people, metres
+    for group in (slice(4, 67), slice(67, 193), slice(193, 259), slice(259, 263)):
+        assert np.ptp(norm.std[group]) == 0.0  # HumanML3D-style group-averaged std

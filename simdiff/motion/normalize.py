@@ -40,6 +40,10 @@ def _check_vector(values: np.ndarray, name: str) -> np.ndarray:
     return values.astype(np.float32)
 
 
+DEFAULT_STATS_DIR = Path(__file__).resolve().parents[1] / "assets" / "cmu_stats"
+"""Mean/Std of the project's CMU corpus (train split), shipped with the package."""
+
+
 class Normalizer:
     """Feature normaliser with ``mean`` and ``std``, each (263,) float32."""
 
@@ -100,6 +104,11 @@ class Normalizer:
 
     def __repr__(self) -> str:
         return f"Normalizer(mean[3]={self.mean[3]:.4f}, std[3]={self.std[3]:.4f})"
+
+
+def default_normalizer() -> Normalizer:
+    """The shipped CMU-corpus Mean/Std (see ``simdiff/assets/cmu_stats/README.md``)."""
+    return Normalizer.from_dir(DEFAULT_STATS_DIR)
 
 
 def _load_vector(path: Path) -> np.ndarray:

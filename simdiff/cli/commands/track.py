@@ -10,9 +10,6 @@ from pathlib import Path
 
 from simdiff.errors import SimdiffError
 
-DEFAULT_STATS = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "humanml3d"
-
-
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "track",
@@ -33,51 +30,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="write each rollout as DIR/<name>.npy joints")
     p.add_argument("--json", action="store_true", help="print one JSON object per motion")
     p.add_argument("--stats", type=Path, default=None, metavar="DIR",
-                   help="folder with Mean.npy/Std.npy for d_L2 (default: $SIMDIFF_STATS or ../shared/data/humanml3d if present)")
+                   help="folder with Mean.npy/Std.npy for d_L2 (default: $SIMDIFF_STATS, else the statistics shipped with simdiff)")
     p.add_argument("--force", action="store_true", help="allow φ outside the validated ranges")
     p.add_argument("--fps", type=float, default=None, help="source frame rate when the file does not say")
     p.set_defaults(func=run)
 
 
-def load_motion(path: Path, fps: float | None = None):
-    """(T, 22, 3) HumanML3D joints from any motion file ``simdiff convert`` reads."""
-    import numpy as np
+def _normalizer(arg: Path | None):
+    """d_L2's normaliser: --stats, else $SIMDIFF_STATS, else the shipped CMU-corpus statistics."""
+    from simdiff.motion.normalize import Normalizer, default_normalizer
 
-    if not path.is_file():
-        raise SimdiffError(f"{path}: no such file")
-    try:
-        from simdiff.motion.io import load_joints
-    except ImportError:
-        load_joints = None
-    if load_joints is not None:
-        kwargs = {"fps": fps} if fps is not None else {}
-        return np.asarray(load_joints(path, **kwargs), dtype=np.float64)
-    if path.suffix.lower() == ".amc":  # until load_joints exists: the AMC reader + retargeting
-        from simdiff.motion.io.asf_amc import find_asf, read_amc
-        from simdiff.motion.io.retarget import retarget_rig as retarget
-
-        asf = find_asf(path)
-        if asf is None:
-            raise SimdiffError(f"{path}: no ASF skeleton found beside it or in ../asf/")
-        rig = read_amc(path, asf, **({"fps": fps} if fps else {}))
-        return np.asarray(retarget(rig, canonical=True), dtype=np.float64)
-    if path.suffix.lower() != ".npy":
-        raise SimdiffError(f"{path}: only .npy and .amc can be read until the motion readers are installed")
-    arr = np.load(path)
-    if arr.ndim != 3 or arr.shape[1:] != (22, 3):
-        raise SimdiffError(f"{path}: expected joints (T, 22, 3), got {arr.shape}")
-    return arr.astype(np.float64)
-
-
-def _stats_dir(arg: Path | None) -> Path | None:
-    if arg is not None:
-        if not (arg / "Mean.npy").is_file() or not (arg / "Std.npy").is_file():
-            raise SimdiffError(f"{arg}: needs Mean.npy and Std.npy")
-        return arg
-    env = os.environ.get("SIMDIFF_STATS")
-    if env:
-        return Path(env)
-    return DEFAULT_STATS if (DEFAULT_STATS / "Mean.npy").is_file() else None
+    path = arg if arg is not None else (Path(os.environ["SIMDIFF_STATS"]) if os.environ.get("SIMDIFF_STATS") else None)
+    return Normalizer.from_dir(path) if path is not None else default_normalizer()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -90,17 +54,14 @@ def run(args: argparse.Namespace) -> int:
     if args.residual < 0:
         raise SimdiffError(f"--residual must be ≥ 0, got {args.residual}")
     env = Environment(args.gravity, float(args.wind[0]), float(args.wind[1])).validate(force=args.force)
-    stats = _stats_dir(args.stats)
-    normalizer = None
-    if stats is not None:
-        from simdiff.motion.normalize import Normalizer
+    from simdiff.motion.io import load_joints
 
-        normalizer = Normalizer.from_dir(stats)
+    normalizer = _normalizer(args.stats)
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
     n_ok = 0
     for path in args.files:
-        joints = load_motion(path, args.fps)
+        joints = np.asarray(load_joints(path, fps=args.fps), dtype=np.float64)
         out, info = project(joints, env, residual=ResidualConfig(max_force=args.residual), normalizer=normalizer,
                             force=args.force)
         n_ok += info.success
