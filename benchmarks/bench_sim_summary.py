@@ -14,6 +14,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 REP = ROOT / "reports" / "sim"
+DEV = {"16_15", "16_17", "16_36", "16_05", "13_30", "02_01", "05_05", "05_10", "06_13", "105_02"}
+"""Clips used while developing the tracker; every other clip is held out."""
 
 
 def main() -> int:
@@ -32,6 +34,9 @@ def main() -> int:
             f"* tracked to the end: {len(ok)}/{len(rs)} = {100 * len(ok) / max(len(rs), 1):.0f} %",
             f"* tracked with mean residual force ≤ 0.1·m·g: {len(ok01)}/{len(rs)} = {100 * len(ok01) / max(len(rs), 1):.0f} %",
         ]
+        for name, part in (("dev", [r for r in rs if r["clip"] in DEV]), ("held-out", [r for r in rs if r["clip"] not in DEV])):
+            n01 = sum(r in ok01 for r in part)
+            lines.append(f"  * {name}: {n01}/{len(part)} = {100 * n01 / max(len(part), 1):.0f} % (tracked {sum(r in ok for r in part)})")
         if len(ok):
             lines += [
                 f"* d_L2 of tracked clips: median {np.median(d):.2f}, range {d.min():.2f}–{d.max():.2f}; ≤ 7: {int((d <= 7).sum())}",

@@ -127,3 +127,29 @@ def test_balance_layer_quiet_on_reference_and_pushes_back(squat_ref):
     delta = on.act(d, 0) - off.act(d, 0)
     ankles = [on.leg[s][2] for s in ("L", "R")]
     assert np.all(delta[ankles] > 0)  # +y at the ankle = toes down: the CoP moves forward
+
+
+def test_residual_follows_a_lower_stance_ankle(squat_ref):
+    """A body standing lower because its stance ankle is lower than the mocap's (e.g. a foot laid
+    flat that the mocap had tilted on an edge) is not held up at the mocap height."""
+    import mujoco
+
+    from simdiff.sim.humanoid import model_index
+    from simdiff.sim.residual import RootResidual
+
+    m = load_model()
+    ix = model_index(m)
+    d = mujoco.MjData(m)
+
+    def fz(cfg: ResidualConfig, dz: float) -> float:
+        d.qpos[:] = squat_ref.qpos[0]
+        d.qpos[2] += dz
+        d.qvel[:] = squat_ref.qvel[0]
+        mujoco.mj_forward(m, d)
+        res = RootResidual(cfg, m, squat_ref, ix, -9.81)
+        assert res.sim_support(d)
+        return float(res.wrench(d, 0.0)[2])
+
+    shifted, absolute = fz(ResidualConfig(), -0.03), fz(ResidualConfig(support_shift_max=0.0), -0.03)
+    assert absolute > 0.2 * ix.mass * 9.81  # kp_z · 3 cm ≈ 0.3·m·g at the mocap height
+    assert shifted < 0.1 * absolute

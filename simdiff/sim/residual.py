@@ -9,7 +9,9 @@ pelvis is computed:
 * force, velocity-level in xy: ``F_xy = m·kv·(v_ref − v)`` on the whole-body COM velocity
   (no position term, so wind can make the character drift: a constant wind w leaves a
   steady velocity error w / (m·kv)); vertical ``F_z = m·(kp_z·Δz + kd_z·Δv_z)`` clipped to
-  ≥ 0 (push-only); then ``|F| ≤ max_force·m·|g_z|``;
+  ≥ 0 (push-only), where the target height is the reference COM height lowered by as much
+  as the simulated stance (lower) ankle sits below the reference's (bounded, never raised);
+  then ``|F| ≤ max_force·m·|g_z|``;
 * torque: ``τ = kp_rot·e_rot + kd_rot·Δω`` on the pelvis orientation, ``|τ| ≤ max_torque``.
 
 It is written to ``data.xfrc_applied[pelvis]`` (applied at the pelvis COM), logged per step
@@ -38,6 +40,11 @@ class ResidualConfig:
             from kd_z 20 → 5 with the same clips tracked); the legs' balance layer damps.
         kp_rot, kd_rot: pelvis orientation gains (N·m/rad, N·m·s/rad).
         ref_window: control frames around now in which the reference must touch the floor.
+        support_shift_max: the vertical target is the reference COM height lowered by as much
+            as the simulated stance (lower) ankle sits below the reference's, at most this (m);
+            it is never raised. A foot that the simulation lays flat where the mocap had it
+            tilted on an edge lowers the body, and the residual must not hold it up at the
+            mocap height (measured: the dancers' residual halves). 0: absolute height.
     """
 
     max_force: float = 0.5
@@ -48,6 +55,7 @@ class ResidualConfig:
     kp_rot: float = 1500.0
     kd_rot: float = 150.0
     ref_window: int = 2
+    support_shift_max: float = 0.05
 
     @property
     def torque_bound(self) -> float:
@@ -102,6 +110,14 @@ class RootResidual:
         quat = reference.qpos[:, 3:7]
         R = Rotation.from_quat(quat[:, [1, 2, 3, 0]])
         self.ref_omega = R.apply(reference.qvel[:, 3:6])
+        # height of the lower ankle of the reference (the stance side), per frame
+        self.ankles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"{s}_Ankle") for s in ("L", "R")]
+        d = mujoco.MjData(model)
+        self.ref_ankle_z = np.zeros(K)
+        for k in range(K):
+            d.qpos[:] = reference.qpos[k]
+            mujoco.mj_kinematics(model, d)
+            self.ref_ankle_z[k] = d.xpos[self.ankles, 2].min()
 
     def sim_support(self, data) -> bool:
         """True when a foot or hand geom touches the floor (contacts of the current step)."""
@@ -130,7 +146,12 @@ class RootResidual:
         c = self.cfg
         f = np.empty(3)
         f[:2] = self.mass * c.kv_xy * (vel_ref[:2] - vel[:2])
-        f[2] = max(0.0, self.mass * (c.kp_z * (com_ref[2] - com[2]) + c.kd_z * (vel_ref[2] - vel[2])))
+        z_ref = com_ref[2]
+        if c.support_shift_max > 0:
+            ankle_ref = (1 - a) * self.ref_ankle_z[k] + a * self.ref_ankle_z[k1]
+            shift = data.xpos[self.ankles, 2].min() - ankle_ref
+            z_ref += float(np.clip(shift, -c.support_shift_max, 0.0))
+        f[2] = max(0.0, self.mass * (c.kp_z * (z_ref - com[2]) + c.kd_z * (vel_ref[2] - vel[2])))
         n = np.linalg.norm(f)
         if n > self.fmax:
             f *= self.fmax / max(n, 1e-12)
