@@ -21,13 +21,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    try:
-        from simdiff.model import default as _default  # noqa: F401  (arrives with the model issue)
-    except ImportError:
+    import importlib
+    import importlib.util
+
+    if importlib.util.find_spec("simdiff.model.default") is None:  # arrives with the shipped weights
         print(
             "simdiff: no default model yet: the shipped weights arrive with the model and "
             "training work; meanwhile use `simdiff convert`, `simdiff metrics` and `simdiff render`.",
             file=sys.stderr,
         )
         return 1
-    return _default.generate_cli(args)
+    return importlib.import_module("simdiff.model.default").generate_cli(args)
