@@ -120,3 +120,25 @@ def test_train_on_a_humanml3d_directory(tmp_path, capsys) -> None:
 
     assert load_file(str(run / "model" / "model.safetensors"))["normalizer.std"].shape == (263,)
     assert main(["train", "backbone", "--data", str(tmp_path / "missing"), "--steps", "1", "--out", str(run)]) == 2
+
+
+def test_adapters_train_on_a_simulator_augmented_corpus(runs, tmp_path) -> None:
+    from simdiff.data.augment import AugmentConfig, augment
+    from simdiff.eval.testing import write_tiny_corpus
+    from simdiff.sim.env import Environment
+
+    def projector(motions, envs):  # stands in for the simulator: returns the motion, always kept
+        for m, e in zip(motions, envs):
+            info = {"success": True, "status": "ok", "fall_frame": None, "d_l2": 1.0, "env": list(e.as_tuple())
+                    if isinstance(e, Environment) else list(e), "residual": {"force_mean_mg": 0.01}}
+            yield np.asarray(m, dtype=np.float32), info
+
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=3, n_test=1, frames=48)
+    augment(corpus, tmp_path / "aug", AugmentConfig(mode="binary"), projector=projector, progress=False)
+    assert main(["train", "adapters", "--data", str(tmp_path / "aug"), "--source", str(corpus),
+                 "--init", str(runs / "bb" / "model"), "--steps", "2", "--batch-size", "2",
+                 "--out", str(tmp_path / "ad"), "--no-progress"]) == 0
+    assert (tmp_path / "ad" / "model" / "model.safetensors").is_file()
+    # Adapters refuse a corpus without φ.
+    assert main(["train", "adapters", "--data", str(corpus), "--init", str(runs / "bb" / "model"),
+                 "--steps", "1", "--out", str(tmp_path / "ad2"), "--no-progress"]) == 2

@@ -17,6 +17,8 @@ def _common(p: argparse.ArgumentParser) -> None:
     data.add_argument("--data", type=Path, help="HumanML3D-layout directory (new_joint_vecs/, texts/, Mean.npy, Std.npy, <split>.txt)")
     data.add_argument("--synthetic", type=int, metavar="N", help="train on N synthetic clips (smoke tests only)")
     p.add_argument("--split", default="train", help="split file name under --data (default: train)")
+    p.add_argument("--source", type=Path, default=None,
+                   help="augmented --data only: also train on this source corpus's clips as env_index 0 (binary setting)")
     p.add_argument("--out", type=Path, required=True, help="run folder: checkpoints/, model/ (resumes if it has checkpoints)")
     p.add_argument("--config", type=Path, help="a run config JSON (see configs/); flags below override it")
     p.add_argument("--steps", type=int, help="total optimiser steps")
@@ -114,9 +116,12 @@ def _dataset(args: argparse.Namespace, seed: int):
         if args.synthetic < 1:
             raise SimdiffError("--synthetic needs at least one clip")
         return synthetic_dataset(args.synthetic, frames=60, seed=seed, with_env=args.mode == "adapters")
-    from simdiff.data.humanml3d import HumanML3D
+    from simdiff.data.augment import open_training_dataset
 
-    return HumanML3D(args.data, split=args.split, seed=seed)
+    dataset = open_training_dataset(args.data, args.split, seed, source=getattr(args, "source", None))
+    if args.mode == "adapters" and not (args.data / "env.json").is_file():
+        raise SimdiffError(f"{args.data}: adapters train on a simulator-augmented corpus (env.json), see `simdiff data augment`")
+    return dataset
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,0 +1,99 @@
+"""Training items from a simulator-augmented corpus, labelled with φ for ``simdiff train adapters``.
+
+Items are HumanML3D items (see :class:`simdiff.data.humanml3d.HumanML3D`) plus
+
+* ``env``: (3,) float32 φ = (g_z m/s², w_x N, w_y N) of the condition the clip was replayed in;
+* ``env_index``: int, the categorical label (binary: 1 simulated, 0 source; random: condition index).
+
+``source`` optionally mixes in the original (kinematic) clips of the source corpus with
+``env_index`` 0 and ``env`` = Earth (−9.81, 0, 0): the binary setting's second class.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from simdiff.data.humanml3d import HumanML3D
+from simdiff.errors import SimdiffError
+from simdiff.motion.normalize import Normalizer
+from simdiff.sim.env import EARTH_GRAVITY
+
+ENV_FILE = "env.json"
+SOURCE_INDEX: int = 0
+"""``env_index`` of source (non-simulated) clips."""
+
+
+def read_env_table(root: str | Path) -> dict[str, dict[str, Any]]:
+    """``root/env.json`` as {clip id: {env, env_index, ...}}."""
+    path = Path(root) / ENV_FILE
+    if not path.is_file():
+        raise SimdiffError(f"{path}: missing (not a simulator-augmented corpus; run simdiff data augment)")
+    try:
+        table = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise SimdiffError(f"{path}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+    for key, row in table.items():
+        if len(row.get("env", [])) != 3 or "env_index" not in row:
+            raise SimdiffError(f"{path}: entry {key!r} needs 'env' (3 numbers) and 'env_index'")
+    return table
+
+
+class AugmentedHumanML3D:
+    """Simulator-augmented clips (and optionally the source clips) with φ labels.
+
+    Args:
+        root: the augmented corpus (``simdiff data augment --out``).
+        split: split file of ``root`` (``train`` = every kept pair).
+        source: the source corpus to mix in with ``env_index`` 0 (None: simulated clips only).
+        source_split: split of ``source`` to mix in.
+        normalizer: default ``root``'s Mean/Std (copied from the source corpus).
+        unit_length, seed: as :class:`HumanML3D`.
+    """
+
+    def __init__(self, root: str | Path, split: str = "train", source: str | Path | None = None,
+                 source_split: str = "train", normalizer: Normalizer | None = None, unit_length: int = 4,
+                 seed: int = 0) -> None:
+        self.env_table = read_env_table(root)
+        self.sim = HumanML3D(root, split, normalizer=normalizer, unit_length=unit_length, seed=seed)
+        self.normalizer = self.sim.normalizer
+        missing = [it.clip_id for it in self.sim.items if it.clip_id not in self.env_table]
+        if missing:
+            raise SimdiffError(f"{Path(root) / ENV_FILE}: no φ for clip {missing[0]!r}")
+        self.source = None
+        if source is not None:
+            self.source = HumanML3D(source, source_split, normalizer=self.normalizer, unit_length=unit_length,
+                                    seed=seed + 1)
+
+    def __len__(self) -> int:
+        return len(self.sim) + (len(self.source) if self.source is not None else 0)
+
+    def get(self, index: int, rng: np.random.Generator | None = None) -> dict[str, Any]:
+        """Item ``index`` (simulated first, then source), drawn with ``rng``."""
+        if not 0 <= index < len(self):
+            raise SimdiffError(f"index {index} out of range for {len(self)} items")
+        if index < len(self.sim):
+            item = self.sim.get(index, rng)
+            row = self.env_table[self.sim.items[index].clip_id]
+            item["env"] = np.asarray(row["env"], dtype=np.float32)
+            item["env_index"] = int(row["env_index"])
+            return item
+        assert self.source is not None
+        item = self.source.get(index - len(self.sim), rng)
+        item["env"] = np.array([EARTH_GRAVITY, 0.0, 0.0], dtype=np.float32)
+        item["env_index"] = SOURCE_INDEX
+        return item
+
+    def __getitem__(self, index: int) -> dict[str, Any]:
+        return self.get(index)
+
+
+def open_training_dataset(root: str | Path, split: str = "train", seed: int = 0,
+                          source: str | Path | None = None) -> HumanML3D | AugmentedHumanML3D:
+    """The dataset ``simdiff train`` should read from ``root``: augmented (with φ) when it has env.json."""
+    if (Path(root) / ENV_FILE).is_file():
+        return AugmentedHumanML3D(root, split, source=source, seed=seed)
+    return HumanML3D(root, split=split, seed=seed)

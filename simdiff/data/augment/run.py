@@ -1,0 +1,339 @@
+"""The augmentation driver: replay every training clip under each condition, filter, write a corpus.
+
+Output (``out``), in the HumanML3D layout plus φ::
+
+    new_joint_vecs/<id>.npy   (T-1, 263) features of the rollout (process_joints: canonical
+                              skeleton, floor, facing +Z), as the source corpus was built
+    new_joints/<id>.npy       (T-1, 22, 3) the joints those features give back
+    texts/<id>.txt            the source clip's caption file, copied byte for byte
+    Mean.npy, Std.npy         copied from the source corpus (the model's normaliser)
+    train.txt, all.txt        kept ids (``<clip>_e<condition:02d>``)
+    env.json                  {id: {env: [g_z, w_x, w_y], env_index, condition, factor, source}}
+    conditions.json           the condition list
+    report.json, report.md    kept fraction per condition, reasons, CPU time
+    augment_settings.json     what a resumed run must match
+    shards/shard_NNNNN.json   one per group of ``shard_size`` source clips: every pair's outcome
+                              and projection info; written last (temp + os.replace), so a shard
+                              either exists whole or is redone
+
+``env_index``: binary mode labels simulated clips 1 (0 is left for the source, kinematic
+clips, see :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`); random mode uses the
+condition index. Resuming: shards whose file exists with the same clips are skipped; files a
+killed shard left behind are overwritten by its re-run, and files of no finished shard are
+deleted when the run finalises.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from simdiff.data.augment.conditions import Condition, make_conditions
+from simdiff.data.augment.filter import REASONS, FilterConfig, keep_pair
+from simdiff.data.augment.projector import Projector, SimProjector
+from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_npy
+from simdiff.errors import SimdiffError
+
+BINARY_SIM_INDEX: int = 1
+"""``env_index`` of simulated clips in binary mode (0 = source clips)."""
+SHARD_DIR = "shards"
+SETTINGS_NAME = "augment_settings.json"
+
+
+@dataclass
+class AugmentConfig:
+    """Options of :func:`augment` (the CLI flags of ``simdiff data augment``).
+
+    Attributes:
+        mode: ``binary`` (Earth only) or ``random`` (``conditions`` one-factor environments).
+        conditions: number of random conditions (paper: 30).
+        seed: seeds the condition draw (the simulation itself is deterministic).
+        split: source split to augment (``train``; never the test split).
+        shard_size: source clips per shard (each shard holds shard_size × conditions pairs).
+        limit: only the first ``limit`` clips of the split (smoke runs).
+        filter: keep thresholds (d_L2 ≤ 7, mean residual ≤ 0.1·m·g).
+        residual_bound: the tracker's root-residual bound (fraction of m·|g_z|; 0 = strict).
+        workers, backend: parallelism of the default projector.
+    """
+
+    mode: str = "random"
+    conditions: int = 30
+    seed: int = 0
+    split: str = "train"
+    shard_size: int = 4
+    limit: int | None = None
+    filter: FilterConfig = field(default_factory=FilterConfig)
+    residual_bound: float = 0.5
+    workers: int = 0
+    backend: str = "process"
+
+    def settings(self) -> dict[str, Any]:
+        """The options a resumed run must share (parallelism and limit may change)."""
+        return {"mode": self.mode, "conditions": self.conditions if self.mode == "random" else 1, "seed": self.seed,
+                "split": self.split, "shard_size": self.shard_size, "filter": dataclasses.asdict(self.filter),
+                "residual_bound": self.residual_bound}
+
+
+def clip_id_for(clip: str, condition: Condition) -> str:
+    """Id of the augmented copy of ``clip`` under ``condition``."""
+    return f"{clip}_e{condition.index:02d}"
+
+
+def env_index_for(mode: str, condition: Condition) -> int:
+    """Categorical label of a simulated clip (see module docstring)."""
+    return BINARY_SIM_INDEX if mode == "binary" else condition.index
+
+
+def load_source_joints(corpus: Path, clip: str) -> np.ndarray:
+    """The full (T, 22, 3) joint sequence of a source clip (T = feature rows + 1).
+
+    Uses ``new_joints`` (T-1 frames, as HumanML3D ships them) extended by the last feature
+    row's velocities; falls back to recovering the joints from the features.
+    """
+    from simdiff.motion.features import extend_last_frame, features_to_joints
+
+    feats_path = corpus / "new_joint_vecs" / f"{clip}.npy"
+    if not feats_path.is_file():
+        raise SimdiffError(f"{feats_path}: missing features of clip {clip}")
+    feats = np.load(feats_path, allow_pickle=False).astype(np.float32)
+    joints_path = corpus / "new_joints" / f"{clip}.npy"
+    joints = np.load(joints_path, allow_pickle=False) if joints_path.is_file() else features_to_joints(feats)
+    joints = np.asarray(joints, dtype=np.float32)
+    if joints.shape != (len(feats), 22, 3):
+        joints = np.asarray(features_to_joints(feats), dtype=np.float32)
+    return extend_last_frame(joints, feats)
+
+
+def rollout_to_layout(rollout: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(T, 22, 3) rollout joints → ((T-1, 263) features, (T-1, 22, 3) joints) as the corpus stores them."""
+    from simdiff.motion.features import features_to_joints, process_joints
+
+    features = process_joints(np.asarray(rollout, dtype=np.float64)).features.astype(np.float32)
+    if not np.all(np.isfinite(features)):
+        raise SimdiffError("non-finite features from a rollout")
+    return features, np.asarray(features_to_joints(features), dtype=np.float32)
+
+
+def _info_dict(info: Any) -> Any:
+    if info is None or isinstance(info, (str, dict)):
+        return info
+    to_dict = getattr(info, "to_dict", None)
+    return to_dict() if callable(to_dict) else dataclasses.asdict(info)
+
+
+def _shard_path(out: Path, index: int) -> Path:
+    return out / SHARD_DIR / f"shard_{index:05d}.json"
+
+
+def _read_json(path: Path) -> Any:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as exc:
+        raise SimdiffError(f"cannot read {path}: {exc}") from None
+
+
+def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[Condition], list[list[str]]]:
+    """(clip ids, conditions, shards as lists of clip ids) for a run; validates the corpus."""
+    from simdiff.data.humanml3d import read_split
+
+    if not corpus.is_dir():
+        raise SimdiffError(f"corpus directory not found: {corpus}")
+    for name in ("Mean.npy", "Std.npy"):
+        if not (corpus / name).is_file():
+            raise SimdiffError(f"{corpus / name}: missing (the augmented corpus reuses the source Mean/Std)")
+    if config.split == "test":
+        raise SimdiffError("refusing to augment the test split (it must stay unseen)")
+    if config.shard_size < 1:
+        raise SimdiffError(f"shard size must be at least 1, got {config.shard_size}")
+    clips = read_split(corpus / f"{config.split}.txt")
+    if config.limit is not None:
+        if config.limit < 1:
+            raise SimdiffError(f"--limit must be at least 1, got {config.limit}")
+        clips = clips[: config.limit]
+    if not clips:
+        raise SimdiffError(f"{corpus / (config.split + '.txt')}: no clips to augment")
+    conditions = make_conditions(config.mode, config.conditions, config.seed)
+    shards = [clips[i : i + config.shard_size] for i in range(0, len(clips), config.shard_size)]
+    return clips, conditions, shards
+
+
+def _check_settings(out: Path, config: AugmentConfig, conditions: list[Condition]) -> None:
+    settings = {**config.settings(), "condition_list": [c.to_dict() for c in conditions]}
+    path = out / SETTINGS_NAME
+    if path.is_file():
+        old = _read_json(path)
+        if old != json.loads(json.dumps(settings)):
+            changed = sorted(k for k in set(old) | set(settings) if old.get(k) != json.loads(json.dumps(settings)).get(k))
+            raise SimdiffError(f"{out} was made with different settings ({', '.join(changed)}); use a new --out")
+    else:
+        write_json(path, settings)
+
+
+def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], conditions: list[Condition],
+               config: AugmentConfig, projector: Projector, tick: Callable[[int], None]) -> dict[str, Any]:
+    """Project, filter and write one shard; returns its record (written by the caller)."""
+    motions, envs, pairs, load_errors = [], [], [], {}
+    for clip in clips:
+        try:
+            joints = load_source_joints(corpus, clip)
+        except SimdiffError as exc:
+            load_errors[clip] = str(exc)
+            continue
+        for cond in conditions:
+            motions.append(joints)
+            envs.append(cond.env)
+            pairs.append((clip, cond))
+    records: list[dict[str, Any]] = []
+    for clip, message in load_errors.items():
+        for cond in conditions:
+            records.append({"clip": clip, "condition": cond.index, "id": clip_id_for(clip, cond), "kept": False,
+                            "reason": "error", "info": message})
+        tick(len(conditions))
+    results = iter(projector(motions, envs)) if motions else iter(())
+    for clip, cond in pairs:
+        try:
+            rollout, info = next(results)
+        except StopIteration:
+            raise SimdiffError(f"the projector returned fewer results than the {len(pairs)} motions given") from None
+        kept, reason = keep_pair(info, config.filter)
+        aid = clip_id_for(clip, cond)
+        if kept:
+            try:
+                feats, joints = rollout_to_layout(rollout)
+            except SimdiffError as exc:
+                kept, reason, info = False, "error", str(exc)
+            else:
+                write_npy(out / "new_joint_vecs" / f"{aid}.npy", feats)
+                write_npy(out / "new_joints" / f"{aid}.npy", joints)
+                write_bytes(out / "texts" / f"{aid}.txt", (corpus / "texts" / f"{clip}.txt").read_bytes())
+        records.append({"clip": clip, "condition": cond.index, "id": aid, "kept": kept, "reason": reason,
+                        "info": _info_dict(info)})
+        tick(1)
+    order = {(c, k.index): i for i, (c, k) in enumerate((c, k) for c in clips for k in conditions)}
+    records.sort(key=lambda r: order[(r["clip"], r["condition"])])
+    return {"shard": index, "clips": clips, "records": records}
+
+
+def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config: AugmentConfig = AugmentConfig(),
+            projector: Projector | None = None, progress: bool = True) -> dict[str, Any]:
+    """Build (or resume) a simulator-augmented corpus; returns the report (also in ``out/report.json``).
+
+    Args:
+        corpus: source corpus in the HumanML3D layout (Mean.npy, Std.npy, <split>.txt).
+        out: output folder (created; resumed when it holds shards of the same settings).
+        config: see :class:`AugmentConfig`.
+        projector: injected projector (tests); default :class:`SimProjector` on ``corpus`` stats.
+        progress: show a tqdm bar (pairs done, rate, ETA) on stderr.
+    """
+    from tqdm import tqdm
+
+    corpus, out = Path(corpus), Path(out)
+    clips, conditions, shards = plan(corpus, config)
+    out.mkdir(parents=True, exist_ok=True)
+    _check_settings(out, config, conditions)
+    todo = []
+    for i, shard in enumerate(shards):
+        path = _shard_path(out, i)
+        if not (path.is_file() and _read_json(path).get("clips") == shard):
+            todo.append(i)
+    own = projector is None
+    proj: Projector = projector or SimProjector(str(corpus), config.workers, config.backend, config.residual_bound)
+    total = len(clips) * len(conditions)
+    done = sum(len(shards[i]) for i in range(len(shards)) if i not in todo) * len(conditions)
+    start = time.time()
+    bar = tqdm(total=total, initial=done, desc="augment", unit="pair", disable=not progress, dynamic_ncols=True)
+    try:
+        for i in todo:
+            record = _run_shard(corpus, out, i, shards[i], conditions, config, proj, bar.update)
+            write_json(_shard_path(out, i), record)
+    finally:
+        bar.close()
+        if own:
+            getattr(proj, "close", lambda: None)()
+    return finalize(corpus, out, config, conditions, len(shards), wall_s=time.time() - start)
+
+
+def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequence[Condition], n_shards: int,
+             wall_s: float = 0.0) -> dict[str, Any]:
+    """Write splits, env.json, Mean/Std and the report from the finished shards; drop orphan files."""
+    records: list[dict[str, Any]] = []
+    protected: set[str] = set()  # kept ids of every finished shard, also those beyond this run's --limit
+    for path in sorted((out / SHARD_DIR).glob("shard_*.json")):
+        shard = _read_json(path)
+        protected.update(r["id"] for r in shard["records"] if r["kept"])
+        if int(shard["shard"]) < n_shards:
+            records.extend(shard["records"])
+    kept = [r for r in records if r["kept"]]
+    by_index = {c.index: c for c in conditions}
+    env = {
+        r["id"]: {"env": list(by_index[r["condition"]].env.as_tuple()), "env_index": env_index_for(config.mode, by_index[r["condition"]]),
+                  "condition": r["condition"], "factor": by_index[r["condition"]].factor, "source": r["clip"]}
+        for r in kept
+    }
+    ids = [r["id"] for r in kept]
+    write_lines(out / "train.txt", ids)
+    write_lines(out / "all.txt", ids)
+    write_json(out / "env.json", env)
+    write_json(out / "conditions.json", [c.to_dict() for c in conditions])
+    for name in ("Mean.npy", "Std.npy"):
+        write_bytes(out / name, (corpus / name).read_bytes())
+    keep_set = set(ids) | protected
+    for sub, ext in (("new_joint_vecs", ".npy"), ("new_joints", ".npy"), ("texts", ".txt")):
+        folder = out / sub
+        if folder.is_dir():
+            for path in folder.glob(f"*{ext}"):
+                if path.stem not in keep_set:
+                    path.unlink()
+            folder.mkdir(exist_ok=True)
+        else:
+            folder.mkdir(parents=True)
+    report = build_report(records, conditions, config)
+    report["wall_s_this_run"] = round(wall_s, 3)
+    write_json(out / "report.json", report)
+    (out / "report.md").write_text(report_markdown(report), encoding="utf-8")
+    return report
+
+
+def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Condition], config: AugmentConfig) -> dict[str, Any]:
+    """Kept fraction and reasons per condition and overall, and the simulator CPU time."""
+    rows = []
+    for cond in conditions:
+        mine = [r for r in records if r["condition"] == cond.index]
+        reasons = {k: sum(1 for r in mine if r["reason"] == k) for k in REASONS}
+        rows.append({**cond.to_dict(), "pairs": len(mine), "kept": reasons["kept"],
+                     "kept_fraction": reasons["kept"] / len(mine) if mine else None, "reasons": reasons})
+    cpu = [float(r["info"].get("cpu_s", 0.0)) for r in records if isinstance(r["info"], dict)]
+    total_kept = sum(1 for r in records if r["kept"])
+    return {"settings": config.settings(), "pairs": len(records), "kept": total_kept,
+            "kept_fraction": total_kept / len(records) if records else None,
+            "clips": len({r["clip"] for r in records}), "sim_cpu_s_total": round(sum(cpu), 3),
+            "per_condition": rows}
+
+
+def report_markdown(report: dict[str, Any]) -> str:
+    """The report as a Markdown table."""
+    frac = report["kept_fraction"]
+    lines = [
+        "# Simulator-augmented corpus", "",
+        f"* pairs: {report['pairs']} from {report['clips']} clips; kept {report['kept']}"
+        + (f" ({100 * frac:.1f} %)" if frac is not None else ""),
+        f"* filter: {report['settings']['filter']}; tracker residual bound {report['settings']['residual_bound']}·m·g",
+        f"* simulator CPU time: {report['sim_cpu_s_total']} s", "",
+        "| cond | factor | g_z | w_x | w_y | pairs | kept | kept % | failed | d_L2 | residual | error |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in report["per_condition"]:
+        g, wx, wy = r["env"]
+        pct = "—" if r["kept_fraction"] is None else f"{100 * r['kept_fraction']:.1f}"
+        rs = r["reasons"]
+        lines.append(f"| {r['index']} | {r['factor']} | {g:.2f} | {wx:.2f} | {wy:.2f} | {r['pairs']} | {r['kept']} | {pct} "
+                     f"| {rs['failed']} | {rs['d_l2']} | {rs['residual']} | {rs['error']} |")
+    return "\n".join(lines) + "\n"
