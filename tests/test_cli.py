@@ -67,3 +67,12 @@ def test_generate_says_no_default_model_yet(capsys):
     code = main(["generate", "a person jumps forward", "--gravity", "-3.7", "--wind", "2", "0"])
     assert code == 1
     assert "no default model yet" in capsys.readouterr().err
+
+
+def test_parsers_can_be_built_repeatedly():
+    import gc
+
+    for _ in range(5):  # group registration must not leak between parsers (ids get reused)
+        build_parser()
+        gc.collect()
+    assert build_parser().parse_args(["data", "report", "x"]).command == "data"

@@ -11,7 +11,9 @@ from simdiff.errors import SimdiffError
 from simdiff.model.config import config_from_dict
 from simdiff.train.config import RunConfig
 
-CONFIGS = sorted((Path(__file__).resolve().parents[1] / "configs").glob("*.json"))
+CONFIG_DIR = Path(__file__).resolve().parents[1] / "configs"
+CONFIGS = sorted(p for p in CONFIG_DIR.glob("*.json") if not p.name.startswith("eval_"))
+EVAL_CONFIGS = sorted(CONFIG_DIR.glob("eval_*.json"))
 
 
 @pytest.mark.parametrize("path", CONFIGS, ids=[p.stem for p in CONFIGS])
@@ -19,6 +21,13 @@ def test_config_parses(path: Path) -> None:
     config = config_from_dict(json.loads(path.read_text()), RunConfig)
     assert config.train.mode in ("backbone", "adapters")
     assert (config.model.sim is not None) == (config.train.mode == "adapters")
+
+
+@pytest.mark.parametrize("path", EVAL_CONFIGS, ids=[p.stem for p in EVAL_CONFIGS])
+def test_experiment_config_parses(path: Path) -> None:
+    from simdiff.eval.experiments import load_config
+
+    assert load_config(path) is not None
 
 
 def test_unknown_key_rejected() -> None:

@@ -17,16 +17,13 @@ from typing import Sequence
 from simdiff import __version__
 from simdiff.errors import SimdiffError
 
-_GROUPS: dict[int, dict[str, argparse._SubParsersAction]] = {}
-
-
 def command_group(subparsers: argparse._SubParsersAction, name: str, help: str) -> argparse._SubParsersAction:
     """Return the sub-subparsers of group ``name`` (e.g. ``data``), creating it once.
 
     Lets several command modules add to one group (``simdiff data build-cmu``,
     ``simdiff data augment``) without knowing about each other.
     """
-    groups = _GROUPS.setdefault(id(subparsers), {})
+    groups: dict[str, argparse._SubParsersAction] = subparsers.__dict__.setdefault("_simdiff_groups", {})
     if name not in groups:
         parser = subparsers.add_parser(name, help=help, description=help)
         sub = parser.add_subparsers(dest=f"{name}_command", metavar="COMMAND")
