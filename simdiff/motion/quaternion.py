@@ -92,3 +92,24 @@ def yaw_quat(angle: np.ndarray) -> np.ndarray:
     angle = np.asarray(angle, dtype=np.float64)
     zeros = np.zeros_like(angle)
     return np.stack([np.cos(angle), zeros, np.sin(angle), zeros], axis=-1)
+
+
+def quat_error(q_ref: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Rotation vector (3,) taking unit quaternion q to q_ref, both (4,) wxyz (radians).
+
+    Scalar code on purpose: called at every physics step of the simulator.
+    """
+    w1, x1, y1, z1 = q_ref
+    w2, x2, y2, z2 = q[0], -q[1], -q[2], -q[3]
+    e = np.array([
+        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+    ])
+    if e[0] < 0:
+        e = -e
+    s = np.linalg.norm(e[1:])
+    if s < 1e-12:
+        return np.zeros(3)
+    return e[1:] / s * 2.0 * np.arctan2(s, e[0])

@@ -24,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from simdiff.motion.quaternion import quat_error
+
 
 @dataclass(frozen=True)
 class ResidualConfig:
@@ -64,24 +66,6 @@ class ResidualConfig:
     @property
     def enabled(self) -> bool:
         return self.max_force > 0 or self.torque_bound > 0
-
-
-def _quat_err(q_ref: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Rotation vector (world) taking unit quaternion q to q_ref, both (4,) wxyz."""
-    w1, x1, y1, z1 = q_ref
-    w2, x2, y2, z2 = q[0], -q[1], -q[2], -q[3]
-    e = np.array([
-        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-    ])
-    if e[0] < 0:
-        e = -e
-    s = np.linalg.norm(e[1:])
-    if s < 1e-12:
-        return np.zeros(3)
-    return e[1:] / s * 2.0 * np.arctan2(s, e[0])
 
 
 class RootResidual:
@@ -156,7 +140,7 @@ class RootResidual:
         if n > self.fmax:
             f *= self.fmax / max(n, 1e-12)
         q_ref = ref.qpos[k, 3:7] if a < 0.5 else ref.qpos[k1, 3:7]
-        e = _quat_err(q_ref, data.xquat[p])
+        e = quat_error(q_ref, data.xquat[p])
         omega = data.cvel[p, :3]
         tau = c.kp_rot * e + c.kd_rot * (self.ref_omega[k] - omega)
         n = np.linalg.norm(tau)

@@ -13,6 +13,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from simdiff.motion.quaternion import quat_error
+
 from simdiff.sim.convert import Reference, _foot_geoms
 from simdiff.sim.humanoid import ModelIndex
 
@@ -85,24 +87,6 @@ class PDTrackerConfig:
     clearance: float = 0.25
     target_margin: float = 0.3
     balance: BalanceConfig | None = BalanceConfig()
-
-
-def _quat_err(q_ref: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Rotation vector (world) taking unit quaternion q to q_ref, both (4,) wxyz."""
-    w1, x1, y1, z1 = q_ref
-    w2, x2, y2, z2 = q[0], -q[1], -q[2], -q[3]
-    e = np.array([
-        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-    ])
-    if e[0] < 0:
-        e = -e
-    s = np.linalg.norm(e[1:])
-    if s < 1e-12:
-        return np.zeros(3)
-    return e[1:] / s * 2.0 * np.arctan2(s, e[0])
 
 
 class PDTracker:
@@ -220,7 +204,7 @@ class PDTracker:
             b.kp_xy * e[1] + b.kd_xy * ev[1],
             b.kp_z * e[2] + b.kd_z * ev[2],
         ])
-        tau = b.kp_rot * _quat_err(self.ref.qpos[k, 3:7], data.xquat[p]) + b.kd_rot * (
+        tau = b.kp_rot * quat_error(self.ref.qpos[k, 3:7], data.xquat[p]) + b.kd_rot * (
             self.ref_omega[k] - data.cvel[p, :3])
         pts = []
         for s in legs:
