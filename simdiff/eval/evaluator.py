@@ -36,9 +36,9 @@ from typing import Any
 import numpy as np
 import torch
 from torch import Tensor, nn
-from torch.nn.utils.rnn import pack_padded_sequence
 
 from simdiff.errors import SimdiffError
+from simdiff.eval.encoders import BiGRUEncoder, MovementConvEncoder
 from simdiff.motion.normalize import Normalizer
 
 CONTACT_DIMS: int = 4
@@ -81,41 +81,25 @@ def _init(module: nn.Module) -> None:
             nn.init.zeros_(module.bias)
 
 
-class MovementEncoder(nn.Module):
+class MovementEncoder(MovementConvEncoder):
     """(B, T, C) → (B, T // 4, D) movement tokens (two stride-2 convolutions, then a linear)."""
 
     def __init__(self, in_dim: int, dim: int, dropout: float) -> None:
-        super().__init__()
-        self.main = nn.Sequential(
-            nn.Conv1d(in_dim, dim, 4, 2, 1), nn.Dropout(dropout), nn.LeakyReLU(0.2),
-            nn.Conv1d(dim, dim, 4, 2, 1), nn.Dropout(dropout), nn.LeakyReLU(0.2),
-        )
-        self.out_net = nn.Linear(dim, dim)
+        super().__init__(in_dim, dim, dim, dropout)
         self.apply(_init)
 
-    def forward(self, x: Tensor) -> Tensor:
-        return self.out_net(self.main(x.transpose(1, 2)).transpose(1, 2))
 
-
-class SequenceEncoder(nn.Module):
+class SequenceEncoder(BiGRUEncoder):
     """(B, N, in) tokens with (B,) valid counts → (B, out): BiGRU with learned h0, final states → MLP."""
 
     def __init__(self, in_dim: int, hidden: int, out_dim: int) -> None:
-        super().__init__()
-        self.input_emb = nn.Linear(in_dim, hidden)
-        self.gru = nn.GRU(hidden, hidden, batch_first=True, bidirectional=True)
-        self.output_net = nn.Sequential(nn.Linear(2 * hidden, hidden), nn.LayerNorm(hidden), nn.LeakyReLU(0.2),
-                                        nn.Linear(hidden, out_dim))
+        super().__init__(in_dim, hidden, out_dim)
         self.hidden = nn.Parameter(torch.randn(2, 1, hidden))
         self.input_emb.apply(_init)
         self.output_net.apply(_init)
 
     def forward(self, tokens: Tensor, counts: Tensor) -> Tensor:
-        b = tokens.shape[0]
-        counts = counts.clamp(min=1, max=tokens.shape[1]).cpu()
-        packed = pack_padded_sequence(self.input_emb(tokens), counts, batch_first=True, enforce_sorted=False)
-        _, last = self.gru(packed, self.hidden.expand(2, b, -1).contiguous())
-        return self.output_net(torch.cat([last[0], last[1]], dim=-1))
+        return self.encode(tokens, counts)
 
 
 class TextProjector(nn.Module):

@@ -38,9 +38,9 @@ from typing import Any
 import numpy as np
 import torch
 from torch import Tensor, nn
-from torch.nn.utils.rnn import pack_padded_sequence
 
 from simdiff.errors import SimdiffError
+from simdiff.eval.encoders import BiGRUEncoder, MovementConvEncoder
 
 POS_TAGS: tuple[str, ...] = ("VERB", "NOUN", "DET", "ADP", "NUM", "AUX", "PRON", "ADJ", "ADV", "Loc_VIP", "Body_VIP",
                              "Obj_VIP", "Act_VIP", "Desc_VIP", "OTHER")
@@ -81,45 +81,17 @@ EXPECTED_SHAPES: dict[str, dict[str, tuple[int, ...]]] = {
 """Parameter shapes of the released ``finest.tar`` (facts §3.1)."""
 
 
-class MovementConvEncoder(nn.Module):
-    """(B, T, 259) → (B, T // 4, 512)."""
-
-    def __init__(self, in_dim: int = 259, hidden: int = 512, out_dim: int = 512) -> None:
-        super().__init__()
-        self.main = nn.Sequential(nn.Conv1d(in_dim, hidden, 4, 2, 1), nn.Dropout(0.2), nn.LeakyReLU(0.2),
-                                  nn.Conv1d(hidden, out_dim, 4, 2, 1), nn.Dropout(0.2), nn.LeakyReLU(0.2))
-        self.out_net = nn.Linear(out_dim, out_dim)
-
-    def forward(self, x: Tensor) -> Tensor:
-        return self.out_net(self.main(x.transpose(1, 2)).transpose(1, 2))
-
-
-class _BiGRUCo(nn.Module):
-    def __init__(self, in_dim: int, hidden: int, out_dim: int) -> None:
-        super().__init__()
-        self.input_emb = nn.Linear(in_dim, hidden)
-        self.gru = nn.GRU(hidden, hidden, batch_first=True, bidirectional=True)
-        self.output_net = nn.Sequential(nn.Linear(2 * hidden, hidden), nn.LayerNorm(hidden), nn.LeakyReLU(0.2),
-                                        nn.Linear(hidden, out_dim))
-        self.hidden = nn.Parameter(torch.zeros(2, 1, hidden))
-
-    def _encode(self, x: Tensor, lengths: Tensor) -> Tensor:
-        packed = pack_padded_sequence(self.input_emb(x), lengths.clamp(min=1).cpu(), batch_first=True, enforce_sorted=False)
-        _, last = self.gru(packed, self.hidden.expand(2, x.shape[0], -1).contiguous())
-        return self.output_net(torch.cat([last[0], last[1]], dim=-1))
-
-
-class MotionEncoderBiGRUCo(_BiGRUCo):
+class MotionEncoderBiGRUCo(BiGRUEncoder):
     """(B, N, 512) movement tokens, (B,) token counts → (B, 512)."""
 
     def __init__(self, in_dim: int = 512, hidden: int = 1024, out_dim: int = 512) -> None:
         super().__init__(in_dim, hidden, out_dim)
 
     def forward(self, tokens: Tensor, counts: Tensor) -> Tensor:
-        return self._encode(tokens, counts)
+        return self.encode(tokens, counts)
 
 
-class TextEncoderBiGRUCo(_BiGRUCo):
+class TextEncoderBiGRUCo(BiGRUEncoder):
     """(B, L, 300) word vectors, (B, L, 15) POS one-hots, (B,) lengths → (B, 512)."""
 
     def __init__(self, word_dim: int = 300, pos_dim: int = 15, hidden: int = 512, out_dim: int = 512) -> None:
@@ -127,7 +99,7 @@ class TextEncoderBiGRUCo(_BiGRUCo):
         self.pos_emb = nn.Linear(pos_dim, word_dim)
 
     def forward(self, words: Tensor, pos: Tensor, lengths: Tensor) -> Tensor:
-        return self._encode(words + self.pos_emb(pos), lengths)
+        return self.encode(words + self.pos_emb(pos), lengths)
 
 
 class _NoGlobals(pickle.Unpickler):

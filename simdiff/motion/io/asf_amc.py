@@ -21,7 +21,7 @@ import numpy as np
 
 from simdiff.errors import MotionFormatError
 from simdiff.motion.io.euler import euler_to_matrix
-from simdiff.motion.io.rig import RigMotion
+from simdiff.motion.io.rig import RigMotion, read_motion_text
 
 INCH: float = 0.0254
 """Metres per inch."""
@@ -86,10 +86,7 @@ def read_asf(path: str | Path) -> AsfSkeleton:
         MotionFormatError: naming the file and line of the first problem.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise MotionFormatError(path, f"cannot read ASF file ({exc.strerror})") from None
+    text = read_motion_text(path, "ASF")
     lines = text.splitlines()
 
     length_unit = 1.0
@@ -272,10 +269,7 @@ def _parse_amc(path: Path, skeleton: AsfSkeleton) -> tuple[dict[str, np.ndarray]
     A vectorised pass handles the usual regular file (same bone order every frame); any
     irregularity falls back to the line-by-line parser, which names the offending line.
     """
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise MotionFormatError(path, f"cannot read AMC file ({exc.strerror})") from None
+    text = read_motion_text(path, "AMC")
     fast = _parse_amc_regular(text, skeleton)
     return fast if fast is not None else _parse_amc_lines(path, text, skeleton)
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from simdiff.errors import MotionFormatError
 from simdiff.motion.io.euler import euler_to_matrix
-from simdiff.motion.io.rig import RigMotion
+from simdiff.motion.io.rig import RigMotion, read_motion_text
 
 _CHANNELS = ("xposition", "yposition", "zposition", "xrotation", "yrotation", "zrotation")
 
@@ -146,10 +146,7 @@ def parse_bvh(path: str | Path) -> BvhFile:
         MotionFormatError: naming the file and line of the first problem.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise MotionFormatError(path, f"cannot read BVH file ({exc.strerror})") from None
+    text = read_motion_text(path, "BVH")
     lines = text.splitlines()
     tokens = _Tokens(path, lines)
     first = tokens.peek()

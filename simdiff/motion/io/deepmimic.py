@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from simdiff.errors import MotionFormatError
-from simdiff.motion.io.rig import RigMotion
+from simdiff.motion.io.rig import RigMotion, read_motion_text
 from simdiff.motion.quaternion import qnormalize, quat_to_matrix
 
 HUMANOID3D: tuple[tuple[str, int, str, tuple[float, float, float]], ...] = (
@@ -106,10 +106,7 @@ def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
         MotionFormatError: naming the file and line of a malformed or truncated input.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise MotionFormatError(path, f"cannot read DeepMimic file ({exc.strerror})") from None
+    text = read_motion_text(path, "DeepMimic")
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:

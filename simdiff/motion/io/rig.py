@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from simdiff.errors import MotionFormatError
+
 
 @dataclass
 class RigMotion:
@@ -59,3 +61,16 @@ class RigMotion:
     def joint(self, name: str) -> np.ndarray:
         """(T, 3) positions of one joint, metres."""
         return self.positions[:, self.index(name)]
+
+
+def read_motion_text(path: Path, kind: str) -> str:
+    """The text of a motion file; an unreadable file raises a one-line ``MotionFormatError``.
+
+    Args:
+        path: the file.
+        kind: format name for the message, e.g. ``"BVH"``.
+    """
+    try:
+        return path.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise MotionFormatError(path, f"cannot read {kind} file ({exc.strerror})") from None
