@@ -198,3 +198,25 @@ def test_cli_with_the_real_simulator(tmp_path: Path, capsys: pytest.CaptureFixtu
     record = json.loads((out / "shards" / "shard_00000.json").read_text())["records"][0]
     assert isinstance(record["info"], dict) and "d_l2" in record["info"]
     assert main(["data", "augment", "--corpus", str(corpus), "--out", str(out), "--mode", "random", "--no-progress"]) == 2
+
+
+def test_per_clip_assigns_balanced_round_robin_conditions(tmp_path: Path) -> None:
+    from simdiff.data.augment.run import assign_conditions
+
+    conds = make_conditions("random", 6, 0)
+    clips = [f"{i:06d}" for i in range(6)]
+    assigned = assign_conditions(clips, conds, 2)
+    assert [k.index for k in assigned["000000"]] == [0, 1] and [k.index for k in assigned["000004"]] == [2, 3]
+    counts = np.bincount([k.index for c in clips for k in assigned[c]], minlength=6)
+    assert counts.tolist() == [2] * 6
+    assert assign_conditions(clips, conds, None)["000003"] == list(conds)
+    with pytest.raises(SimdiffError, match="per-clip"):
+        assign_conditions(clips, conds, 0)
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=3, n_test=2, frames=48)
+    out = tmp_path / "aug"
+    report = augment(corpus, out, AugmentConfig(mode="random", conditions=6, seed=1, shard_size=2, per_clip=2),
+                     projector=FakeProjector(), progress=False)
+    assert report["pairs"] == 6 and report["settings"]["per_clip"] == 2
+    seen = [(r["clip"], r["condition"]) for p in sorted((out / "shards").glob("*.json"))
+            for r in json.loads(p.read_text())["records"]]
+    assert seen == [("000000", 0), ("000000", 1), ("000001", 2), ("000001", 3), ("000002", 4), ("000002", 5)]

@@ -30,6 +30,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--residual-bound", type=float, default=0.5,
                    help="tracker's root residual bound, fraction of m*|g_z| (default 0.5; 0 = strict, no residual)")
     p.add_argument("--shard-size", type=int, default=4, help="source clips per shard (default 4)")
+    p.add_argument("--per-clip", type=int,
+                   help="random mode: project each clip under this many of the conditions, balanced "
+                        "round-robin (default: all of them; the paper's full cross product)")
     p.add_argument("--limit", type=int, help="augment only the first N clips of the split")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(func=run)
@@ -42,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
                            filter=FilterConfig(max_d_l2=args.max_d_l2, max_residual=args.max_residual),
-                           residual_bound=args.residual_bound, workers=args.workers, backend=args.backend)
+                           residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
+                           per_clip=args.per_clip)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)
     frac = report["kept_fraction"]
     print(f"kept {report['kept']}/{report['pairs']} pairs" + (f" ({100 * frac:.1f} %)" if frac is not None else "")

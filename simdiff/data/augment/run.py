@@ -62,6 +62,8 @@ class AugmentConfig:
         filter: keep thresholds (d_L2 ≤ 7, mean residual ≤ 0.1·m·g).
         residual_bound: the tracker's root-residual bound (fraction of m·|g_z|; 0 = strict).
         workers, backend: parallelism of the default projector.
+        per_clip: random mode only: project each clip under this many of the conditions
+            (balanced round-robin over the split order) instead of all of them; None = all.
     """
 
     mode: str = "random"
@@ -74,12 +76,31 @@ class AugmentConfig:
     residual_bound: float = 0.5
     workers: int = 0
     backend: str = "process"
+    per_clip: int | None = None
 
     def settings(self) -> dict[str, Any]:
         """The options a resumed run must share (parallelism and limit may change)."""
-        return {"mode": self.mode, "conditions": self.conditions if self.mode == "random" else 1, "seed": self.seed,
-                "split": self.split, "shard_size": self.shard_size, "filter": dataclasses.asdict(self.filter),
-                "residual_bound": self.residual_bound}
+        settings = {"mode": self.mode, "conditions": self.conditions if self.mode == "random" else 1,
+                    "seed": self.seed, "split": self.split, "shard_size": self.shard_size,
+                    "filter": dataclasses.asdict(self.filter), "residual_bound": self.residual_bound}
+        if self.per_clip is not None:
+            settings["per_clip"] = self.per_clip
+        return settings
+
+
+def assign_conditions(clips: Sequence[str], conditions: Sequence[Condition], per_clip: int | None
+                      ) -> dict[str, list[Condition]]:
+    """Conditions each clip is projected under: all, or ``per_clip`` of them round-robin.
+
+    Clip ``k`` of the split gets conditions ``k·per_clip … k·per_clip + per_clip − 1`` (mod the number
+    of conditions), so every condition is used equally often and neighbouring (similar) clips differ.
+    """
+    if per_clip is None or per_clip >= len(conditions):
+        return {c: list(conditions) for c in clips}
+    if per_clip < 1:
+        raise SimdiffError(f"--per-clip must be at least 1, got {per_clip}")
+    n = len(conditions)
+    return {c: [conditions[(k * per_clip + j) % n] for j in range(per_clip)] for k, c in enumerate(clips)}
 
 
 def clip_id_for(clip: str, condition: Condition) -> str:
@@ -177,11 +198,12 @@ def _check_settings(out: Path, config: AugmentConfig, conditions: list[Condition
         write_json(path, settings)
 
 
-def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], conditions: list[Condition],
+def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[Condition]],
                config: AugmentConfig, projector: Projector, tick: Callable[[int], None]) -> dict[str, Any]:
     """Project, filter and write one shard; returns its record (written by the caller)."""
     motions, envs, pairs, load_errors = [], [], [], {}
     for clip in clips:
+        conditions = assigned[clip]
         try:
             joints = load_source_joints(corpus, clip)
         except SimdiffError as exc:
@@ -193,6 +215,7 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], conditions
             pairs.append((clip, cond))
     records: list[dict[str, Any]] = []
     for clip, message in load_errors.items():
+        conditions = assigned[clip]
         for cond in conditions:
             records.append({"clip": clip, "condition": cond.index, "id": clip_id_for(clip, cond), "kept": False,
                             "reason": "error", "info": message})
@@ -217,7 +240,7 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], conditions
         records.append({"clip": clip, "condition": cond.index, "id": aid, "kept": kept, "reason": reason,
                         "info": _info_dict(info)})
         tick(1)
-    order = {(c, k.index): i for i, (c, k) in enumerate((c, k) for c in clips for k in conditions)}
+    order = {(c, k.index): i for i, (c, k) in enumerate((c, k) for c in clips for k in assigned[c])}
     records.sort(key=lambda r: order[(r["clip"], r["condition"])])
     return {"shard": index, "clips": clips, "records": records}
 
@@ -239,6 +262,7 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
     clips, conditions, shards = plan(corpus, config)
     out.mkdir(parents=True, exist_ok=True)
     _check_settings(out, config, conditions)
+    assigned = assign_conditions(clips, conditions, config.per_clip if config.mode == "random" else None)
     todo = []
     for i, shard in enumerate(shards):
         path = _shard_path(out, i)
@@ -246,13 +270,13 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
             todo.append(i)
     own = projector is None
     proj: Projector = projector or SimProjector(str(corpus), config.workers, config.backend, config.residual_bound)
-    total = len(clips) * len(conditions)
-    done = sum(len(shards[i]) for i in range(len(shards)) if i not in todo) * len(conditions)
+    total = sum(len(assigned[c]) for c in clips)
+    done = sum(len(assigned[c]) for i in range(len(shards)) if i not in todo for c in shards[i])
     start = time.time()
     bar = tqdm(total=total, initial=done, desc="augment", unit="pair", disable=not progress, dynamic_ncols=True)
     try:
         for i in todo:
-            record = _run_shard(corpus, out, i, shards[i], conditions, config, proj, bar.update)
+            record = _run_shard(corpus, out, i, shards[i], assigned, config, proj, bar.update)
             write_json(_shard_path(out, i), record)
     finally:
         bar.close()
