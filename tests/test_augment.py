@@ -148,9 +148,15 @@ SCRIPT = textwrap.dedent('''
     from test_augment import fake_info, fake_rollout
     from simdiff.data.augment import AugmentConfig, augment
 
+    calls = []
+
     def slow(motions, envs):
+        # shard 0 runs; from shard 1 on, yield one pair, then hang (until killed) inside the shard
+        calls.append(1)
         for i, (m, e) in enumerate(zip(motions, envs)):
-            time.sleep({delay})
+            if len(calls) > 1 and i == 1:
+                open({marker!r}, "w").close()
+                time.sleep(600)
             yield fake_rollout(m), fake_info(e, i)
 
     augment({corpus!r}, {out!r}, AugmentConfig(mode="random", conditions=3, seed=2, shard_size=1),
@@ -162,15 +168,16 @@ def test_augment_resumes_after_kill_with_identical_output(tmp_path: Path) -> Non
     corpus = write_tiny_corpus(tmp_path / "c", n_train=4, n_test=1, frames=48)
     killed, clean = tmp_path / "killed", tmp_path / "clean"
     script = tmp_path / "run.py"
-    script.write_text(SCRIPT.format(tests=str(Path(__file__).parent), corpus=str(corpus), out=str(killed), delay=0.4))
+    marker = tmp_path / "inside_shard_1"
+    script.write_text(SCRIPT.format(tests=str(Path(__file__).parent), corpus=str(corpus), out=str(killed),
+                                    marker=str(marker)))
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
     proc = subprocess.Popen([sys.executable, str(script)], env=env, stderr=subprocess.PIPE)
     first = killed / "shards" / "shard_00000.json"
-    deadline = time.time() + 60
-    while not first.is_file() and time.time() < deadline and proc.poll() is None:
+    deadline = time.time() + 120
+    while not marker.is_file() and time.time() < deadline and proc.poll() is None:
         time.sleep(0.02)
-    time.sleep(0.5)  # well inside shard 1 (3 pairs x 0.4 s)
-    proc.send_signal(signal.SIGKILL)
+    proc.send_signal(signal.SIGKILL)  # inside shard 1, one of its pairs done
     proc.wait(10)
     assert first.is_file(), proc.stderr.read().decode() if proc.stderr else ""
     done = sorted(p.name for p in (killed / "shards").glob("shard_*.json"))
@@ -220,3 +227,22 @@ def test_per_clip_assigns_balanced_round_robin_conditions(tmp_path: Path) -> Non
     seen = [(r["clip"], r["condition"]) for p in sorted((out / "shards").glob("*.json"))
             for r in json.loads(p.read_text())["records"]]
     assert seen == [("000000", 0), ("000000", 1), ("000001", 2), ("000001", 3), ("000002", 4), ("000002", 5)]
+
+
+def test_training_dataset_concatenates_augmented_corpora(tmp_path: Path) -> None:
+    from simdiff.data.augment.dataset import ConcatItems
+
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=3, n_test=2, frames=48)
+    a, b = tmp_path / "a", tmp_path / "b"
+    augment(corpus, a, AugmentConfig(mode="binary"), projector=FakeProjector(), progress=False)
+    augment(corpus, b, AugmentConfig(mode="random", conditions=6, seed=1, per_clip=2), projector=FakeProjector(),
+            progress=False)
+    one, two = open_training_dataset(a), open_training_dataset(b)
+    both = open_training_dataset([a, b])
+    assert isinstance(both, ConcatItems) and len(both) == len(one) + len(two) > len(one)
+    rng = np.random.default_rng(0)
+    last = both.get(len(both) - 1, rng)
+    assert last["env"].shape == (3,) and "caption" in last
+    assert both.get(0, np.random.default_rng(0))["env"].tolist() == pytest.approx([-9.81, 0.0, 0.0])
+    with pytest.raises(SimdiffError, match="out of range"):
+        both.get(len(both))

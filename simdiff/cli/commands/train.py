@@ -14,7 +14,9 @@ from simdiff.cli.main import command_group
 
 def _common(p: argparse.ArgumentParser) -> None:
     data = p.add_mutually_exclusive_group(required=True)
-    data.add_argument("--data", type=Path, help="HumanML3D-layout directory (new_joint_vecs/, texts/, Mean.npy, Std.npy, <split>.txt)")
+    data.add_argument("--data", type=Path, nargs="+",
+                      help="HumanML3D-layout directory (new_joint_vecs/, texts/, Mean.npy, Std.npy, <split>.txt); "
+                           "several folders are read as one dataset")
     data.add_argument("--synthetic", type=int, metavar="N", help="train on N synthetic clips (smoke tests only)")
     p.add_argument("--split", default="train", help="split file name under --data (default: train)")
     p.add_argument("--source", type=Path, default=None,
@@ -118,10 +120,12 @@ def _dataset(args: argparse.Namespace, seed: int):
         return synthetic_dataset(args.synthetic, frames=60, seed=seed, with_env=args.mode == "adapters")
     from simdiff.data.augment import open_training_dataset
 
-    dataset = open_training_dataset(args.data, args.split, seed, source=getattr(args, "source", None))
-    if args.mode == "adapters" and not (args.data / "env.json").is_file():
-        raise SimdiffError(f"{args.data}: adapters train on a simulator-augmented corpus (env.json), see `simdiff data augment`")
-    return dataset
+    for folder in args.data:
+        if not folder.is_dir():
+            raise SimdiffError(f"--data {folder}: not a directory")
+        if args.mode == "adapters" and not (folder / "env.json").is_file():
+            raise SimdiffError(f"{folder}: adapters train on a simulator-augmented corpus (env.json), see `simdiff data augment`")
+    return open_training_dataset(list(args.data), args.split, seed, source=getattr(args, "source", None))
 
 
 def run(args: argparse.Namespace) -> int:

@@ -91,9 +91,54 @@ class AugmentedHumanML3D:
         return self.get(index)
 
 
-def open_training_dataset(root: str | Path, split: str = "train", seed: int = 0,
-                          source: str | Path | None = None) -> HumanML3D | AugmentedHumanML3D:
-    """The dataset ``simdiff train`` should read from ``root``: augmented (with φ) when it has env.json."""
+class ConcatItems:
+    """Several datasets read as one (indices run through them in order); the first one's normaliser.
+
+    Used to train on more than one simulator-augmented corpus (e.g. the random-φ set and the
+    Earth-gravity binary set). All parts must share the normaliser (same source corpus Mean/Std).
+    """
+
+    def __init__(self, parts: list[Any]) -> None:
+        if not parts:
+            raise SimdiffError("no datasets to concatenate")
+        self.parts = parts
+        self.normalizer = getattr(parts[0], "normalizer", None)
+        ref = self.normalizer
+        for part in parts[1:]:
+            other = getattr(part, "normalizer", None)
+            if ref is not None and other is not None and not (np.allclose(np.asarray(ref.mean), np.asarray(other.mean))
+                                                               and np.allclose(np.asarray(ref.std), np.asarray(other.std))):
+                raise SimdiffError("the training corpora have different Mean/Std: augment them from one source corpus")
+        self.offsets = np.cumsum([0] + [len(p) for p in parts])
+
+    def __len__(self) -> int:
+        return int(self.offsets[-1])
+
+    def get(self, index: int, rng: np.random.Generator | None = None) -> dict[str, Any]:
+        """Item ``index`` of the concatenation, drawn with ``rng``."""
+        if not 0 <= index < len(self):
+            raise SimdiffError(f"index {index} out of range for {len(self)} items")
+        k = int(np.searchsorted(self.offsets, index, side="right") - 1)
+        part = self.parts[k]
+        local = index - int(self.offsets[k])
+        get = getattr(part, "get", None)
+        return get(local, rng) if callable(get) else part[local]
+
+    def __getitem__(self, index: int) -> dict[str, Any]:
+        return self.get(index)
+
+
+def open_training_dataset(root: str | Path | list[str | Path], split: str = "train", seed: int = 0,
+                          source: str | Path | None = None) -> HumanML3D | AugmentedHumanML3D | ConcatItems:
+    """The dataset ``simdiff train`` should read from ``root``: augmented (with φ) when it has env.json.
+
+    ``root`` may be a list of folders (concatenated; ``source`` is mixed in once).
+    """
+    if isinstance(root, (list, tuple)):
+        if len(root) == 1:
+            return open_training_dataset(root[0], split, seed, source)
+        parts = [open_training_dataset(r, split, seed + 7 * i, source if i == 0 else None) for i, r in enumerate(root)]
+        return ConcatItems(parts)
     if (Path(root) / ENV_FILE).is_file():
         return AugmentedHumanML3D(root, split, source=source, seed=seed)
     return HumanML3D(root, split=split, seed=seed)
