@@ -146,3 +146,20 @@ def test_categorical_env_index(tmp_path) -> None:
     cfg.model.sim.num_categories = 4
     losses = Trainer(tmp_path / "ad", cfg, ds, text_encoder=HashText(), init_model=tmp_path / "bb" / "model").train(progress=False)
     assert len(losses) == 2
+
+
+def test_ema_warms_up_so_initial_weights_fade() -> None:
+    import torch
+    from torch import nn
+
+    from simdiff.train.ema import EMA
+
+    p = nn.Parameter(torch.zeros(3))
+    ema = EMA({"p": p}, decay=0.999)
+    assert ema.decay_at(0) == pytest.approx(0.1) and ema.decay_at(None) == 0.999 and ema.decay_at(10**6) == 0.999
+    with torch.no_grad():
+        p.fill_(1.0)
+    for step in range(1000):
+        ema.update(step)
+    # without warm-up the initial zeros would still weigh 0.999**1000 = 0.37
+    assert float(ema.shadow["p"][0]) > 0.99

@@ -194,7 +194,7 @@ class Trainer:
             nn.utils.clip_grad_norm_(list(self.trainable.values()), tc.optim.grad_clip)
         self.optimizer.step()
         if self.ema is not None:
-            self.ema.update()
+            self.ema.update(self.step)
         self.step += 1
         value = float(loss.detach())
         if not math.isfinite(value):
