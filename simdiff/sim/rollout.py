@@ -8,6 +8,13 @@ Failure: a fall (head below ``head_ratio`` of the reference head height, or the 
 error after removing the horizontal COM offset above ``max_error`` m), or MuJoCo
 instability (a warning or a non-finite state), in which case the rollout is marked failed
 and must not be used as data.
+
+Fall recovery (:class:`RecoveryConfig`): the full physics state is saved at every control
+frame. When the character falls, the rollout rewinds ``window`` control frames and
+re-simulates from there with the next alternative tracker setting for ``hold`` frames, then
+hands back to the main tracker. Only the committed trajectory is returned (states, residual
+log); the discarded attempts count in ``cpu_s``. No force is added: the alternatives only
+choose other PD targets, so every physics invariant holds as without recovery.
 """
 
 from __future__ import annotations
@@ -22,7 +29,7 @@ from simdiff.sim.convert import Reference
 from simdiff.sim.env import Environment
 from simdiff.sim.humanoid import ModelIndex, model_index
 from simdiff.sim.residual import ResidualConfig, RootResidual
-from simdiff.sim.tracker import PDTracker, Tracker
+from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig, Tracker
 
 
 @dataclass(frozen=True)
@@ -40,6 +47,31 @@ class FallConfig:
     max_error: float = 0.35
 
 
+def _default_variants() -> tuple[PDTrackerConfig, ...]:
+    return (
+        PDTrackerConfig(lead=1.0, balance=BalanceConfig(step_gain=0.5)),
+        PDTrackerConfig(lead=2.0, balance=BalanceConfig(kd_xy=10.0)),
+        PDTrackerConfig(lead=1.5, clearance=0.4, balance=BalanceConfig(kp_rot=1200.0)),
+    )
+
+
+@dataclass(frozen=True)
+class RecoveryConfig:
+    """Fall recovery by rewinding and re-simulating a window with another tracker setting.
+
+    Attributes:
+        window: control frames to rewind before the frame where the fall was detected.
+        hold: control frames, from the rewind point, during which the alternative tracker acts.
+        max_retries: rewinds per rollout (0 disables recovery).
+        variants: alternative :class:`PDTrackerConfig` settings, tried in turn (cyclically).
+    """
+
+    window: int = 12
+    hold: int = 30
+    max_retries: int = 6
+    variants: tuple[PDTrackerConfig, ...] = field(default_factory=_default_variants)
+
+
 @dataclass
 class RolloutResult:
     """What one rollout produced.
@@ -51,8 +83,9 @@ class RolloutResult:
         residual: (S, 6) applied residual wrench (world force N, torque N·m) per physics step.
         support: (S,) a foot/hand touched the floor at that step; airborne: (S,) no floor contact at all.
         violations: physics-invariant violations found by the audit (empty = none).
-        cpu_s: CPU seconds of the stepping loop.
+        cpu_s: CPU seconds of the stepping loop (rewound attempts included).
         timestep: physics step (s); mass: kg; gravity: |g_z|.
+        recoveries: how many times the rollout rewound after a fall.
     """
 
     status: str
@@ -66,6 +99,7 @@ class RolloutResult:
     timestep: float = 1.0 / 450.0
     mass: float = 72.0
     gravity: float = 9.81
+    recoveries: int = 0
 
     @property
     def success(self) -> bool:
@@ -107,6 +141,7 @@ def rollout(
     *,
     stop_on_fall: bool = True,
     audit: bool = False,
+    recovery: RecoveryConfig | None = None,
 ) -> RolloutResult:
     """Simulate the reference under ``env`` with ``tracker`` and the gated residual.
 
@@ -118,6 +153,7 @@ def rollout(
         residual: residual config (``max_force=0`` is strict).
         stop_on_fall: stop at the first fall (otherwise simulate to the end).
         audit: check the physics invariants at every step (see :func:`_audit`).
+        recovery: rewind-and-retry on a fall (default None: off; also off without ``stop_on_fall``).
     Returns:
         A :class:`RolloutResult`.
     """
@@ -146,10 +182,28 @@ def rollout(
     ref_head = reference.body_pos[:, 15, 2]
     hml = ix.hml_bodies
     p = ix.pelvis
+    rec = recovery if (recovery is not None and stop_on_fall and recovery.max_retries > 0
+                       and recovery.variants) else None
+    spec = int(mujoco.mjtState.mjSTATE_INTEGRATION)
+    states = np.zeros((K, mujoco.mj_stateSize(m, spec))) if rec is not None else None
+    alternates: dict[int, Tracker] = {}
+    override: tuple[int, int, int] | None = None  # (first frame, end frame, variant)
+    retries = 0
     step = 0
+    k = 0
     t0 = time.process_time()
-    for k in range(K - 1):
-        d.ctrl[:] = tracker.act(d, k)
+    while k < K - 1:
+        if states is not None:
+            mujoco.mj_getState(m, d, states[k], spec)
+        active = tracker
+        if override is not None and override[0] <= k < override[1]:
+            v = override[2]
+            if v not in alternates:
+                alternates[v] = PDTracker(rec.variants[v])
+                alternates[v].reset(m, d, reference, ix)
+            active = alternates[v]
+        d.ctrl[:] = active.act(d, k)
+        step = k * n_sub
         for _ in range(n_sub):
             mujoco.mj_step1(m, d)
             w = res.wrench(d, d.time)
@@ -176,15 +230,25 @@ def rollout(
             err = np.linalg.norm(d.xpos[hml] - off - reference.body_pos[kk], axis=1).mean()
             if err > fall.max_error:
                 status, fall_time = "fell", d.time
+        if status == "fell" and rec is not None and retries < rec.max_retries:
+            start = max(0, kk - rec.window)
+            override = (start, start + rec.hold, retries % len(rec.variants))
+            retries += 1
+            mujoco.mj_setState(m, d, states[start], spec)
+            mujoco.mj_forward(m, d)
+            status, fall_time = "ok", None
+            k = start
+            continue
         if status != "ok" and stop_on_fall:
             break
+        k += 1
     cpu = time.process_time() - t0
     if status == "fell" and not stop_on_fall:
         pass
     return RolloutResult(
         status=status, fall_time=fall_time, qpos=qpos[: step + 1], residual=wrench[:step], support=support[:step],
         airborne=airborne[:step], violations=violations, cpu_s=cpu, timestep=float(m.opt.timestep), mass=ix.mass,
-        gravity=abs(env.gravity),
+        gravity=abs(env.gravity), recoveries=retries,
     )
 
 

@@ -1,0 +1,137 @@
+"""Validated parameters of one generation request (the viewer's sliders and prompt box).
+
+Ranges match the ``simdiff generate`` CLI: gravity g_z ∈ [−20, −1] m/s², |wind| ≤ 10 N,
+adapter strength α ∈ [0, 2], length ≤ 9.8 s at 20 fps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any, Mapping
+
+from simdiff.errors import SimdiffError
+from simdiff.motion.skeleton import FPS, MAX_FRAMES
+from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND
+
+ALPHA_RANGE: tuple[float, float] = (0.0, 2.0)
+"""Adapter strength α bounds (0 = backbone only, 1 = trained strength)."""
+MAX_SECONDS: float = MAX_FRAMES / FPS
+"""Longest motion in seconds (9.8 s)."""
+MAX_STEPS: int = 1000
+"""Most sampler steps a request may ask for."""
+GUIDANCE_RANGE: tuple[float, float] = (0.0, 20.0)
+"""Classifier-free guidance scale bounds."""
+MAX_TEXT: int = 500
+"""Longest prompt in characters."""
+
+
+@dataclass(frozen=True)
+class GenerateParams:
+    """One generation: prompt, environment φ, adapter strength, length and sampler settings.
+
+    Attributes:
+        text: the prompt (stripped, non-empty).
+        gravity: g_z in m/s² (Earth −9.81).
+        wind_x, wind_y: horizontal wind force in newtons (HumanML3D +X, +Z).
+        alpha: adapter strength α.
+        seconds: motion length in seconds (20 fps).
+        seed: noise seed (≥ 0).
+        steps: DDIM steps, or None for the sampler's default (50).
+        guidance: classifier-free guidance scale.
+    """
+
+    text: str
+    gravity: float = EARTH_GRAVITY
+    wind_x: float = 0.0
+    wind_y: float = 0.0
+    alpha: float = 1.0
+    seconds: float = 6.0
+    seed: int = 0
+    steps: int | None = None
+    guidance: float = 2.5
+
+    @property
+    def frames(self) -> int:
+        """Motion length in frames at 20 fps (1..196)."""
+        return max(1, min(MAX_FRAMES, round(self.seconds * FPS)))
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain JSON-able values."""
+        return asdict(self)
+
+
+def limits() -> dict[str, Any]:
+    """The accepted ranges, for the page's sliders (units: m/s², N, s)."""
+    return {
+        "gravity": list(GRAVITY_RANGE), "wind": MAX_WIND, "alpha": list(ALPHA_RANGE), "seconds": MAX_SECONDS,
+        "fps": FPS, "steps": MAX_STEPS, "guidance": list(GUIDANCE_RANGE), "text": MAX_TEXT,
+    }
+
+
+def _number(body: Mapping[str, Any], key: str, default: float) -> float:
+    value = body.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise SimdiffError(f"{key} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _integer(body: Mapping[str, Any], key: str, default: int | None) -> int | None:
+    value = body.get(key, default)
+    if value is None:
+        return None
+    if isinstance(value, float) and value.is_integer():
+        value = int(value)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise SimdiffError(f"{key} must be an integer, got {value!r}")
+    return value
+
+
+def _check_range(key: str, value: float, low: float, high: float, unit: str = "") -> None:
+    if not low <= value <= high:
+        raise SimdiffError(f"{key} must be in [{low:g}, {high:g}]{unit}, got {value:g}")
+
+
+def parse_generate(body: Any) -> GenerateParams:
+    """Validate a ``POST /api/generate`` JSON body.
+
+    Args:
+        body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance}``;
+            everything but ``text`` is optional.
+    Raises:
+        SimdiffError: one line naming the bad field and value.
+    """
+    if not isinstance(body, dict):
+        raise SimdiffError(f"request body must be a JSON object, got {type(body).__name__}")
+    known = set(GenerateParams.__dataclass_fields__)
+    unknown = sorted(set(body) - known)
+    if unknown:
+        raise SimdiffError(f"unknown field {unknown[0]!r} (known: {', '.join(sorted(known))})")
+    text = body.get("text")
+    if not isinstance(text, str) or not text.strip():
+        raise SimdiffError(f"text must be a non-empty prompt, got {text!r}")
+    text = " ".join(text.split())
+    if len(text) > MAX_TEXT:
+        raise SimdiffError(f"text is {len(text)} characters long, the limit is {MAX_TEXT}")
+    defaults = GenerateParams(text=text)
+    gravity = _number(body, "gravity", defaults.gravity)
+    _check_range("gravity", gravity, *GRAVITY_RANGE, " m/s²")
+    wind = {}
+    for key in ("wind_x", "wind_y"):
+        wind[key] = _number(body, key, 0.0)
+        _check_range(key, wind[key], -MAX_WIND, MAX_WIND, " N")
+    alpha = _number(body, "alpha", defaults.alpha)
+    _check_range("alpha", alpha, *ALPHA_RANGE)
+    seconds = _number(body, "seconds", defaults.seconds)
+    if not 1.0 / FPS <= seconds <= MAX_SECONDS:
+        raise SimdiffError(f"seconds must be in [{1.0 / FPS:g}, {MAX_SECONDS:g}], got {seconds:g}")
+    seed = _integer(body, "seed", 0)
+    if seed is None or not 0 <= seed < 2**63:
+        raise SimdiffError(f"seed must be a non-negative integer, got {seed!r}")
+    steps = _integer(body, "steps", None)
+    if steps is not None and not 1 <= steps <= MAX_STEPS:
+        raise SimdiffError(f"steps must be in [1, {MAX_STEPS}], got {steps}")
+    guidance = _number(body, "guidance", defaults.guidance)
+    _check_range("guidance", guidance, *GUIDANCE_RANGE)
+    return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
+                          guidance=guidance, **wind)

@@ -1,0 +1,41 @@
+// The viewer's JSON API (see simdiff/serve/server.py). Every call resolves to the decoded answer
+// or rejects with an Error whose message is the server's one-line explanation.
+
+async function request(url, options = {}) {
+  let response;
+  try {
+    response = await fetch(url, options);
+  } catch (err) {
+    throw new Error("cannot reach the server: is `simdiff serve` still running?");
+  }
+  let body = null;
+  try {
+    body = await response.json();
+  } catch (err) {
+    throw new Error(`${response.status} ${response.statusText}: the server did not answer JSON`);
+  }
+  if (!response.ok) throw new Error(body && body.error ? body.error : `${response.status} ${response.statusText}`);
+  return body;
+}
+
+export const api = {
+  /** Model status, listed files, slider limits, defaults, skeleton. */
+  info: () => request("/api/info"),
+
+  /** Generate one motion: {text, gravity, wind_x, wind_y, alpha, seconds, seed} → {joints, fps, parents, meta}. */
+  generate: (params) => request("/api/generate", {
+    method: "POST",
+    headers: { "Content-Type": "application/json" },
+    body: JSON.stringify(params),
+  }),
+
+  /** Upload a motion file (.npy joints or features, .bvh, DeepMimic) → same shape as generate. */
+  open: (file) => request(`/api/open?name=${encodeURIComponent(file.name)}`, {
+    method: "POST",
+    headers: { "Content-Type": "application/octet-stream" },
+    body: file,
+  }),
+
+  /** The index-th file named on the command line. */
+  openListed: (index) => request(`/api/files/${index}`),
+};

@@ -1,0 +1,219 @@
+// Page wiring: controls → API → player. Page state for tests and scripts is window.simdiffState.
+
+import { api } from "./api.js";
+import { SkeletonPlayer } from "./player.js";
+
+const $ = (id) => document.getElementById(id);
+const SLIDERS = ["gravity", "wind_x", "wind_y", "alpha"];
+
+const state = {
+  status: "starting",  // starting | loading | generating | opening | ready | idle | error
+  error: null,         // last one-line error, null after a success
+  frames: 0,           // frames of the motion on screen
+  frame: 0,
+  playing: false,
+  generation_id: 0,    // generated motions shown so far
+  params: null,        // parameters of the motion on screen (generated ones)
+  source: null,        // "generate" | "file" | "upload"
+  digest: null,        // checksum of the joints on screen (changes when the motion does)
+  meta: null,
+  model: null,
+};
+window.simdiffState = state;
+
+const player = new SkeletonPlayer($("view"), {
+  onFrame(frame, frames, playing) {
+    Object.assign(state, { frame, frames, playing });
+    $("scrub").max = String(Math.max(0, frames - 1));
+    $("scrub").value = String(frame);
+    const fps = player.motion ? player.motion.fps : 20;
+    $("time").textContent = `${(frame / fps).toFixed(2)} / ${(Math.max(0, frames - 1) / fps).toFixed(2)} s`;
+    $("play").textContent = playing ? "Pause" : "Play";
+  },
+});
+window.simdiffPlayer = player;
+
+function setStatus(status, text) {
+  state.status = status;
+  $("status").textContent = text;
+  document.body.classList.toggle("busy", status === "generating" || status === "opening");
+}
+
+function showError(message) {
+  state.error = message;
+  $("error").textContent = message;
+  $("error").hidden = false;
+  setStatus("error", "");
+}
+
+function digest(joints) {
+  let sum = 0;
+  joints.forEach((pose, t) => pose.forEach(([x, y, z], j) => { sum += (t + 1) * (x + 2 * y + 3 * z) + j * 1e-3; }));
+  return Math.round(sum * 1e4) / 1e4;
+}
+
+function show(motion) {
+  player.load(motion);
+  const meta = motion.meta;
+  Object.assign(state, { frames: motion.joints.length, source: meta.source, digest: digest(motion.joints), meta, error: null });
+  $("error").hidden = true;
+  let caption;
+  if (meta.source === "generate") {
+    const p = meta.params;
+    state.params = p;
+    state.generation_id += 1;
+    caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${p.alpha.toFixed(2)}` : "");
+    setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s.`);
+  } else {
+    state.params = null;
+    caption = meta.name;
+    setStatus("ready", `Opened ${meta.name}: ${meta.frames} frames (${meta.seconds.toFixed(2)} s).`);
+  }
+  $("caption").textContent = caption;
+}
+
+// -- generation: one request at a time, the latest parameters win ------------------------------
+
+let busy = false;
+let pending = null;
+
+function readParams() {
+  const value = (id) => Number($(id).value);
+  return {
+    text: $("prompt").value.trim() || $("prompt").placeholder,
+    gravity: value("gravity"), wind_x: value("wind_x"), wind_y: value("wind_y"), alpha: value("alpha"),
+    seconds: value("seconds"), seed: Math.round(value("seed")),
+  };
+}
+
+async function generate() {
+  pending = readParams();
+  if (busy) return;
+  busy = true;
+  try {
+    while (pending) {
+      const params = pending;
+      pending = null;
+      setStatus("generating", state.model && !state.model.loaded ? "Loading the model and generating…" : "Generating…");
+      try {
+        show(await api.generate(params));
+        if (state.model) state.model.loaded = true;
+      } catch (err) {
+        showError(err.message);
+      }
+    }
+  } finally {
+    busy = false;
+  }
+}
+
+async function openWith(label, load) {
+  setStatus("opening", `Opening ${label}…`);
+  try {
+    show(await load());
+  } catch (err) {
+    showError(err.message);
+  }
+}
+
+// -- controls --------------------------------------------------------------------------------
+
+function configure(info) {
+  const { limits, defaults } = info;
+  const ranges = {
+    gravity: limits.gravity, wind_x: [-limits.wind, limits.wind], wind_y: [-limits.wind, limits.wind], alpha: limits.alpha,
+  };
+  for (const id of SLIDERS) {
+    const input = $(id);
+    [input.min, input.max] = ranges[id].map(String);
+    input.value = String(defaults[id]);
+    const label = () => { $(`${id}-value`).textContent = Number(input.value).toFixed(id === "gravity" || id === "alpha" ? 2 : 1); };
+    label();
+    input.addEventListener("input", label);
+    input.addEventListener("change", generate);
+    input.disabled = !info.model.env;
+  }
+  $("env-note").hidden = info.model.env || !info.model.found;
+  $("prompt").value = defaults.text;
+  Object.assign($("seconds"), { min: String(1 / limits.fps), max: String(limits.seconds), value: String(defaults.seconds) });
+  $("seed").value = String(defaults.seed);
+  $("version").textContent = `v${info.version}`;
+  const m = info.model;
+  $("model-info").textContent = m.error ? m.error : `Model: ${m.path} (${m.kind})`;
+  $("generate").disabled = !m.found || Boolean(m.error);
+  for (const b of $("gravity-presets").querySelectorAll("button")) {
+    b.disabled = !m.env;
+    b.addEventListener("click", () => {
+      $("gravity").value = b.dataset.gravity;
+      $("gravity").dispatchEvent(new Event("input"));
+      generate();
+    });
+  }
+  const list = $("file-list");
+  if (info.files.length) {
+    list.hidden = false;
+    list.replaceChildren(new Option("files from the command line…", ""),
+      ...info.files.map((f) => new Option(`${f.name} (${f.frames} frames)`, String(f.index))));
+    list.addEventListener("change", () => {
+      if (list.value !== "") openWith(list.selectedOptions[0].text, () => api.openListed(Number(list.value)));
+    });
+  }
+}
+
+function bindControls() {
+  $("generate-form").addEventListener("submit", (e) => { e.preventDefault(); generate(); });
+  $("prompt").addEventListener("keydown", (e) => {
+    if (e.key === "Enter" && !e.shiftKey) { e.preventDefault(); generate(); }
+  });
+  $("play").addEventListener("click", () => player.toggle());
+  $("scrub").addEventListener("input", () => {
+    const frame = Number($("scrub").value);  // read first: pausing redraws the timeline
+    player.pause();
+    player.setFrame(frame);
+  });
+  $("follow").addEventListener("change", () => { player.follow = $("follow").checked; player._dirty = true; });
+  $("file-input").addEventListener("change", () => {
+    const file = $("file-input").files[0];
+    if (file) openWith(file.name, () => api.open(file));
+    $("file-input").value = "";
+  });
+  const stage = $("stage");
+  stage.addEventListener("dragover", (e) => { e.preventDefault(); document.body.classList.add("dragging"); });
+  stage.addEventListener("dragleave", () => document.body.classList.remove("dragging"));
+  stage.addEventListener("drop", (e) => {
+    e.preventDefault();
+    document.body.classList.remove("dragging");
+    const file = e.dataTransfer.files[0];
+    if (file) openWith(file.name, () => api.open(file));
+  });
+  document.addEventListener("keydown", (e) => {
+    if (e.target.closest("input, textarea, select, button")) return;
+    if (e.key === " ") { e.preventDefault(); player.toggle(); }
+    else if (e.key === "ArrowRight") { player.pause(); player.setFrame(player.frame + 1); }
+    else if (e.key === "ArrowLeft") { player.pause(); player.setFrame(player.frame - 1); }
+  });
+}
+
+async function start() {
+  bindControls();
+  setStatus("loading", "Connecting…");
+  let info;
+  try {
+    info = await api.info();
+  } catch (err) {
+    showError(err.message);
+    return;
+  }
+  state.model = info.model;
+  configure(info);
+  if (info.files.length) {
+    $("file-list").value = "0";
+    await openWith(info.files[0].name, () => api.openListed(0));
+  } else if (info.model.found && !info.model.error) {
+    await generate();
+  } else {
+    setStatus("idle", "No model to generate with: open a motion file.");
+  }
+}
+
+start();

@@ -1,0 +1,300 @@
+"""``simdiff serve``: the JSON API end to end over HTTP (server in a thread on port 0, urllib)."""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import socket
+import threading
+import urllib.error
+import urllib.request
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import torch
+
+from simdiff.cli.main import main
+from simdiff.errors import SimdiffError
+from simdiff.model.generator import MotionGenerator
+from simdiff.motion import synthetic
+from simdiff.motion.features import features_to_joints, joints_to_features
+from simdiff.motion.io import load_joints, write_bvh
+from simdiff.motion.skeleton import PARENTS
+from simdiff.serve import ListedMotion, MotionService, ViewerServer, parse_generate
+from simdiff.serve.testing import write_tiny_model
+from simdiff.train.testing import HashTextEncoder
+
+STEPS = 4  # DDIM steps per test generation: enough to exercise the sampler, fast on a busy CPU
+
+
+@pytest.fixture(scope="module", autouse=True)
+def one_thread():
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # a tiny model on a loaded 2-core machine is far faster single-threaded
+    yield
+    torch.set_num_threads(threads)
+
+
+@pytest.fixture(scope="module")
+def model_dir(tmp_path_factory) -> Path:
+    return write_tiny_model(tmp_path_factory.mktemp("tiny_model"))
+
+
+@pytest.fixture(scope="module")
+def walk() -> np.ndarray:
+    return synthetic.walk(30, turn_rate=0.3)
+
+
+def _start(service: MotionService) -> ViewerServer:
+    server = ViewerServer(service, "127.0.0.1", 0)
+    server.start_in_thread()
+    return server
+
+
+@pytest.fixture(scope="module")
+def server(model_dir, walk):
+    listed = [ListedMotion("walk.npy", Path("walk.npy"), walk)]
+    srv = _start(MotionService(model_dir, files=listed, text_encoder=HashTextEncoder(), steps=STEPS))
+    yield srv
+    srv.shutdown()
+    srv.server_close()
+
+
+def call(server: ViewerServer, path: str, body: Any = None, *, content_type: str | None = None,
+         headers: dict[str, str] | None = None) -> tuple[int, Any, str]:
+    """(status, decoded JSON or text, content type) of one request."""
+    data = None
+    headers = dict(headers or {})
+    if body is not None:
+        data = body if isinstance(body, bytes) else json.dumps(body).encode()
+        headers.setdefault("Content-Type", content_type or ("application/octet-stream" if isinstance(body, bytes) else "application/json"))
+    request = urllib.request.Request(server.url + path.lstrip("/"), data=data, headers=headers)
+    try:
+        with urllib.request.urlopen(request, timeout=60) as response:
+            status, raw, ctype = response.status, response.read(), response.headers["Content-Type"]
+    except urllib.error.HTTPError as exc:
+        status, raw, ctype = exc.code, exc.read(), exc.headers["Content-Type"]
+    return status, (json.loads(raw) if ctype == "application/json" else raw.decode()), ctype
+
+
+def npy_bytes(array: np.ndarray) -> bytes:
+    buffer = io.BytesIO()
+    np.save(buffer, array)
+    return buffer.getvalue()
+
+
+# -- page ---------------------------------------------------------------------------------------
+
+
+def test_page_and_assets_are_served(server):
+    status, page, ctype = call(server, "/")
+    assert status == 200 and ctype.startswith("text/html")
+    assert '<canvas id="view">' in page and "/static/ui.js" in page
+    for name in ("player.js", "api.js", "ui.js"):
+        status, text, ctype = call(server, f"/static/{name}")
+        assert status == 200 and ctype.startswith("text/javascript") and len(text) > 200
+    assert call(server, "/static/style.css")[0] == 200
+    assert call(server, "/static/../service.py")[0] == 404
+    assert call(server, "/static/missing.js")[0] == 404
+    assert call(server, "/api/nothing")[0] == 404
+
+
+def test_info_reports_model_files_limits_skeleton(server, model_dir):
+    status, info, _ = call(server, "/api/info")
+    assert status == 200
+    assert info["model"] == {"path": str(model_dir), "found": True, "loaded": info["model"]["loaded"],
+                             "kind": "simdiff", "env": True, "error": None}
+    assert info["files"] == [{"index": 0, "name": "walk.npy", "frames": 30}]
+    assert info["limits"]["gravity"] == [-20.0, -1.0] and info["limits"]["wind"] == 10.0
+    assert info["limits"]["alpha"] == [0.0, 2.0] and info["limits"]["seconds"] == pytest.approx(9.8)
+    assert info["defaults"]["gravity"] == pytest.approx(-9.81)
+    assert info["skeleton"]["parents"] == list(PARENTS)
+
+
+# -- generate -----------------------------------------------------------------------------------
+
+
+def test_generate_matches_direct_sampling(server, model_dir):
+    body = {"text": "a person  jumps forward", "gravity": -5.0, "wind_x": 3.0, "wind_y": -2.0, "alpha": 1.5,
+            "seconds": 2.0, "seed": 7}
+    status, out, _ = call(server, "/api/generate", body)
+    assert status == 200, out
+    joints = np.asarray(out["joints"])
+    assert joints.shape == (40, 22, 3) and out["fps"] == 20 and out["parents"] == list(PARENTS)
+    meta = out["meta"]
+    assert meta["source"] == "generate" and meta["frames"] == 40 and meta["seconds"] == 2.0 and meta["env_used"]
+    assert meta["params"]["text"] == "a person jumps forward" and meta["params"]["steps"] == STEPS
+
+    gen = MotionGenerator.load(model_dir, load_text=False)
+    gen.text_encoder = HashTextEncoder()
+    clip = gen.generate(["a person jumps forward"], 40, env=(-5.0, 3.0, -2.0), alpha=1.5, steps=STEPS, seed=7).clips()[0]
+    expected = features_to_joints(clip.numpy())
+    np.testing.assert_allclose(joints, expected, atol=1e-4)  # rounded to 0.1 mm on the wire
+
+
+def test_same_seed_repeats_and_gravity_changes_the_motion(server):
+    body = {"text": "a person walks", "seconds": 1.5, "seed": 3}
+    first = np.asarray(call(server, "/api/generate", body)[1]["joints"])
+    again = call(server, "/api/generate", body)[1]
+    assert np.array_equal(first, np.asarray(again["joints"]))
+    moon = np.asarray(call(server, "/api/generate", {**body, "gravity": -1.62})[1]["joints"])
+    assert first.shape == moon.shape == (30, 22, 3)
+    assert np.abs(first - moon).max() > 1e-3  # the adapters react to φ
+    windy = np.asarray(call(server, "/api/generate", {**body, "wind_y": 10.0})[1]["joints"])
+    assert np.abs(first - windy).max() > 1e-3
+
+
+def test_generation_requests_are_serialised(server):
+    results: list[tuple[int, Any, str]] = []
+    threads = [threading.Thread(target=lambda s=s: results.append(call(server, "/api/generate", {"text": "run", "seconds": 1, "seed": s})))
+               for s in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert [r[0] for r in results] == [200, 200, 200]
+    ids = sorted(r[1]["meta"]["id"] for r in results)
+    assert ids == list(range(ids[0], ids[0] + 3))
+
+
+@pytest.mark.parametrize("body, needle", [
+    ({"text": "  "}, "text must be a non-empty prompt"),
+    ({"gravity": -9.81}, "text must be a non-empty prompt"),
+    ({"text": "walk", "gravity": -25}, "gravity must be in [-20, -1] m/s², got -25"),
+    ({"text": "walk", "gravity": 0}, "gravity must be in [-20, -1]"),
+    ({"text": "walk", "wind_x": 10.5}, "wind_x must be in [-10, 10] N, got 10.5"),
+    ({"text": "walk", "wind_y": -11}, "wind_y must be in [-10, 10] N, got -11"),
+    ({"text": "walk", "alpha": 2.5}, "alpha must be in [0, 2], got 2.5"),
+    ({"text": "walk", "seconds": 10}, "seconds must be in [0.05, 9.8], got 10"),
+    ({"text": "walk", "seconds": 0}, "seconds must be in"),
+    ({"text": "walk", "gravity": "low"}, "gravity must be a finite number, got 'low'"),
+    ({"text": "walk", "seed": 1.5}, "seed must be an integer, got 1.5"),
+    ({"text": "walk", "seed": -1}, "seed must be a non-negative integer"),
+    ({"text": "walk", "steps": 0}, "steps must be in [1, 1000], got 0"),
+    ({"text": "walk", "windx": 1}, "unknown field 'windx'"),
+    (["walk"], "request body must be a JSON object"),
+])
+def test_bad_generate_request_is_a_400_with_one_line(server, body, needle):
+    status, out, _ = call(server, "/api/generate", body)
+    assert status == 400
+    assert needle in out["error"] and "\n" not in out["error"]
+
+
+def test_generate_needs_json(server):
+    status, out, _ = call(server, "/api/generate", b'{"text": "walk"}', content_type="text/plain")
+    assert status == 415 and "application/json" in out["error"]
+    status, out, _ = call(server, "/api/generate", b"{text: walk", content_type="application/json")
+    assert status == 400 and out["error"].startswith("request body is not valid JSON")
+
+
+def test_foreign_host_and_origin_are_refused(server):
+    status, out, _ = call(server, "/api/info", headers={"Host": "evil.example"})
+    assert status == 403 and "evil.example" in out["error"]
+    status, out, _ = call(server, "/api/generate", {"text": "walk"}, headers={"Origin": "http://evil.example"})
+    assert status == 403 and "cross-origin" in out["error"]
+    assert call(server, "/api/info", headers={"Host": f"localhost:{server.port}"})[0] == 200
+
+
+def test_parse_generate_defaults_and_frames():
+    params = parse_generate({"text": " a  person\twaves "})
+    assert params.text == "a person waves" and params.frames == 120 and params.gravity == pytest.approx(-9.81)
+    assert parse_generate({"text": "x", "seconds": 9.8, "seed": 2.0}).frames == 196
+    assert parse_generate({"text": "x", "seconds": 0.05}).frames == 1
+    with pytest.raises(SimdiffError, match="alpha"):
+        parse_generate({"text": "x", "alpha": float("nan")})
+
+
+def test_no_model_answers_503_and_files_still_open(tmp_path, walk):
+    srv = _start(MotionService(tmp_path / "nowhere", files=[ListedMotion("w.npy", Path("w.npy"), walk)]))
+    try:
+        info = call(srv, "/api/info")[1]
+        assert info["model"]["found"] is False and "nowhere" in info["model"]["error"]
+        status, out, _ = call(srv, "/api/generate", {"text": "walk"})
+        assert status == 503 and str(tmp_path / "nowhere") in out["error"]
+        assert call(srv, "/api/files/0")[0] == 200
+    finally:
+        srv.shutdown()
+        srv.server_close()
+
+
+# -- files --------------------------------------------------------------------------------------
+
+
+def test_open_uploaded_joints_features_and_bvh(server, walk, tmp_path):
+    status, out, _ = call(server, "/api/open?name=walk.npy", npy_bytes(walk))
+    assert status == 200 and out["meta"]["source"] == "upload" and out["meta"]["name"] == "walk.npy"
+    np.testing.assert_allclose(np.asarray(out["joints"]), walk, atol=1e-4)
+
+    features = joints_to_features(walk)
+    status, out, _ = call(server, "/api/open?name=feats.npy", npy_bytes(features))
+    assert status == 200 and out["meta"]["frames"] == 29
+    np.testing.assert_allclose(np.asarray(out["joints"]), features_to_joints(features), atol=1e-4)
+
+    bvh = write_bvh(tmp_path / "walk.bvh", walk)
+    status, out, _ = call(server, "/api/open?name=walk.bvh", bvh.read_bytes())
+    assert status == 200, out
+    np.testing.assert_allclose(np.asarray(out["joints"]), load_joints(bvh), atol=1e-4)
+
+
+@pytest.mark.parametrize("name, data, needle", [
+    ("bad.npy", npy_bytes(np.zeros((5, 7), np.float32)), "bad.npy: expected (T, 22, 3) joints or (T, 263) features"),
+    ("junk.bvh", b"\x00\xff not a bvh", "junk.bvh"),
+    ("model.exe", b"MZ", "model.exe: unsupported file type '.exe'"),
+    ("empty.npy", b"", "empty.npy: empty file"),
+    ("", b"xx", "upload needs a file name"),
+])
+def test_bad_upload_is_a_400_naming_the_file(server, name, data, needle):
+    status, out, _ = call(server, f"/api/open?name={name}", data)
+    assert status == 400
+    assert needle in out["error"] and "simdiff-serve-" not in out["error"]  # never the temp path
+
+
+def test_listed_files_open_by_index(server, walk):
+    status, out, _ = call(server, "/api/files/0")
+    assert status == 200 and out["meta"] == {"source": "file", "name": "walk.npy", "path": "walk.npy", "frames": 30, "seconds": 1.5}
+    np.testing.assert_allclose(np.asarray(out["joints"]), walk, atol=1e-4)
+    status, out, _ = call(server, "/api/files/3")
+    assert status == 400 and "no listed file 3" in out["error"]
+
+
+# -- command line -------------------------------------------------------------------------------
+
+
+def test_cli_missing_file_is_a_one_line_error(tmp_path, capsys):
+    assert main(["serve", str(tmp_path / "missing.npy"), "--no-browser", "--port", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("simdiff: error:") and "missing.npy" in err and "\n" not in err
+
+
+def test_cli_builds_a_server_with_listed_files(tmp_path, walk, model_dir):
+    from simdiff.cli.commands.serve import build_server
+
+    np.save(tmp_path / "walk.npy", walk)
+    args = argparse.Namespace(files=[tmp_path / "walk.npy"], port=0, host="127.0.0.1", model=model_dir,
+                              device="cpu", steps=None, no_browser=True)
+    srv = build_server(args)
+    srv.verbose = False
+    srv.start_in_thread()
+    try:
+        assert srv.url == f"http://127.0.0.1:{srv.port}/" and srv.port > 0
+        info = call(srv, "/api/info")[1]
+        assert info["files"][0]["name"] == "walk.npy" and info["model"]["kind"] == "simdiff"
+        with socket.socket() as busy:  # a taken port is a one-line error naming it
+            busy.bind(("127.0.0.1", 0))
+            busy.listen()
+            taken = busy.getsockname()[1]
+            with pytest.raises(SimdiffError, match=f"port {taken} on 127.0.0.1 is already in use"):
+                build_server(argparse.Namespace(**{**vars(args), "files": [], "port": taken}))
+    finally:
+        srv.shutdown()
+        srv.server_close()
+
+
+def test_cli_rejects_bad_port_and_steps(capsys):
+    assert main(["serve", "--port", "70000", "--no-browser"]) == 2
+    assert "--port must be 0..65535, got 70000" in capsys.readouterr().err
+    assert main(["serve", "--steps", "0", "--no-browser"]) == 2
+    assert "--steps must be 1..1000, got 0" in capsys.readouterr().err
