@@ -63,10 +63,10 @@ def test_bad_input_gives_one_line_error(tmp_path: Path, argv, needle):
     assert len(lines) == 1 and lines[0].startswith("simdiff: error:") and needle in lines[0]
 
 
-def test_generate_says_no_default_model_yet(capsys):
-    code = main(["generate", "a person jumps forward", "--gravity", "-3.7", "--wind", "2", "0"])
-    assert code == 1
-    assert "no default model yet" in capsys.readouterr().err
+def test_generate_names_a_missing_model(tmp_path: Path, capsys):
+    code = main(["generate", "a person jumps forward", "--model", str(tmp_path / "nowhere"), "--out", str(tmp_path / "o")])
+    assert code == 2
+    assert "nowhere/config.json: model file not found" in capsys.readouterr().err
 
 
 def test_parsers_can_be_built_repeatedly():

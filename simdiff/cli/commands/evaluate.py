@@ -1,4 +1,4 @@
-"""``simdiff evaluate train-evaluator|run``: our T2M-style evaluator and the experiment runner."""
+"""``simdiff evaluate train-evaluator|run|all``: our T2M-style evaluator and the paper's experiments."""
 
 from __future__ import annotations
 
@@ -24,14 +24,51 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     t.add_argument("--device", default="cpu", help="torch device (default cpu)")
     t.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     t.set_defaults(func=run_train)
-    r = group.add_parser("run", help="run an experiment config (configs/eval_*.json) into reports/",
-                         description="Measure a table or figure (table1, table2, fig4, fig5, retrack) from a JSON config; "
-                                     "finished rows are cached, so an interrupted run resumes.")
-    r.add_argument("--config", type=Path, required=True, help="experiment config (configs/eval_*.json)")
-    r.add_argument("--out-dir", help="reports folder (default: the config's out_dir, 'reports')")
-    r.add_argument("--device", help="torch device (default: the config's)")
-    r.add_argument("--no-progress", action="store_true", help="hide progress bars")
+    r = group.add_parser("run", help="run one experiment config (configs/eval_*.json) into reports/<name>/",
+                         description="Measure table1, table2, fig4, fig5 or retrack from a JSON config into "
+                                     "<out-dir>/<name>/ (report.md, report.json, figures). Finished rows are cached, so an "
+                                     "interrupted run resumes; a row whose settings changed is measured again.")
+    r.add_argument("config", type=Path, help="experiment config (configs/eval_<kind>.json)")
+    _common(r)
     r.set_defaults(func=run_experiment)
+    a = group.add_parser("all", help="run table2, table1, fig4, fig5 and retrack in sequence",
+                         description="Run the five experiments in order (table2 first: table1 takes its best α and reuses "
+                                     "its rows) from <configs>/eval_<kind>.json. --budget quick is the ~30-minute CPU "
+                                     "preset each config defines; full is the configs as written.")
+    a.add_argument("--configs", type=Path, default=Path("configs"), help="folder with eval_<kind>.json (default configs)")
+    a.add_argument("--only", nargs="+", metavar="KIND", help="run only these experiments (table1 table2 fig4 fig5 retrack)")
+    _common(a)
+    a.set_defaults(func=run_all)
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    """Budget, path overrides, --set, output, device, dry run, progress."""
+    p.add_argument("--budget", choices=("quick", "full"), default="full",
+                   help="CPU budget preset from the config's 'budgets' (default full: the config as written)")
+    p.add_argument("--corpus", help="HumanML3D-layout corpus folder (overrides 'corpus')")
+    p.add_argument("--evaluator", help="evaluator folder (overrides 'evaluator.path')")
+    p.add_argument("--backbone", help="MDM backbone model folder (overrides 'paths.backbone')")
+    p.add_argument("--adapters", help="continuous (φ) SimDiff model folder (overrides 'paths.adapters')")
+    p.add_argument("--adapters-binary", help="categorical (binary) SimDiff model folder (overrides 'paths.adapters_binary')")
+    p.add_argument("--set", dest="assignments", action="append", default=[], metavar="KEY=VALUE",
+                   help="override any config value by dotted key, e.g. protocol.replications=3 or models.0.alpha=0.5 "
+                        "(VALUE is JSON when it parses); repeatable")
+    p.add_argument("--out-dir", help="reports folder (overrides 'out_dir', default reports)")
+    p.add_argument("--device", help="torch device (overrides 'device', default cpu)")
+    p.add_argument("--dry-run", action="store_true", help="list the rows (cached / reused / to measure) with time estimates")
+    p.add_argument("--no-progress", action="store_true", help="hide progress bars")
+
+
+def _overrides(args: argparse.Namespace) -> list[tuple[str, object]]:
+    from simdiff.eval.experiments.config import parse_assignment
+
+    out: list[tuple[str, object]] = [parse_assignment(a) for a in args.assignments]
+    for flag, key in (("corpus", "corpus"), ("evaluator", "evaluator.path"), ("backbone", "paths.backbone"),
+                      ("adapters", "paths.adapters"), ("adapters_binary", "paths.adapters_binary"),
+                      ("out_dir", "out_dir"), ("device", "device")):
+        if getattr(args, flag) is not None:
+            out.append((key, getattr(args, flag)))
+    return out
 
 
 def run_train(args: argparse.Namespace) -> int:
@@ -70,11 +107,42 @@ def _asdict(config) -> dict:
     return json.loads(json.dumps(dataclasses.asdict(config)))
 
 
-def run_experiment(args: argparse.Namespace) -> int:
-    from simdiff.eval.experiments import run_experiment as run
+def _print_plan(rows: list[dict]) -> float:
+    from simdiff.eval.experiments.report import duration
 
-    report = run(args.config, command=["simdiff", *sys.argv[1:]], progress=not args.no_progress,
-                 out_dir=args.out_dir, device=args.device)
+    for r in rows:
+        print(f"  {r['experiment']:8s} {r['key']:40s} {r['state']:8s} {duration(r['estimate_s']) if r['estimate_s'] else ''}")
+    total = sum(r["estimate_s"] for r in rows)
+    print(f"  {rows[0]['experiment'] if rows else ''}: {len(rows)} rows, estimated {duration(total)} to measure")
+    return total
+
+
+def run_experiment(args: argparse.Namespace) -> int:
+    from simdiff.eval.experiments import plan_experiment, run_experiment as run
+
+    overrides = _overrides(args)
+    if args.dry_run:
+        _print_plan(plan_experiment(args.config, budget=args.budget, overrides=overrides))
+        return 0
+    report = run(args.config, budget=args.budget, overrides=overrides, command=["simdiff", *sys.argv[1:]],
+                 progress=not args.no_progress)
     out = Path(report["config"]["out_dir"]) / report["name"]
     print(f"{report['kind']} {report['name']}: {len(report['rows'])} rows; report: {out / 'report.md'}")
+    return 0
+
+
+def run_all(args: argparse.Namespace) -> int:
+    from simdiff.eval.experiments import ORDER, config_path, plan_experiment, run_all as run
+    from simdiff.eval.experiments.report import duration
+
+    overrides = _overrides(args)
+    if args.dry_run:
+        total = 0.0
+        for kind in [k for k in ORDER if not args.only or k in args.only]:
+            total += _print_plan(plan_experiment(config_path(args.configs, kind), budget=args.budget, overrides=overrides))
+        print(f"all: estimated {duration(total)} (table1's best-α rows and the rows it reuses from table2 "
+              "are known only once table2 has run)")
+        return 0
+    run(args.configs, budget=args.budget, overrides=overrides, only=args.only, command=["simdiff", *sys.argv[1:]],
+        progress=not args.no_progress)
     return 0

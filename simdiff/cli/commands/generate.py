@@ -1,4 +1,4 @@
-"""``simdiff generate TEXT``: text (+ gravity, wind) → motion with the shipped default model."""
+"""``simdiff generate TEXT``: text (+ gravity, wind) → motion files with the shipped default model."""
 
 from __future__ import annotations
 
@@ -6,29 +6,144 @@ import argparse
 import sys
 from pathlib import Path
 
+EPILOG = """\
+outputs (in --out, default ./out/<prompt>/), per sample K = 0, 1, ...:
+  sampleK_joints.npy     (T, 22, 3) joint positions, metres, Y-up, 20 fps
+  sampleK_features.npy   (T, 263) un-normalised HumanML3D features, one row per joint frame
+  sampleK.bvh            BVH animation (metres, Y-up, 20 fps; Blender: scale 1)
+  sampleK.gif            stick-figure animation (.mp4 with --format npy,bvh,mp4)
+  generation.json        prompt, environment, seed, sampler, steps, guidance, alpha, model, timings
+with --compare, files are named <component><value>_sampleK.* and one video
+compare_sampleK.gif shows the environments side by side (same prompt, same noise).
+
+examples:
+  simdiff generate "a person jumps forward" --gravity -3.7 --wind 2 0
+  simdiff generate "a person walks in a circle" --length 8 --num-samples 3 --no-video
+  simdiff generate "a person jumps forward" --compare gravity=-9.81,-3.7,-1.6
+"""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "generate",
-        help="generate a motion from text under gravity and wind with the shipped default model",
-        description="Generate a motion from a text prompt under explicit gravity and wind.",
+        help="generate a motion from text under gravity and wind (default model)",
+        description="Generate a motion from a text prompt under explicit gravity and wind with the\n"
+                    "shipped default model (or --model / $SIMDIFF_MODEL) and write it as .npy joints\n"
+                    "and features, a BVH and a stick-figure GIF. Runs on the CPU; no simulator is used.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("text", help='what the person does, e.g. "a person jumps forward"')
-    p.add_argument("--gravity", type=float, default=-9.81, help="vertical gravity g_z in m/s² (default -9.81)")
-    p.add_argument("--wind", type=float, nargs=2, default=(0.0, 0.0), metavar=("X", "Y"), help="horizontal wind force in newtons")
-    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: ./out)")
+    p.add_argument("text", metavar="TEXT", help='what the person does, e.g. "a person jumps forward"')
+    env = p.add_argument_group("environment φ")
+    env.add_argument("--gravity", type=float, metavar="G",
+                     help="vertical gravity in m/s², negative (default -9.81 Earth; Mars -3.7, Moon -1.6)")
+    env.add_argument("--wind", type=float, nargs=2, metavar=("X", "Y"),
+                     help="horizontal wind force in newtons along +X and +Z (the character's left and "
+                          "forward at frame 0) (default 0 0)")
+    env.add_argument("--compare", metavar="SPEC",
+                     help="render the same prompt and seed under several environments side by side: "
+                          "gravity=-9.81,-3.7,-1.6 or wind_x=... or wind_y=... (replaces that component)")
+    env.add_argument("--force", action="store_true",
+                     help="allow environments outside the trained range (gravity -20..-1 m/s², |wind| <= 10 N)")
+    smp = p.add_argument_group("sampling")
+    length = smp.add_mutually_exclusive_group()
+    length.add_argument("--length", type=float, metavar="SECONDS", help="motion length in seconds, up to 9.8 (default 6)")
+    length.add_argument("--frames", type=int, metavar="N", help="motion length in frames at 20 fps, 1..196 (default 120)")
+    smp.add_argument("--seed", type=int, default=0, metavar="S", help="noise seed; sample K uses seed+K (default 0)")
+    smp.add_argument("--num-samples", type=int, default=1, metavar="K", help="samples to generate (default 1)")
+    smp.add_argument("--sampler", choices=["ddim", "ddpm"], help="diffusion sampler (default ddim)")
+    smp.add_argument("--steps", type=int, metavar="N", help="diffusion steps (default 50 for ddim, 1000 for ddpm)")
+    smp.add_argument("--guidance", type=float, metavar="W", help="classifier-free guidance scale, 1 = off (default 2.5)")
+    smp.add_argument("--alpha", type=float, metavar="A",
+                     help="strength of the environment adapters, 0 = ignore φ (default 1, or the model's sampling.json)")
+    out = p.add_argument_group("output")
+    out.add_argument("--out", type=Path, metavar="DIR",
+                     help="output folder, files in it are replaced (default ./out/<prompt>, or <prompt>-2, -3, ... "
+                          "when that one is not empty)")
+    out.add_argument("--format", metavar="LIST",
+                     help="comma-separated outputs among npy, bvh, gif, mp4 (default npy,bvh,gif)")
+    out.add_argument("--no-video", action="store_true", help="skip the GIF/MP4 (fastest)")
+    out.add_argument("-q", "--quiet", action="store_true",
+                     help="no progress bars or notes (warnings still show); print only the file paths")
+    run_ = p.add_argument_group("model and compute")
+    run_.add_argument("--model", type=Path, metavar="DIR",
+                      help="model folder with model.safetensors + config.json (default $SIMDIFF_MODEL, else the "
+                           "shipped model)")
+    run_.add_argument("--device", default="cpu", help="torch device, e.g. cpu or cuda (default cpu)")
+    run_.add_argument("--threads", type=int, metavar="N", help="CPU threads for torch (default: torch's choice)")
     p.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    import importlib
-    import importlib.util
+def _note(args: argparse.Namespace, message: str) -> None:
+    """A one-line note on stderr (hidden by --quiet)."""
+    if not args.quiet:
+        print(f"simdiff: {message}", file=sys.stderr)
 
-    if importlib.util.find_spec("simdiff.model.default") is None:  # arrives with the shipped weights
-        print(
-            "simdiff: no default model yet: the shipped weights arrive with the model and "
-            "training work; meanwhile use `simdiff convert`, `simdiff metrics` and `simdiff render`.",
-            file=sys.stderr,
-        )
-        return 1
-    return importlib.import_module("simdiff.model.default").generate_cli(args)
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from simdiff.errors import SimdiffError
+    from simdiff.product.outputs import fresh_dir, prepare_out_dir, slug
+    from simdiff.product.request import build_request, with_model_defaults
+    from simdiff.sim.env import GRAVITY_RANGE, MAX_WIND
+
+    start = time.perf_counter()
+    request = build_request(  # every user value is checked before torch is imported
+        args.text, gravity=args.gravity, wind=args.wind, length_s=args.length, frames=args.frames, seed=args.seed,
+        num_samples=args.num_samples, sampler=args.sampler or "ddim", steps=args.steps,
+        guidance=2.5 if args.guidance is None else args.guidance, alpha=1.0 if args.alpha is None else args.alpha,
+        compare=args.compare, formats=args.format, no_video=args.no_video, force=args.force,
+    )
+    if args.threads is not None and args.threads < 1:
+        raise SimdiffError(f"--threads must be at least 1, got {args.threads}")
+    from simdiff.model.default import check_model_dir, sampling_defaults  # imports torch (simdiff.model)
+
+    folder = check_model_dir(args.model)
+    stored = sampling_defaults(args.model)
+    given = {name for name in ("sampler", "steps", "guidance", "alpha") if getattr(args, name) is not None}
+    request = with_model_defaults(request, stored, given)
+    alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")
+    for env in request.envs:
+        try:
+            env.validate()
+        except SimdiffError:
+            lo, hi = GRAVITY_RANGE
+            print(f"simdiff: warning: {env.as_tuple()} is outside the trained range (gravity {lo:g}..{hi:g} m/s², "
+                  f"|wind| <= {MAX_WIND:g} N); the motion is an extrapolation", file=sys.stderr)
+            break
+    out_dir = prepare_out_dir(args.out if args.out is not None else fresh_dir(Path("out") / slug(request.text)))
+
+    import torch
+
+    from simdiff.model.default import load_default
+    from simdiff.product.pipeline import Timer, describe_env, run_generation
+
+    try:
+        device = torch.device(args.device)
+    except (RuntimeError, ValueError):
+        raise SimdiffError(f"unknown --device {args.device!r}; use cpu or cuda") from None
+    if args.threads is not None:
+        torch.set_num_threads(args.threads)
+    timer = Timer()
+    _note(args, f"loading model {folder}")
+    with timer.stage("load_model"):
+        generator = load_default(args.model, device)
+    if not generator.is_simdiff:
+        ignored = [name for name, value in (("--gravity", args.gravity), ("--wind", args.wind),
+                                            ("--alpha", args.alpha), ("--compare", args.compare)) if value is not None]
+        if ignored:
+            print(f"simdiff: warning: {folder} is a backbone-only model (no environment input); "
+                  f"{', '.join(ignored)} ignored", file=sys.stderr)
+        request = request.with_envs(request.envs[:1])
+    elif generator.config.sim.mode != "continuous":
+        raise SimdiffError(f"{folder} has categorical environments; use `simdiff sample --env-index` with it")
+    meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet, alpha_source)
+    for path in paths:
+        print(path)
+    n = len(meta["samples"])
+    where = describe_env(request.envs[0]) if generator.is_simdiff and request.compare is None else (
+        f"{len(request.envs)} environments" if generator.is_simdiff else describe_env(None))
+    _note(args, f"{n} motion{'s' if n > 1 else ''} of {request.frames} frames ({request.seconds:g} s), {where}, "
+                f"in {time.perf_counter() - start:.1f} s")
+    return 0

@@ -1,4 +1,4 @@
-"""``simdiff render``: stick-figure GIF/MP4 animations and PNG filmstrips of joint files."""
+"""``simdiff render``: stick-figure (or, with ``--body``, MuJoCo humanoid) GIF/MP4 animations and PNG filmstrips."""
 
 from __future__ import annotations
 
@@ -40,6 +40,8 @@ def _run(args: argparse.Namespace) -> int:
     captions = args.caption if args.caption else [f.stem for f in files]
     out = Path(args.out)
     fps = args.fps if args.fps is not None else FPS
+    if args.body:
+        return _run_body(args, motions, captions, out, fps)
     if args.filmstrip or out.suffix.lower() == ".png":
         render_filmstrip(motions, out, captions=captions, n_frames=args.frames, fps=fps)
     else:
@@ -48,11 +50,23 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_body(args: argparse.Namespace, motions: list, captions: list[str], out: Path, fps: float) -> int:
+    """``--body``: the MuJoCo humanoid (IK of the joints), offscreen OpenGL."""
+    from simdiff.viz.body import render_body
+
+    if args.filmstrip and out.suffix.lower() != ".png":
+        raise SimdiffError(f"--body --filmstrip writes a .png, got {str(out)!r}")
+    size = tuple(args.size) if args.size is not None else None
+    render_body(motions, out, captions=captions, fps=fps, size=size, n_frames=args.frames)
+    print(out)
+    return 0
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``simdiff render``."""
     parser = subparsers.add_parser(
         "render",
-        help="render joint motions as a stick-figure GIF/MP4 or a PNG filmstrip",
+        help="render joint motions as a stick-figure (or --body humanoid) GIF/MP4 or a PNG filmstrip",
         description="Render one or more (T, 22, 3) joint motions side by side. The output suffix picks the "
         "format: .gif or .mp4 animation, .png filmstrip (also with --filmstrip).",
     )
@@ -63,4 +77,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--filmstrip", action="store_true", help="save a filmstrip image instead of an animation")
     parser.add_argument("--frames", type=int, default=8, metavar="N", help="frames per filmstrip row (default 8)")
     parser.add_argument("--fps", type=float, default=None, help="frames per second (default 20)")
+    parser.add_argument("--body", action="store_true",
+                        help="render the MuJoCo humanoid (offscreen OpenGL: EGL or OSMesa) instead of stick figures")
+    parser.add_argument("--size", type=int, nargs=2, default=None, metavar=("W", "H"),
+                        help="--body: pixels per panel (default 640 480; filmstrip cells 320 360)")
     parser.set_defaults(func=_run)

@@ -5,8 +5,6 @@ from __future__ import annotations
 from fractions import Fraction
 
 import numpy as np
-from scipy import signal
-from scipy.interpolate import CubicSpline
 
 _MAX_FACTOR = 64
 """Largest up/down factor handled by polyphase filtering; other ratios interpolate."""
@@ -60,6 +58,8 @@ def resample(positions: np.ndarray, src_fps: float, dst_fps: float = 20.0) -> np
 
 def _polyphase(x: np.ndarray, up: int, down: int) -> np.ndarray:
     """``resample_poly`` on x padded by odd reflection (value and slope kept at the ends)."""
+    from scipy import signal  # lazy: scipy.signal costs ~0.6 s to import
+
     half = 10 * max(up, down) / up + 2  # FIR half-length in input samples, plus margin
     blocks = min(int(np.ceil(half / down)), (x.shape[0] - 2) // down)
     pad = blocks * down
@@ -76,6 +76,9 @@ def _filter_and_interpolate(
     x: np.ndarray, src_fps: float, dst_fps: float, n_out: int
 ) -> np.ndarray:
     """Butterworth low-pass (when decimating) then cubic-spline sampling at dst times."""
+    from scipy import signal
+    from scipy.interpolate import CubicSpline
+
     if dst_fps < src_fps:
         cutoff = 0.8 * (dst_fps / 2.0) / (src_fps / 2.0)
         sos = signal.butter(4, cutoff, output="sos")

@@ -1,0 +1,72 @@
+"""Report writing shared by the experiments: header (provenance, budget, paths, time) and cells."""
+
+from __future__ import annotations
+
+from typing import Any
+
+T2M_METRICS: tuple[tuple[str, str], ...] = (
+    ("r_precision_top1", "R@1↑"), ("r_precision_top2", "R@2↑"), ("r_precision_top3", "R@3↑"), ("fid", "FID↓"),
+    ("mm_dist", "MM-Dist↓"), ("diversity", "Diversity→"), ("multimodality", "MModality↑"))
+PHYSICS_METRICS: tuple[tuple[str, str], ...] = (
+    ("penetration", "Penetrate (mm)↓"), ("floating", "Float (mm)↓"), ("sliding", "Slide (mm/frame)↓"),
+    ("skate_ratio", "Skate ratio↓"))
+METRIC_LABELS: dict[str, str] = dict(T2M_METRICS + PHYSICS_METRICS)
+
+
+def mean_ci(summary: dict[str, Any] | None, key: str, digits: int = 3) -> str:
+    """``mean ± ci95`` of a protocol summary entry (``—`` when absent; no ± for a single replication)."""
+    if not summary or key not in summary:
+        return "—"
+    s = summary[key]
+    if s.get("n", 2) < 2:
+        return f"{s['mean']:.{digits}f}"
+    return f"{s['mean']:.{digits}f} ± {s['ci95']:.{digits}f}"
+
+
+def value(x: Any, digits: int = 3) -> str:
+    """A number with ``digits`` decimals (``—`` for None/NaN)."""
+    if x is None or (isinstance(x, float) and x != x):
+        return "—"
+    return f"{x:.{digits}f}"
+
+
+def fmt_env(env: Any) -> str:
+    """φ as ``(g, wx, wy)``."""
+    if env is None:
+        return "—"
+    return "(" + ", ".join(f"{float(v):g}" for v in env) + ")"
+
+
+def duration(seconds: float) -> str:
+    """Seconds as ``42 s``, ``3.5 min`` or ``2.1 h``."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.1f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def header(report: dict[str, Any], title: str) -> list[str]:
+    """Title, provenance, budget, resolved paths and measured/estimated time."""
+    p = report["provenance"]
+    m = p["machine"]
+    b = report["budget"]
+    rows = report["rows"]
+    measured = sum(r.get("wall_s") or 0.0 for r in rows if not r.get("reused_from"))
+    estimate = sum(r.get("estimate_s") or 0.0 for r in rows if not r.get("reused_from"))
+    lines = [f"# {title}", "",
+             f"* command: `{p['command']}` (in `{p.get('cwd', '?')}`)",
+             f"* git commit: {p['git_commit']}{' (dirty tree)' if p['git_dirty'] else ''}",
+             f"* seed: {p['seed']}",
+             f"* machine: {m['host']}, {m['platform']}, {m['cpus']} CPUs ({m.get('torch_threads', '?')} torch threads), "
+             f"torch {m['torch']}, {m['device']} ({m['device_name']})",
+             f"* started {p['started']}, finished {p['finished']}; load average (1, 5, 15 min) at start "
+             f"{m.get('load_avg_start')}, at end {m.get('load_avg_end')}",
+             f"* budget: **{b['name']}**" + (f" — {b['about']}" if b.get("about") else ""),
+             f"* config: `{report['config'].get('source', '')}`"]
+    if b.get("set"):
+        lines.append("* budget overrides: " + ", ".join(f"`{k}={v}`" for k, v in b["set"].items()))
+    lines.append("* paths: " + ", ".join(f"{k} `{v}`" for k, v in report["paths"].items()))
+    lines.append(f"* rows: {len(rows)} ({sum(1 for r in rows if r.get('reused_from'))} reused from other reports); "
+                 f"measurement time {duration(measured)} (estimated {duration(estimate)})")
+    return lines + [""]

@@ -1,0 +1,102 @@
+"""Table 1: ground truth, MDM, PhysDiff and SimDiff, each with DDPM and DDIM sampling.
+
+SimDiff rows at the paper's α (0.1) and at the best α (``best_alpha`` in the config, else
+the ``best_alpha_from`` report, table2; without either the best-α rows are left out and the
+report says so). PhysDiff projects at t = 60, 40, 20, 0: End4/Space1 of DDIM-50, the same
+original timesteps out of DDPM-1000. DDPM rows follow ``ddpm_samples`` (CPU budget).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from simdiff.eval.experiments.rows import ground_truth_plan, method_plan
+from simdiff.eval.experiments.runner import RowPlan, Runner
+from simdiff.eval.experiments.tables import method_figure, metrics_table
+
+TITLE = "Table 1 — MDM, PhysDiff and SimDiff with DDPM and DDIM"
+
+
+def best_alpha(runner: Runner) -> tuple[float | None, str]:
+    """(best α, where it came from), read once per run: the rows and the report agree."""
+    if "best_alpha" not in runner.notes:
+        runner.notes["best_alpha"] = _read_best_alpha(runner)
+    return runner.notes["best_alpha"]
+
+
+def _read_best_alpha(runner: Runner) -> tuple[float | None, str]:
+    c = runner.config
+    if c.best_alpha is not None:
+        return float(c.best_alpha), "config"
+    path = Path(c.out_dir) / c.best_alpha_from / "report.json"
+    if path.is_file():
+        best = json.loads(path.read_text(encoding="utf-8")).get("best_alpha")
+        if best:
+            return float(best["alpha"]), f"{path} (select_by {best.get('select_by')})"
+    return None, (f"not available when this run started: no {path} with a best α and no 'best_alpha' in the config; "
+                  "run table2 first (simdiff evaluate all does) and run table1 again")
+
+
+def alphas(runner: Runner) -> list[tuple[float, str]]:
+    """(α, why) for SimDiff rows, duplicates merged (``0.1 (paper, best)``)."""
+    out: dict[float, list[str]] = {}
+    for a in runner.config.alphas or [None]:
+        if a == "best":
+            value, _ = best_alpha(runner)
+            if value is not None:
+                out.setdefault(value, []).append("best")
+        elif a is None:
+            continue
+        else:
+            out.setdefault(float(a), []).append("paper" if abs(float(a) - 0.1) < 1e-12 else "config")
+    return [(a, ", ".join(why)) for a, why in out.items()]
+
+
+def plan(runner: Runner) -> list[RowPlan]:
+    c = runner.config
+    plans = [ground_truth_plan(runner)]
+    sim_alphas = alphas(runner)
+    for spec in c.models:
+        for sampler in c.samplers:
+            if runner.is_simdiff(spec):
+                pairs = sim_alphas or [(spec.alpha, "model")]
+                plans += [method_plan(runner, spec, sampler, a, alpha_choice=why) for a, why in pairs]
+            else:
+                plans.append(method_plan(runner, spec, sampler, None))
+    return plans
+
+
+def ddpm_note(runner: Runner) -> str:
+    """What the DDPM rows measured, in words."""
+    c = runner.config
+    if c.ddpm_samples == 0:
+        return "the same protocol as the DDIM rows"
+    if c.ddpm_samples >= c.protocol.batch_size:
+        return f"{c.ddpm_samples} test motions, {c.ddpm_replications} replication(s), no MultiModality"
+    return f"{c.ddpm_samples} test motions (physics and time only)"
+
+
+def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
+    c = runner.config
+    value, source = best_alpha(runner)
+    report["best_alpha"] = {"alpha": value, "source": source}
+    figure = method_figure(report["rows"], runner.out / "table1.png")
+    physdiff = [m for m in c.models if m.physdiff is not None]
+    lines = metrics_table(report["rows"])
+    lines += ["", f"* best α: {value if value is not None else '—'} ({source})",
+              f"* protocol (DDIM rows): {c.protocol.replications} replications × {runner.samples_per_replication(c.protocol)} "
+              f"test motions (batches of {c.protocol.batch_size}, samples_limit {c.protocol.samples_limit}); MultiModality "
+              + (f"{c.protocol.mm_prompts} prompts × {c.protocol.mm_repeats} repeats, {c.protocol.mm_times} pairs"
+                 if c.protocol.mm_prompts else "off"),
+              "* DDPM rows: " + ddpm_note(runner)]
+    for m in physdiff:
+        for sampler in c.samplers:
+            cfg = runner.physdiff_config(m, sampler)
+            lines.append(f"* {m.name} {sampler.upper()}: projection at t = {', '.join(map(str, cfg.project_at))} "
+                         f"({cfg.steps or ('1000' if sampler == 'ddpm' else '50')} steps), residual bound {cfg.residual_bound}")
+    lines.append("* s/motion: generation time per motion in the protocol's batches of 32 (PhysDiff: with projection); "
+                 "see fig4 for batch-1 latency")
+    lines += ["", f"![Table 1]({figure.name})"]
+    return lines

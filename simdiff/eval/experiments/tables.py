@@ -1,0 +1,90 @@
+"""Markdown and figure helpers for protocol tables (table1, table2)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from simdiff.eval.experiments.report import PHYSICS_METRICS, T2M_METRICS, mean_ci, value
+from simdiff.eval.experiments.rows import phys_err
+
+
+def metrics_table(rows: list[dict[str, Any]], first: str = "Method") -> list[str]:
+    """One Markdown row per measured row: T2M metrics, physics metrics, Phys-Err, s/motion (mean ± 95% CI)."""
+    cols = [label for _, label in T2M_METRICS] + [label for _, label in PHYSICS_METRICS]
+    lines = [f"| {first} | Sampler | α | n × R | " + " | ".join(cols) + " | Phys-Err (mm)↓ | s/motion |",
+             "|" + "---|" * (len(cols) + 6)]
+    for r in rows:
+        alpha = "—" if r.get("alpha") is None else f"{r['alpha']:g}" + (f" ({r['alpha_choice']})" if r.get("alpha_choice") else "")
+        sampler = (r.get("sampler") or "—").upper()
+        if "summary" in r:
+            s = r["summary"]
+            n = f"{r['samples_per_replication']} × {r['replications_run']}"
+            cells = [mean_ci(s, k) for k, _ in T2M_METRICS] + [mean_ci(s, k) for k, _ in PHYSICS_METRICS]
+        else:
+            p = r.get("physics", {})
+            n = f"{r.get('samples', '?')} × 1 †"
+            cells = ["—"] * len(T2M_METRICS) + [value(p.get(k)) for k, _ in PHYSICS_METRICS]
+        sps = value(r.get("s_per_motion"), 2) if r.get("s_per_motion") is not None else "—"
+        lines.append(f"| {r['method']} | {sampler} | {alpha} | {n} | " + " | ".join(cells) +
+                     f" | {value(phys_err(r), 2)} | {sps} |")
+    if any("summary" not in r for r in rows):
+        lines += ["", "† physics metrics and time only: too few motions for R-precision (batches of 32), FID or Diversity."]
+    return lines
+
+
+def alpha_figure(rows: list[dict[str, Any]], path: Path, best: float | None = None) -> Path:
+    """FID, R@3, Phys-Err and skate ratio against α (log axis), mean ± 95% CI."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    keys = [("fid", "FID ↓"), ("r_precision_top3", "R-precision top-3 ↑"), ("phys_err", "Phys-Err (mm) ↓"),
+            ("skate_ratio", "skate ratio ↓")]
+    fig, axes = plt.subplots(1, len(keys), figsize=(3.3 * len(keys), 3.1))
+    for ax, (key, title) in zip(axes, keys):
+        for method in dict.fromkeys(r["method"] for r in rows):
+            mine = sorted((r for r in rows if r["method"] == method and "summary" in r), key=lambda r: r["alpha"])
+            xs = [r["alpha"] for r in mine]
+            if key == "phys_err":
+                parts = ("penetration", "floating", "sliding")
+                ys, es = [phys_err(r) for r in mine], [sum(r["summary"][k]["ci95"] for k in parts) for r in mine]
+            else:
+                ys, es = [r["summary"][key]["mean"] for r in mine], [r["summary"][key]["ci95"] for r in mine]
+            ax.errorbar(xs, ys, yerr=es, fmt="o-", capsize=3, label=method)
+        if best is not None:
+            ax.axvline(best, color="#999999", ls="--", lw=1)
+        ax.set_xscale("log")
+        ax.set_xlabel("adapter scale α")
+        ax.set_title(title, fontsize=10)
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def method_figure(rows: list[dict[str, Any]], path: Path) -> Path:
+    """Two bar panels per row: FID (protocol rows) and Phys-Err (all rows)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = [r["method"] + (f"\n{r['sampler'].upper()}" if r.get("sampler") else "")
+              + (f" α={r['alpha']:g}" if r.get("alpha") is not None else "") for r in rows]
+    fig, axes = plt.subplots(1, 2, figsize=(max(8.0, 1.5 * len(rows)), 3.6))
+    fid = [r["summary"]["fid"]["mean"] if "summary" in r and "fid" in r["summary"] else 0.0 for r in rows]
+    fid_err = [r["summary"]["fid"]["ci95"] if "summary" in r and "fid" in r["summary"] else 0.0 for r in rows]
+    pe = [phys_err(r) or 0.0 for r in rows]
+    axes[0].bar(range(len(rows)), fid, yerr=fid_err, color="#4c72b0", capsize=3)
+    axes[0].set_title("FID ↓ (DDPM subset rows: not measured)", fontsize=9)
+    axes[1].bar(range(len(rows)), pe, color="#dd8452")
+    axes[1].set_title("Phys-Err = penetrate + float + slide (mm) ↓", fontsize=9)
+    for ax in axes:
+        ax.set_xticks(range(len(rows)), labels, fontsize=7, rotation=45, ha="right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

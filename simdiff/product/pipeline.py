@@ -1,0 +1,232 @@
+"""The generation pipeline behind ``simdiff generate``: prompt → features → joints → files, timed.
+
+Sample ``k`` under every environment starts from the same noise (seed ``seed + k``), so a
+``--compare`` video shows the effect of φ alone, and ``--seed S --num-samples 1`` reproduces
+sample ``k`` of ``--seed S-k``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Iterator
+
+import numpy as np
+
+from simdiff import __version__
+from simdiff.motion.skeleton import FPS
+from simdiff.product.outputs import env_label, render_video, write_metadata, write_motion
+from simdiff.product.request import GenerationRequest
+from simdiff.sim.env import Environment
+
+FEATURES_NOTE = ("(T, 263) float32 un-normalised HumanML3D features, one row per joint frame as the model "
+                 "samples them (MDM convention); joints = simdiff.motion.features.features_to_joints(features)")
+
+
+@dataclass
+class Timer:
+    """Wall-clock and process-CPU seconds per named stage (stages may repeat; times add up)."""
+
+    wall: dict[str, float] = field(default_factory=dict)
+    cpu: dict[str, float] = field(default_factory=dict)
+
+    @contextmanager
+    def stage(self, name: str) -> Iterator[None]:
+        w, c = time.perf_counter(), time.process_time()
+        try:
+            yield
+        finally:
+            self.wall[name] = self.wall.get(name, 0.0) + time.perf_counter() - w
+            self.cpu[name] = self.cpu.get(name, 0.0) + time.process_time() - c
+
+    def rounded(self, which: dict[str, float]) -> dict[str, float]:
+        """Stage → seconds (3 decimals) plus ``total``."""
+        out = {k: round(v, 3) for k, v in which.items()}
+        out["total"] = round(sum(which.values()), 3)
+        return out
+
+
+@dataclass
+class Sample:
+    """One generated motion.
+
+    Attributes:
+        column: index of its environment in ``request.envs``.
+        index: sample number k (seed = request.seed + k).
+        env: φ it was generated under; None for a backbone-only model.
+        features: (T, 263) float32 un-normalised features.
+        joints: (T, 22, 3) float32 positions in metres, Y-up.
+    """
+
+    column: int
+    index: int
+    seed: int
+    env: Environment | None
+    features: np.ndarray
+    joints: np.ndarray
+
+
+def _progress(quiet: bool):
+    """A ``progress(iterable, total, desc)`` wrapper printing a tqdm bar on stderr (nothing when quiet)."""
+    from tqdm.auto import tqdm
+
+    def wrap(iterable: Iterable, total: int, desc: str) -> Iterable:
+        return tqdm(iterable, total=total, desc=desc, unit="frame", leave=False, disable=quiet, file=sys.stderr,
+                    dynamic_ncols=True)
+
+    return wrap
+
+
+def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: bool = False) -> list[Sample]:
+    """Encode the prompt once, sample every (environment, k) pair, and decode joints.
+
+    Args:
+        generator: a :class:`~simdiff.model.generator.MotionGenerator` with a text encoder.
+        request: the validated request; its environments are ignored for a backbone-only model.
+    """
+    from tqdm.auto import tqdm
+
+    from simdiff.motion.features import features_to_joints
+
+    simdiff_model = bool(generator.is_simdiff)
+    envs: list[Environment | None] = list(request.envs) if simdiff_model else [None]
+    with timer.stage("encode_text"):
+        text = generator.encode_text([request.text])
+    runs = [(c, k) for c in range(len(envs)) for k in range(request.num_samples)]
+    bar = tqdm(total=request.steps * len(runs), desc=f"{request.sampler} sampling", unit="step", leave=False,
+               disable=quiet, file=sys.stderr, dynamic_ncols=True)
+
+    def progress(steps: Iterable) -> Iterator:
+        for t in steps:
+            yield t
+            bar.update(1)
+
+    features = []
+    try:
+        with timer.stage("sample"):
+            for c, k in runs:
+                env = envs[c]
+                out = generator.generate(
+                    [request.text], request.frames, env=None if env is None else env.as_tuple(),
+                    alpha=request.alpha, sampler=request.sampler, steps=request.steps, guidance=request.guidance,
+                    seed=request.seed + k, text_embeddings=text, progress=progress,
+                )
+                features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
+    finally:
+        bar.close()
+    samples = []
+    with timer.stage("decode"):
+        for (c, k), f in zip(runs, features):
+            joints = np.asarray(features_to_joints(f), dtype=np.float32)
+            samples.append(Sample(c, k, request.seed + k, envs[c], f, joints))
+    return samples
+
+
+def describe_env(env: Environment | None) -> str:
+    """``g -3.7 m/s², wind (2, 0) N`` (or ``no environment`` for a backbone-only model)."""
+    if env is None:
+        return "no environment (backbone-only model)"
+    return f"g {env.gravity:g} m/s², wind ({env.wind_x:g}, {env.wind_y:g}) N"
+
+
+def stem_name(request: GenerationRequest, sample: Sample) -> str:
+    """File stem of a sample: ``sample0``, or ``gravity-3.7_sample0`` under ``--compare``."""
+    if request.compare is None or sample.env is None:
+        return f"sample{sample.index}"
+    value = getattr(sample.env, request.compare)
+    return f"{request.compare}{env_label(value)}_sample{sample.index}"
+
+
+def write_outputs(samples: list[Sample], request: GenerationRequest, out_dir: Path, timer: Timer,
+                  quiet: bool = False) -> tuple[list[dict[str, Path]], list[Path]]:
+    """Write every sample's files and the videos; returns (kind → path per sample, video paths).
+
+    Without ``--compare`` each sample gets its own video ``sampleK.gif``; with it, one video per
+    k shows the environments side by side (``compare_sampleK.gif``).
+    """
+    files: list[dict[str, Path]] = []
+    for s in samples:
+        stem = out_dir / stem_name(request, s)
+        written: dict[str, Path] = {}
+        with timer.stage("write_npy"):
+            written.update(write_motion(stem, s.joints, s.features, [f for f in request.formats if f == "npy"]))
+        with timer.stage("write_bvh"):
+            written.update(write_motion(stem, s.joints, s.features, [f for f in request.formats if f == "bvh"]))
+        files.append(written)
+    videos: list[Path] = []
+    progress = _progress(quiet)
+    compare = request.compare is not None and len({s.column for s in samples}) > 1
+    for kind in request.video_formats:
+        with timer.stage(f"render_{kind}"):
+            if compare:
+                for k in range(request.num_samples):
+                    group = [s for s in samples if s.index == k]
+                    path = out_dir / f"compare_sample{k}.{kind}"
+                    captions = [f"{request.text} · {describe_env(s.env)}" for s in group]
+                    videos.append(render_video([s.joints for s in group], captions, path, FPS, progress))
+                continue
+            for s, written in zip(samples, files):
+                path = out_dir / f"{stem_name(request, s)}.{kind}"
+                written[kind] = render_video([s.joints], [f"{request.text} · {describe_env(s.env)}"], path, FPS,
+                                             progress)
+                videos.append(path)
+    return files, videos
+
+
+def _env_dict(env: Environment) -> dict:
+    return {"gravity": env.gravity, "wind": [env.wind_x, env.wind_y]}
+
+
+def metadata(request: GenerationRequest, generator, model_dir: Path, samples: list[Sample],
+             files: list[dict[str, Path]], videos: list[Path], timer: Timer, alpha_source: str = "default") -> dict:
+    """The ``generation.json`` record of one run (file names relative to the output folder)."""
+    cfg = generator.config
+    simdiff_model = bool(generator.is_simdiff)
+    records = [{"index": s.index, "seed": s.seed, "environment": None if s.env is None else _env_dict(s.env),
+                "frames": int(s.joints.shape[0]), "files": {kind: p.name for kind, p in written.items()}}
+               for s, written in zip(samples, files)]
+    return {
+        "simdiff_version": __version__,
+        "prompt": request.text,
+        "frames": request.frames,
+        "seconds": request.seconds,
+        "fps": FPS,
+        "model": {
+            "path": str(Path(model_dir).resolve()),
+            "kind": f"simdiff ({cfg.sim.mode} environment)" if simdiff_model else "backbone only (environment ignored)",
+            "latent_dim": cfg.backbone.latent_dim,
+            "num_layers": cfg.backbone.num_layers,
+            "text_encoder": cfg.text_encoder,
+        },
+        "environment": _env_dict(request.envs[0]) if simdiff_model and request.compare is None else None,
+        "compare": ({"component": request.compare,
+                     "values": [getattr(e, request.compare) for e in request.envs]}
+                    if simdiff_model and request.compare else None),
+        "seed": request.seed,
+        "num_samples": request.num_samples,
+        "sampler": request.sampler,
+        "steps": request.steps,
+        "guidance": request.guidance,
+        "alpha": request.alpha if simdiff_model else None,
+        "alpha_source": alpha_source if simdiff_model else None,
+        "features_layout": FEATURES_NOTE,
+        "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",
+        "samples": records,
+        "videos": [p.name for p in videos],
+        "timings_s": timer.rounded(timer.wall),
+        "cpu_s": timer.rounded(timer.cpu),
+    }
+
+
+def run_generation(generator, request: GenerationRequest, out_dir: Path, model_dir: Path, timer: Timer,
+                   quiet: bool = False, alpha_source: str = "default") -> tuple[dict, list[Path]]:
+    """Sample, write every file and ``generation.json``; returns (metadata, written paths in print order)."""
+    samples = sample_motions(generator, request, timer, quiet)
+    files, videos = write_outputs(samples, request, out_dir, timer, quiet)
+    meta = metadata(request, generator, model_dir, samples, files, videos, timer, alpha_source)
+    meta_path = write_metadata(out_dir / "generation.json", meta)
+    paths = {p for written in files for p in written.values()} | set(videos)
+    return meta, sorted(paths, key=lambda p: p.name) + [meta_path]

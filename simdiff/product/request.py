@@ -1,0 +1,243 @@
+"""A checked generation request: what ``simdiff generate`` validates before loading any model.
+
+Pure Python + numpy (no torch), so bad input fails in milliseconds with one line naming the value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from simdiff.errors import SimdiffError
+from simdiff.motion.skeleton import FPS
+from simdiff.sim.env import EARTH_GRAVITY, Environment
+
+MAX_FRAMES: int = 196
+"""Longest motion in frames (9.8 s at 20 fps); equals :data:`simdiff.model.generator.MAX_FRAMES`."""
+MAX_STEPS: int = 1000
+"""Diffusion steps the models are trained with (the most a sampler can take)."""
+MAX_SAMPLES: int = 64
+"""Most samples per run (each is sampled, written and rendered)."""
+MAX_COMPARE: int = 8
+"""Most environments in one ``--compare`` video."""
+COMPARE_KEYS: tuple[str, ...] = ("gravity", "wind_x", "wind_y")
+"""Environment components ``--compare`` can vary."""
+FORMATS: tuple[str, ...] = ("npy", "bvh", "gif", "mp4")
+"""Output kinds: ``npy`` = joints + features, ``bvh``, and the ``gif``/``mp4`` stick video."""
+DEFAULT_FORMATS: tuple[str, ...] = ("npy", "bvh", "gif")
+VIDEO_FORMATS: tuple[str, ...] = ("gif", "mp4")
+SAMPLER_DEFAULT_STEPS: dict[str, int] = {"ddim": 50, "ddpm": 1000}
+
+
+@dataclass(frozen=True)
+class GenerationRequest:
+    """Everything one ``simdiff generate`` run does, already validated.
+
+    Attributes:
+        text: the prompt (stripped, non-empty).
+        frames: motion length in frames at 20 fps, 1..196.
+        envs: the environments φ to generate under: one, or several for ``--compare``.
+        compare: the φ component varied across ``envs`` (``gravity``, ``wind_x``, ``wind_y``) or None.
+        seed: noise seed of sample 0; sample k uses ``seed + k`` (the same under every environment).
+        num_samples: samples per environment.
+        sampler: ``ddim`` or ``ddpm``.
+        steps: diffusion steps.
+        guidance: classifier-free guidance scale (1 = off).
+        alpha: adapter strength α (0 = backbone only).
+        formats: output kinds, a subset of :data:`FORMATS`.
+        force: environments outside the trained range were allowed.
+    """
+
+    text: str
+    frames: int = 120
+    envs: tuple[Environment, ...] = (Environment(),)
+    compare: str | None = None
+    seed: int = 0
+    num_samples: int = 1
+    sampler: str = "ddim"
+    steps: int = 50
+    guidance: float = 2.5
+    alpha: float = 1.0
+    formats: tuple[str, ...] = DEFAULT_FORMATS
+    force: bool = False
+
+    @property
+    def seconds(self) -> float:
+        """Motion length in seconds."""
+        return self.frames / FPS
+
+    @property
+    def video_formats(self) -> tuple[str, ...]:
+        """The requested video kinds (``gif``, ``mp4``), possibly none."""
+        return tuple(f for f in self.formats if f in VIDEO_FORMATS)
+
+    def with_envs(self, envs: tuple[Environment, ...]) -> "GenerationRequest":
+        """A copy with other environments (used when a backbone-only model ignores φ)."""
+        return replace(self, envs=envs, compare=None)
+
+
+def check_text(text: str) -> str:
+    """The stripped prompt; blank text raises."""
+    stripped = " ".join(str(text).split())
+    if not stripped:
+        raise SimdiffError("the text prompt is empty; describe the motion, e.g. \"a person jumps forward\"")
+    return stripped
+
+
+def frames_from(length_s: float | None = None, frames: int | None = None, default: int = 120) -> int:
+    """Frames at 20 fps from ``--length SECONDS`` or ``--frames N`` (at most one given).
+
+    Raises:
+        SimdiffError: both given, non-finite, or outside 1..196 frames (0.05..9.8 s).
+    """
+    if length_s is not None and frames is not None:
+        raise SimdiffError(f"give --length ({length_s} s) or --frames ({frames}), not both")
+    if length_s is not None:
+        if not math.isfinite(length_s):
+            raise SimdiffError(f"--length must be a number of seconds, got {length_s}")
+        n = int(round(length_s * FPS))
+        if not 1 <= n <= MAX_FRAMES:
+            raise SimdiffError(f"--length {length_s:g} s is {n} frames; it must be 1..{MAX_FRAMES} frames "
+                               f"({1 / FPS:g}..{MAX_FRAMES / FPS:g} s at {FPS} fps)")
+        return n
+    n = default if frames is None else int(frames)
+    if not 1 <= n <= MAX_FRAMES:
+        raise SimdiffError(f"--frames must be 1..{MAX_FRAMES} ({MAX_FRAMES / FPS:g} s at {FPS} fps), got {n}")
+    return n
+
+
+def parse_compare(spec: str) -> tuple[str, tuple[float, ...]]:
+    """``"gravity=-9.81,-3.7,-1.6"`` → ``("gravity", (-9.81, -3.7, -1.6))``; also ``wind_x=`` and ``wind_y=``.
+
+    Raises:
+        SimdiffError: unknown component, no ``=``, a value that is not a finite number, fewer than
+            2 or more than :data:`MAX_COMPARE` values, or a repeated value.
+    """
+    usage = "expected gravity=G1,G2,... or wind_x=X1,X2,... or wind_y=Y1,Y2,..."
+    key, sep, rest = str(spec).partition("=")
+    key = key.strip().lower().replace("-", "_")
+    if not sep or key not in COMPARE_KEYS:
+        raise SimdiffError(f"bad --compare {spec!r}: {usage}")
+    values = []
+    for item in rest.split(","):
+        try:
+            value = float(item)
+        except ValueError:
+            raise SimdiffError(f"bad --compare {spec!r}: {item.strip()!r} is not a number") from None
+        if not math.isfinite(value):
+            raise SimdiffError(f"bad --compare {spec!r}: {item.strip()!r} is not a finite number")
+        values.append(value)
+    if not 2 <= len(values) <= MAX_COMPARE:
+        raise SimdiffError(f"bad --compare {spec!r}: give 2..{MAX_COMPARE} values, got {len(values)}")
+    if len(set(values)) != len(values):
+        raise SimdiffError(f"bad --compare {spec!r}: a value is repeated")
+    return key, tuple(values)
+
+
+def parse_formats(spec: str | None, no_video: bool = False) -> tuple[str, ...]:
+    """``"npy,bvh,gif"`` → ``("npy", "bvh", "gif")``; ``no_video`` drops gif/mp4.
+
+    Raises:
+        SimdiffError: an unknown kind, or nothing left to write.
+    """
+    kinds = DEFAULT_FORMATS if spec is None else tuple(dict.fromkeys(k.strip().lower() for k in spec.split(",") if k.strip()))
+    bad = [k for k in kinds if k not in FORMATS]
+    if bad:
+        raise SimdiffError(f"unknown --format {bad[0]!r}; choose from {', '.join(FORMATS)} (comma-separated)")
+    if no_video:
+        kinds = tuple(k for k in kinds if k not in VIDEO_FORMATS)
+    if not kinds:
+        raise SimdiffError("nothing to write: --format is empty (or only video with --no-video)")
+    return kinds
+
+
+def environments(gravity: float, wind: tuple[float, float], compare: tuple[str, tuple[float, ...]] | None,
+                 force: bool = False) -> tuple[Environment, ...]:
+    """The validated environment(s): φ from ``gravity``/``wind``, one per ``compare`` value if given.
+
+    Raises:
+        SimdiffError: gravity ≥ 0 or non-finite, or (without ``force``) outside the trained range
+            (g ∈ [−20, −1] m/s², |w| ≤ 10 N); the message names the value.
+    """
+    base = Environment(check_finite("--gravity", gravity), check_finite("--wind X", wind[0]),
+                       check_finite("--wind Y", wind[1]))
+    if compare is None:
+        envs: tuple[Environment, ...] = (base,)
+    else:
+        key, values = compare
+        field = {"gravity": "gravity", "wind_x": "wind_x", "wind_y": "wind_y"}[key]
+        envs = tuple(replace(base, **{field: v}) for v in values)
+    for env in envs:
+        env.validate(force=force)
+    return envs
+
+
+def steps_for(sampler: str, steps: int | None) -> int:
+    """Diffusion steps: ``steps`` or the sampler's default (DDIM 50, DDPM 1000), checked in 1..1000."""
+    if sampler not in SAMPLER_DEFAULT_STEPS:
+        raise SimdiffError(f"unknown sampler {sampler!r}; choose ddim or ddpm")
+    n = SAMPLER_DEFAULT_STEPS[sampler] if steps is None else int(steps)
+    if not 1 <= n <= MAX_STEPS:
+        raise SimdiffError(f"--steps must be 1..{MAX_STEPS}, got {n}")
+    return n
+
+
+def check_finite(name: str, value: float, minimum: float | None = None) -> float:
+    """``value`` as float if finite (and ≥ ``minimum``); else a one-line error naming ``name``."""
+    value = float(value)
+    if not math.isfinite(value):
+        raise SimdiffError(f"{name} must be a finite number, got {value}")
+    if minimum is not None and value < minimum:
+        raise SimdiffError(f"{name} must be ≥ {minimum:g}, got {value:g}")
+    return value
+
+
+def with_model_defaults(request: GenerationRequest, stored: dict[str, float | int | str],
+                        given: set[str]) -> GenerationRequest:
+    """Apply a model's stored sampling settings (``sampling.json``) to the options the user did not give.
+
+    Args:
+        stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha`` (see
+            :func:`simdiff.model.default.sampling_defaults`).
+        given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``).
+    """
+    sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
+    if "steps" in given:
+        steps = request.steps
+    elif "sampler" in given and sampler != stored.get("sampler", sampler):
+        steps = steps_for(sampler, None)
+    else:
+        steps = steps_for(sampler, stored.get("steps"))  # type: ignore[arg-type]
+    return replace(
+        request, sampler=sampler, steps=steps,
+        guidance=request.guidance if "guidance" in given else check_finite("guidance", stored.get("guidance", request.guidance), 0.0),
+        alpha=request.alpha if "alpha" in given else check_finite("alpha", stored.get("alpha", request.alpha)),
+    )
+
+
+def build_request(text: str, *, gravity: float | None = None, wind: tuple[float, float] | None = None,
+                  length_s: float | None = None, frames: int | None = None, seed: int = 0, num_samples: int = 1,
+                  sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
+                  compare: str | None = None, formats: str | None = None, no_video: bool = False,
+                  force: bool = False) -> GenerationRequest:
+    """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
+    if seed < 0:
+        raise SimdiffError(f"--seed must be ≥ 0, got {seed}")
+    if not 1 <= num_samples <= MAX_SAMPLES:
+        raise SimdiffError(f"--num-samples must be 1..{MAX_SAMPLES}, got {num_samples}")
+    spec = parse_compare(compare) if compare is not None else None
+    return GenerationRequest(
+        text=check_text(text),
+        frames=frames_from(length_s, frames),
+        envs=environments(EARTH_GRAVITY if gravity is None else gravity, (0.0, 0.0) if wind is None else tuple(wind),
+                          spec, force),
+        compare=spec[0] if spec else None,
+        seed=int(seed),
+        num_samples=int(num_samples),
+        sampler=sampler,
+        steps=steps_for(sampler, steps),
+        guidance=check_finite("--guidance", guidance, 0.0),
+        alpha=check_finite("--alpha", alpha),
+        formats=parse_formats(formats, no_video),
+        force=bool(force),
+    )

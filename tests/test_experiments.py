@@ -1,0 +1,276 @@
+"""The paper's experiments end to end on tiny random models, a tiny corpus and a fake simulator."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from simdiff.errors import SimdiffError
+from simdiff.eval.experiments import load_config, plan_experiment, run_all, run_experiment
+from simdiff.eval.experiments.config import parse_assignment
+from simdiff.eval.experiments.fig5 import motion_stats
+from simdiff.eval.experiments.runner import Runner
+from simdiff.eval.experiments.table2 import select_alpha
+from simdiff.eval.experiments.testing import EchoProjector, write_tiny_setup
+from simdiff.motion.synthetic import jump, walk
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+PROTO = {"replications": 2, "batch_size": 8, "samples_limit": 0, "diversity_times": 8, "mm_prompts": 2, "mm_repeats": 2,
+         "mm_times": 1, "seed": 0}
+FAST = {"steps": 2, "ddpm_steps": 5}
+PHYS = {"project_at": [500, 0]}  # steps of both DDIM-2 and DDPM-5
+
+
+@pytest.fixture(autouse=True, scope="module")
+def one_thread():
+    """One torch thread: on a busy 2-core machine two spinning threads make tiny models ~25× slower."""
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(before)
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("experiments")
+    return {**write_tiny_setup(root), "root": root}
+
+
+def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -> Path:
+    """A config of ``kind`` over the tiny setup (hash text encoder, tiny protocol)."""
+    models = extra.pop("models", None) or {
+        "table1": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
+                   {"name": "SimDiff", "model": "adapters_binary", "env_index": 1, **FAST}],
+        "table2": [{"name": "SimDiff", "model": "adapters_binary", "env_index": 1, **FAST}],
+        "fig4": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
+                 {"name": "SimDiff", "model": "adapters", **FAST}],
+        "fig5": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}],
+        "retrack": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
+                    {"name": "SimDiff", "model": "adapters", **FAST}],
+    }[kind]
+    cfg = {"name": name or kind, "kind": kind, "corpus": str(setup["corpus"]),
+           "paths": {r: str(setup[r]) for r in ("backbone", "adapters", "adapters_binary")},
+           "evaluator": {"kind": "ours", "path": str(setup["evaluator"])}, "protocol": PROTO, "models": models,
+           "out_dir": str(setup["root"] / "reports"), "text_encoder": "hash", **extra}
+    path = setup["root"] / f"eval_{name or kind}.json"
+    path.write_text(json.dumps(cfg))
+    return path
+
+
+def test_shipped_configs_are_the_five_experiments_with_relative_paths() -> None:
+    paths = sorted(CONFIGS.glob("eval_*.json"))
+    assert [p.stem for p in paths] == ["eval_fig4", "eval_fig5", "eval_retrack", "eval_table1", "eval_table2"]
+    for path in paths:
+        raw = json.loads(path.read_text())
+        assert raw["kind"] == raw["name"] == path.stem[5:]
+        for value in [raw["corpus"], raw["evaluator"]["path"], *raw["paths"].values()]:
+            assert not Path(value).is_absolute() and "/tmp" not in value, value
+        quick = load_config(path, "quick")
+        full = load_config(path, "full")
+        assert quick.budgets["quick"]["about"] and quick.budget == "quick"
+        assert quick != full
+    t1, t2 = load_config(CONFIGS / "eval_table1.json", "quick"), load_config(CONFIGS / "eval_table2.json", "quick")
+    assert t1.protocol == t2.protocol  # so table1 reuses table2's SimDiff rows
+    assert t1.samplers == ["ddpm", "ddim"] and t1.alphas == [0.1, "best"] and t1.ddpm_samples == 4
+    assert t2.alphas == [0.01, 0.05, 0.1, 0.2, 0.5, 1.0]
+    assert [m.physdiff["project_at"] for m in t1.models if m.physdiff] == [[60, 40, 20, 0]]
+
+
+def test_budget_and_overrides_apply_in_order(tmp_path: Path) -> None:
+    path = CONFIGS / "eval_table1.json"
+    c = load_config(path, "quick", [parse_assignment("protocol.replications=5"), ("paths.backbone", "/x/bb"),
+                                    parse_assignment("models.0.name=Backbone")])
+    assert c.protocol.replications == 5 and c.protocol.samples_limit == 0  # the override beats the budget
+    assert c.paths["backbone"] == "/x/bb" and c.models[0].name == "Backbone"
+    assert c.resolved_paths()["backbone"] == "/x/bb"
+    assert Path(c.resolved_paths()["corpus"]).is_absolute()
+    with pytest.raises(SimdiffError, match="no budget 'huge'"):
+        load_config(path, "huge")
+    with pytest.raises(SimdiffError, match="protocl"):
+        load_config(path, None, [("protocl.replications", 3)])
+    with pytest.raises(SimdiffError, match="not an index"):
+        load_config(path, None, [("models.9.alpha", 3)])
+    with pytest.raises(SimdiffError, match="KEY=VALUE"):
+        parse_assignment("replications")
+    assert parse_assignment("a.b=[1, 2]") == ("a.b", [1, 2]) and parse_assignment("x=runs/m") == ("x", "runs/m")
+
+
+def test_select_alpha_rules() -> None:
+    def row(alpha: float, fid: float, pen: float) -> dict:
+        s = {"fid": {"mean": fid}, "penetration": {"mean": pen}, "floating": {"mean": 0.0}, "sliding": {"mean": 0.0}}
+        return {"alpha": alpha, "method": "S", "sampler": "ddim", "summary": s}
+
+    rows = [row(0.01, 1.0, 9.0), row(0.1, 2.0, 2.0), row(1.0, 5.0, 1.0)]
+    assert select_alpha(rows, "fid")["alpha"] == 0.01
+    assert select_alpha(rows, "phys_err")["alpha"] == 1.0
+    assert select_alpha(rows, "balanced")["alpha"] == 0.1  # scaled (0+1)/2, (0.25+0.125)/2, (1+0)/2
+    assert select_alpha([], "balanced") is None
+
+
+def test_motion_stats_apex_and_drift() -> None:
+    s = motion_stats(jump(60, height=0.3, start=20))
+    assert s["apex_m"] == pytest.approx(0.3, abs=0.01) and abs(s["drift_x_m"]) < 1e-6
+    w = walk(41, speed=1.0)  # 2 s forward (+Z)
+    s = motion_stats(w)
+    assert s["drift_z_m"] == pytest.approx(2.0, abs=0.05) and abs(s["drift_x_m"]) < 0.05
+
+
+def test_table2_then_table1_best_alpha_reuse_and_resume(setup: dict[str, Path], monkeypatch: pytest.MonkeyPatch) -> None:
+    sim = EchoProjector()
+    t2 = run_experiment(write(setup, "table2", alphas=[0.1, 1.0]), projector=sim, progress=False, command=["simdiff", "t2"])
+    assert [r["alpha"] for r in t2["rows"]] == [0.1, 1.0]
+    assert t2["rows"][0]["summary"]["fid"]["mean"] != t2["rows"][1]["summary"]["fid"]["mean"]  # α reaches the model
+    best = t2["best_alpha"]["alpha"]
+    assert best in (0.1, 1.0) and (setup["root"] / "reports/table2/table2.png").is_file()
+
+    t1_path = write(setup, "table1", samplers=["ddpm", "ddim"], alphas=[0.1, "best"], reuse_rows_from=["table2"],
+                    ddpm_samples=3)
+    t1 = run_experiment(t1_path, projector=sim, progress=False, command=["simdiff", "t1"])
+    keys = [r["key"] for r in t1["rows"]]
+    expect = ["ground_truth", "MDM_ddpm", "MDM_ddim", "PhysDiff_ddpm", "PhysDiff_ddim", "SimDiff_ddpm_alpha0.1"]
+    if best == 1.0:
+        expect += ["SimDiff_ddpm_alpha1", "SimDiff_ddim_alpha0.1", "SimDiff_ddim_alpha1"]
+    else:
+        expect += ["SimDiff_ddim_alpha0.1"]
+    assert sorted(keys) == sorted(expect)
+    rows = {r["key"]: r for r in t1["rows"]}
+    # DDPM rows: physics + time on 3 motions (fewer than a batch); DDIM rows: the full protocol with MultiModality
+    assert rows["MDM_ddpm"]["measured"] == "subset" and rows["MDM_ddpm"]["samples"] == 3
+    assert set(rows["MDM_ddpm"]["physics"]) == {"penetration", "floating", "sliding", "skate_ratio"}
+    s = rows["PhysDiff_ddim"]["summary"]
+    assert {"r_precision_top1", "r_precision_top3", "fid", "mm_dist", "diversity", "multimodality", "skate_ratio"} <= set(s)
+    assert s["fid"]["n"] == 2 and rows["PhysDiff_ddim"]["samples_per_replication"] == 8
+    # SimDiff DDIM at 0.1 is table2's row, relabelled, not measured again
+    reused = rows["SimDiff_ddim_alpha0.1"]
+    assert reused["reused_from"].endswith("table2/rows/SimDiff_ddim_alpha0.1.json")
+    assert reused["summary"] == t2["rows"][0]["summary"] and reused["alpha_choice"].startswith("paper")
+    assert t1["best_alpha"]["alpha"] == best
+    # PhysDiff projected under Earth, 2 projections per batch: DDPM 1 batch of 3, DDIM 2 reps × (1 batch + 2 MM prompts)
+    assert {e for _, envs in sim.calls for e in envs} == {(-9.81, 0.0, 0.0)}
+    assert len(sim.calls) == 2 * 1 + 2 * 2 * (1 + 2)
+    md = (setup["root"] / "reports/table1/report.md").read_text()
+    for text in ("Table 1", "git commit", "seed: 0", "budget: **full**", str(setup["backbone"]), "PhysDiff", "MModality",
+                 "projection at t = 500, 0", "† physics metrics"):
+        assert text in md, text
+    report = json.loads((setup["root"] / "reports/table1/report.json").read_text())
+    assert report["paths"]["adapters_binary"] == str(setup["adapters_binary"]) and report["provenance"]["command"] == "simdiff t1"
+
+    # resume: nothing is measured again; a changed setting re-measures only the rows it affects
+    def boom(*args, **kwargs):
+        raise AssertionError("measured again")
+
+    monkeypatch.setattr(Runner, "protocol_measure", boom)
+    monkeypatch.setattr(Runner, "subset_measure", boom)
+    monkeypatch.setattr(Runner, "gt_measure", boom)
+    again = run_experiment(t1_path, projector=sim, progress=False)
+    assert [r["summary"] if "summary" in r else r["physics"] for r in again["rows"]] == \
+           [r["summary"] if "summary" in r else r["physics"] for r in t1["rows"]]
+    assert [p["state"] for p in plan_experiment(t1_path)] == ["cached"] * len(keys)
+    changed = [p for p in plan_experiment(t1_path, overrides=[("ddpm_samples", 2)]) if p["state"] == "measure"]
+    assert {p["key"] for p in changed} == {k for k in keys if "ddpm" in k}
+
+
+def test_fig4_times_every_method_and_sampler(setup: dict[str, Path]) -> None:
+    sim = EchoProjector()
+    report = run_experiment(write(setup, "fig4", samplers=["ddpm", "ddim"],
+                                  timing={"text": "a person jumps", "length": 24, "repeats": 3, "ddpm_repeats": 1, "warmup": 1}),
+                            projector=sim, progress=False)
+    cells = {(r["method"], r["sampler"]): r for r in report["rows"]}
+    assert set(cells) == {(m, s) for m in ("MDM", "PhysDiff", "SimDiff") for s in ("ddpm", "ddim")}
+    assert len(cells["MDM", "ddim"]["times_s"]) == 3 and len(cells["MDM", "ddpm"]["times_s"]) == 1
+    assert cells["PhysDiff", "ddim"]["projection_median_s"] is not None and cells["MDM", "ddim"]["projection_median_s"] is None
+    assert len(sim.calls) == 3 * 2 + 1 * 2 and sim.calls[0][0] == [25]  # batch 1, 24 rows → 25 joint frames
+    assert report["reference"]["method"] == "MDM" and report["reference"]["sampler"] == "ddim"
+    md = (setup["root"] / "reports/fig4/report.md").read_text()
+    assert "× reference" in md and (setup["root"] / "reports/fig4/fig4.png").is_file()
+
+
+def test_fig5_sweeps_combination_and_filmstrips(setup: dict[str, Path]) -> None:
+    control = {"prompts": ["a person jumps"], "seeds": 2, "length": 20, "gravity": [-1.0, -9.81], "wind": [0.0, 10.0],
+               "combos": [[-3.0, 7.0, 7.0]], "alpha": 1.0, "filmstrip_frames": 2}
+    report = run_experiment(write(setup, "fig5", env_control=control), progress=False)
+    envs = [(r["method"], r["factor"], tuple(r["env"]) if r["env"] else None) for r in report["rows"]]
+    assert envs == [("MDM", "reference", None), ("SimDiff", "gravity", (-1.0, 0.0, 0.0)), ("SimDiff", "gravity", (-9.81, 0.0, 0.0)),
+                    ("SimDiff", "wind_x", (-9.81, 10.0, 0.0)), ("SimDiff", "wind_y", (-9.81, 0.0, 10.0)),
+                    ("SimDiff", "gravity", (-3.0, 0.0, 0.0)), ("SimDiff", "wind_x", (-9.81, 7.0, 0.0)),
+                    ("SimDiff", "wind_y", (-9.81, 0.0, 7.0)), ("SimDiff", "combo", (-3.0, 7.0, 7.0))]
+    apex = [r["summary"]["apex_m"]["mean"] for r in report["rows"][1:]]
+    assert len(set(np.round(apex, 6))) > 1  # φ reaches the model
+    assert all(len(r["samples"]) == 2 for r in report["rows"])
+    out = setup["root"] / "reports/fig5"
+    for name in ("fig5.png", "fig5_combination.png", "fig5_strip_gravity.png", "fig5_strip_wind.png", "fig5_strip_combo0.png"):
+        assert (out / name).is_file(), name
+    md = (out / "report.md").read_text()
+    assert "Unseen combination φ = (-3, 7, 7)" in md and "| apex_m |" in md
+
+
+def test_retrack_reports_tracked_fraction_per_method_and_env(setup: dict[str, Path]) -> None:
+    sim = EchoProjector(fail_every=2)
+    report = run_experiment(write(setup, "retrack", envs=[[-3.0, 0.0, 0.0]], retrack_samples=4), projector=sim, progress=False)
+    rows = {r["method"]: r for r in report["rows"]}
+    assert set(rows) == {"Ground truth", "MDM", "PhysDiff", "SimDiff"}
+    for r in rows.values():
+        assert r["n"] == 4 and r["tracked"] == 2 and r["tracked_fraction"] == 0.5 and r["d_l2_mean"] == pytest.approx(1.5)
+    # every re-tracking call and every PhysDiff projection ran under the row's φ
+    assert {e for _, envs in sim.calls for e in envs} == {(-3.0, 0.0, 0.0)}
+    assert (setup["root"] / "reports/retrack/retrack.png").is_file()
+
+
+def test_run_all_only_and_missing_model(setup: dict[str, Path], tmp_path: Path) -> None:
+    configs = tmp_path / "configs"
+    configs.mkdir()
+    mdm = [{"name": "MDM", "model": "backbone", **FAST}]
+    for kind in ("table2", "fig4"):
+        path = write(setup, kind, name=f"all_{kind}", alphas=[1.0], models=None if kind == "table2" else mdm,
+                     timing={"length": 16, "repeats": 1, "ddpm_repeats": 1})
+        (configs / f"eval_{kind}.json").write_text(path.read_text())
+    logs: list[str] = []
+    reports = run_all(configs, only=["fig4", "table2"], overrides=[("samplers", ["ddim"])], projector=EchoProjector(),
+                      progress=False, log=logs.append)
+    assert [r["kind"] for r in reports] == ["table2", "fig4"]  # dependency order, not the order asked
+    assert "estimated" in logs[0] and len(logs) == 4
+    with pytest.raises(SimdiffError, match="unknown experiment 'fig9'"):
+        run_all(configs, only=["fig9"])
+    with pytest.raises(SimdiffError, match=r"no model.safetensors \(set it with --backbone DIR\)"):
+        run_experiment(write(setup, "fig4", name="missing"), overrides=[("paths.backbone", str(tmp_path / "none"))],
+                       projector=EchoProjector(), progress=False)
+
+
+def test_cli_dry_run_and_one_line_errors(setup: dict[str, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    from simdiff.cli.main import main
+
+    path = write(setup, "table2", name="cli_table2", alphas=[0.2])
+    assert main(["evaluate", "run", str(path), "--dry-run", "--set", "protocol.replications=4"]) == 0
+    out = capsys.readouterr().out
+    assert "SimDiff_ddim_alpha0.2" in out and "measure" in out and "estimated" in out
+    assert main(["evaluate", "run", str(path), "--set", "protocol.replications"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("simdiff: error:") and "KEY=VALUE" in err and "\n" not in err
+    assert main(["evaluate", "run", str(CONFIGS / "eval_table1.json"), "--budget", "quick", "--corpus", str(setup["corpus"]),
+                 "--evaluator", str(setup["evaluator"]), "--backbone", str(setup["root"] / "nowhere"),
+                 "--out-dir", str(setup["root"] / "cli_reports")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("simdiff: error: model folder") and "--backbone DIR" in err and err.count("\n") == 1
+    assert main(["evaluate", "run", str(CONFIGS / "eval_table1.json"), "--corpus", str(setup["root"] / "no_corpus"),
+                 "--out-dir", str(setup["root"] / "cli_reports")]) == 2
+    assert "--corpus DIR" in capsys.readouterr().err
+
+
+def test_table1_uses_the_best_alpha_known_when_it_started(setup: dict[str, Path], tmp_path: Path) -> None:
+    from simdiff.eval.experiments import table1
+
+    config = load_config(write(setup, "table1", name="t1_best", alphas=[0.1, "best"]), None,
+                         [("out_dir", str(tmp_path)), ("samplers", ["ddim"])])
+    runner = Runner(config, progress=False)
+    keys = [p.key for p in table1.plan(runner)]
+    assert keys == ["ground_truth", "MDM_ddim", "PhysDiff_ddim", "SimDiff_ddim_alpha0.1"]
+    (tmp_path / "table2").mkdir()
+    (tmp_path / "table2" / "report.json").write_text(json.dumps({"best_alpha": {"alpha": 0.5, "select_by": "balanced"}}))
+    value, source = table1.best_alpha(runner)  # the report appeared mid-run: this run keeps what it planned with
+    assert value is None and "run table2 first" in source
+    assert [p.key for p in table1.plan(Runner(config, progress=False))][-1] == "SimDiff_ddim_alpha0.5"

@@ -1,0 +1,121 @@
+"""``simdiff generate`` end to end on a tiny saved model (real MiniLM text encoder), and its one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from simdiff.cli.main import main
+from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network
+
+
+@pytest.fixture(autouse=True)
+def restore_threads():
+    threads = torch.get_num_threads()
+    yield
+    torch.set_num_threads(threads)
+
+
+def save_tiny(folder: Path, sim: bool = True) -> Path:
+    torch.manual_seed(0)
+    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig() if sim else None)
+    MotionGenerator(build_network(config), config, std=torch.full((263,), 0.05)).save(folder)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def tiny_model(tmp_path_factory) -> Path:
+    return save_tiny(tmp_path_factory.mktemp("tiny_sim"))
+
+
+def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
+    (tiny_model / "sampling.json").write_text('{"alpha": 0.5}')
+    try:
+        code = main(["generate", "a person jumps forward", "--gravity", "-3.7", "--wind", "2", "0", "--frames", "10",
+                     "--steps", "2", "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1",
+                     "--format", "npy,bvh,gif", "-q"])
+    finally:
+        (tiny_model / "sampling.json").unlink()
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert captured.err == ""  # quiet: no bars, no notes
+    printed = captured.out.split()
+    assert [Path(p).name for p in printed] == ["sample0.bvh", "sample0.gif", "sample0_features.npy",
+                                               "sample0_joints.npy", "generation.json"]
+    assert all(Path(p).is_file() for p in printed)
+    assert np.load(tmp_path / "o" / "sample0_joints.npy").shape == (10, 22, 3)
+    meta = json.loads((tmp_path / "o" / "generation.json").read_text())
+    assert (meta["alpha"], meta["alpha_source"], meta["steps"], meta["frames"]) == (0.5, "sampling.json", 2, 10)
+    assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
+
+
+def test_backbone_model_warns_once_and_ignores_phi(tmp_path: Path, capsys) -> None:
+    model = save_tiny(tmp_path / "bb", sim=False)
+    code = main(["generate", "a person walks", "--gravity", "-1.6", "--compare", "gravity=-9.81,-1.6", "--frames", "6",
+                 "--steps", "1", "--model", str(model), "--out", str(tmp_path / "o"), "--no-video", "--threads", "1",
+                 "-q"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 0
+    assert len(err) == 1 and err[0].startswith("simdiff: warning:") and "--gravity, --compare ignored" in err[0]
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == [
+        "generation.json", "sample0.bvh", "sample0_features.npy", "sample0_joints.npy"]
+
+
+def test_default_output_folder_is_named_after_the_prompt(tiny_model: Path, tmp_path: Path, monkeypatch, capsys) -> None:
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SIMDIFF_MODEL", str(tiny_model))
+    assert main(["generate", "A person: waves!", "--frames", "4", "--steps", "1", "--format", "npy", "--threads", "1",
+                 "-q"]) == 0
+    assert (tmp_path / "out" / "a_person_waves" / "sample0_joints.npy").is_file()
+    assert main(["generate", "A person waves", "--frames", "4", "--steps", "1", "--format", "npy", "--threads", "1",
+                 "-q"]) == 0  # a second run never overwrites the first
+    assert (tmp_path / "out" / "a_person_waves-2" / "generation.json").is_file()
+    assert capsys.readouterr().out.split()[-1] == "out/a_person_waves-2/generation.json"
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["   "], "text prompt is empty"),
+    (["walk", "--length", "12"], "--length 12 s is 240 frames"),
+    (["walk", "--gravity", "0"], "gravity must be negative"),
+    (["walk", "--gravity", "nan"], "--gravity must be a finite number, got nan"),
+    (["walk", "--wind", "12", "0"], "12 N exceeds"),
+    (["walk", "--steps", "0"], "--steps must be 1..1000, got 0"),
+    (["walk", "--guidance", "nan"], "--guidance must be a finite number"),
+    (["walk", "--compare", "gravity:-1,-2"], "bad --compare 'gravity:-1,-2'"),
+    (["walk", "--model", "{tmp}/nowhere"], "nowhere/config.json: model file not found"),
+    (["walk", "--model", "{tmp}/corrupt"], "corrupt: cannot load model"),
+])
+def test_bad_input_one_line_exit_2(tmp_path: Path, argv: list[str], needle: str, capsys) -> None:
+    corrupt = save_tiny(tmp_path / "corrupt")
+    (corrupt / "model.safetensors").write_bytes(b"not a safetensors file")
+    argv = [a.format(tmp=tmp_path) for a in argv]
+    code = main(["generate", *argv, "--out", str(tmp_path / "o"), "-q"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and err[0].startswith("simdiff: error:") and needle in err[0], err
+
+
+def test_missing_shipped_model_message(tmp_path: Path, monkeypatch) -> None:
+    from simdiff.model import default
+
+    monkeypatch.delenv("SIMDIFF_MODEL", raising=False)
+    monkeypatch.setattr(default, "DEFAULT_MODEL_DIR", tmp_path / "default_model")
+    from simdiff.errors import SimdiffError
+
+    with pytest.raises(SimdiffError, match="no default model installed .*pass --model DIR or set SIMDIFF_MODEL"):
+        default.check_model_dir()
+
+
+def test_help_lists_every_option() -> None:
+    proc = subprocess.run([sys.executable, "-m", "simdiff", "generate", "--help"], capture_output=True, text=True)
+    assert proc.returncode == 0
+    for option in ("--gravity", "--wind", "--length", "--frames", "--seed", "--num-samples", "--sampler", "--steps",
+                   "--guidance", "--alpha", "--out", "--model", "--force", "--format", "--compare", "--no-video",
+                   "--quiet", "--threads", "generation.json"):
+        assert option in proc.stdout, option
