@@ -7,6 +7,8 @@ import json
 import os
 from pathlib import Path
 
+from simdiff.cli.options import add_environment_options
+
 from simdiff.errors import SimdiffError
 
 
@@ -26,9 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     p.add_argument("files", nargs="+", type=Path, metavar="FILE", help="motion files")
-    p.add_argument("--gravity", type=float, default=-9.81, help="vertical gravity g_z in m/s² (default -9.81)")
-    p.add_argument("--wind", type=float, nargs=2, default=(0.0, 0.0), metavar=("X", "Y"),
-                   help="wind force in N along HumanML3D +X (left) and +Z (forward) (default 0 0)")
+    add_environment_options(p)
     p.add_argument("--residual", type=float, default=0.5, metavar="R",
                    help="tracking: root residual bound as a fraction of m·g; 0 = strict (default 0.5)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR",

@@ -8,6 +8,8 @@ import math
 import os
 from pathlib import Path
 
+from simdiff.cli.options import add_environment_options
+
 from simdiff.errors import SimdiffError
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -22,9 +24,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     p.add_argument("files", nargs="+", type=Path, metavar="FILE", help="motion files")
-    p.add_argument("--gravity", type=float, default=-9.81, help="vertical gravity g_z in m/s² (default -9.81)")
-    p.add_argument("--wind", type=float, nargs=2, default=(0.0, 0.0), metavar=("X", "Y"),
-                   help="wind force in N along HumanML3D +X (left) and +Z (forward) (default 0 0)")
+    add_environment_options(p)
     p.add_argument("--residual", type=float, default=0.5, metavar="R",
                    help="root residual bound as a fraction of m·g (torque bound 600·R N·m); 0 = strict (default 0.5)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="write each rollout as DIR/<name>.npy joints")
