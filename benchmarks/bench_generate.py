@@ -55,8 +55,8 @@ def random_model(folder: Path, preset: str) -> Path:
 
 def command(model: Path, out: Path, threads: int, length: float, no_video: bool) -> list[str]:
     cmd = [sys.executable, "-m", "simdiff", "generate", README_TEXT, *README_ENV, "--model", str(model),
-           "--out", str(out), "--threads", str(threads), "--length", f"{length:g}", "-q"]
-    return cmd + (["--no-video"] if no_video else [])
+           "--out", str(out), "--length", f"{length:g}", "-q"]
+    return cmd + (["--threads", str(threads)] if threads else []) + (["--no-video"] if no_video else [])
 
 
 def timed_run(cmd: list[str], out: Path) -> dict:
@@ -74,7 +74,8 @@ def timed_run(cmd: list[str], out: Path) -> dict:
     stages_cpu = {k: v for k, v in meta["cpu_s"].items() if k != "total"}
     stages_wall["startup"] = round(wall - sum(stages_wall.values()), 3)
     stages_cpu["startup"] = round(cpu - sum(stages_cpu.values()), 3)
-    return {"wall_s": round(wall, 3), "cpu_s": round(cpu, 3), "stages_wall_s": stages_wall, "stages_cpu_s": stages_cpu,
+    return {"wall_s": round(wall, 3), "cpu_s": round(cpu, 3), "threads": meta.get("threads"),
+            "stages_wall_s": stages_wall, "stages_cpu_s": stages_cpu,
             "files": sorted(p.name for p in out.iterdir())}
 
 
@@ -143,7 +144,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--model", type=Path, help="model folder (default: shipped model, else a random --preset one)")
     parser.add_argument("--preset", default="small", help="backbone size of the random model (default small)")
-    parser.add_argument("--threads", type=int, default=2, help="torch CPU threads in the command (default 2)")
+    parser.add_argument("--threads", type=int, default=2,
+                        help="torch CPU threads in the command (default 2; 0 = the command's own default)")
     parser.add_argument("--length", type=float, default=6.0, help="motion length in seconds (default 6)")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs (default 3)")
     parser.add_argument("--no-video", action="store_true", help="skip the GIF")
@@ -176,12 +178,14 @@ def main() -> None:
     summary = summarise(runs)
     result = {
         "benchmark": "bench_generate",
-        "command": " ".join(["simdiff", "generate", repr(README_TEXT), *README_ENV, "--length", f"{args.length:g}",
-                             "--threads", str(args.threads)] + (["--no-video"] if args.no_video else [])),
+        "command": " ".join(["simdiff", "generate", repr(README_TEXT), *README_ENV, "--length", f"{args.length:g}"]
+                            + (["--threads", str(args.threads)] if args.threads else [])
+                            + (["--no-video"] if args.no_video else [])),
         "model": {"kind": kind, "path": str(model), "latent_dim": config["backbone"]["latent_dim"],
                   "num_layers": config["backbone"]["num_layers"], "simdiff": config["sim"] is not None},
         "sampler": "ddim-50, guidance 2.5 (batched CFG)",
-        "threads": args.threads,
+        "threads": args.threads or "default (idle cores)",
+        "threads_used": runs[0]["threads"],
         "machine": {"cpus": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version(),
                     "loadavg_1min_before_after": [round(load_before[0], 2), round(load_after[0], 2)]},
         "target_s": TARGET_S,

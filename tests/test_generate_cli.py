@@ -53,6 +53,7 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
     assert (meta["alpha"], meta["alpha_source"], meta["steps"], meta["frames"]) == (0.5, "sampling.json", 2, 10)
     assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
+    assert meta["threads"] == 1
 
 
 def test_backbone_model_warns_once_and_ignores_phi(tmp_path: Path, capsys) -> None:

@@ -118,3 +118,12 @@ def test_validation_errors_do_not_import_torch() -> None:
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.strip().splitlines() == [
         'simdiff: error: the text prompt is empty; describe the motion, e.g. "a person jumps forward"']
+
+
+@pytest.mark.parametrize("cpus, load, torch_default, expected", [
+    (2, 0.1, 2, 2), (2, 1.0, 2, 1), (2, 7.5, 2, 1), (16, 3.2, 8, 8), (16, 12.0, 8, 4), (4, 0.0, 2, 2),
+])
+def test_default_threads_follow_idle_cores(cpus: int, load: float, torch_default: int, expected: int) -> None:
+    from simdiff.product.threads import default_threads
+
+    assert default_threads(torch_default, cpus=cpus, load=load) == expected

@@ -176,6 +176,12 @@ def write_outputs(samples: list[Sample], request: GenerationRequest, out_dir: Pa
     return files, videos
 
 
+def _torch_threads() -> int:
+    import torch
+
+    return int(torch.get_num_threads())
+
+
 def _env_dict(env: Environment) -> dict:
     return {"gravity": env.gravity, "wind": [env.wind_x, env.wind_y]}
 
@@ -216,6 +222,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",
         "samples": records,
         "videos": [p.name for p in videos],
+        "threads": _torch_threads(),
         "timings_s": timer.rounded(timer.wall),
         "cpu_s": timer.rounded(timer.cpu),
     }

@@ -70,7 +70,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                       help="model folder with model.safetensors + config.json (default $SIMDIFF_MODEL, else the "
                            "shipped model)")
     run_.add_argument("--device", default="cpu", help="torch device, e.g. cpu or cuda (default cpu)")
-    run_.add_argument("--threads", type=int, metavar="N", help="CPU threads for torch (default: torch's choice)")
+    run_.add_argument("--threads", type=int, metavar="N",
+                      help="CPU threads for torch (default: the idle cores, from the load average)")
     p.set_defaults(func=run)
 
 
@@ -123,8 +124,9 @@ def run(args: argparse.Namespace) -> int:
         device = torch.device(args.device)
     except (RuntimeError, ValueError):
         raise SimdiffError(f"unknown --device {args.device!r}; use cpu or cuda") from None
-    if args.threads is not None:
-        torch.set_num_threads(args.threads)
+    from simdiff.product.threads import default_threads
+
+    torch.set_num_threads(args.threads if args.threads is not None else default_threads(torch.get_num_threads()))
     timer = Timer()
     _note(args, f"loading model {folder}")
     with timer.stage("load_model"):
