@@ -112,7 +112,10 @@ def reference_residual(joints: np.ndarray, env: Environment = Environment(), *, 
         joints: (T, 22, 3) HumanML3D joints, metres, Y-up, 20 fps (T ≥ 4).
         env: φ; gravity and wind enter the inverse dynamics (validated by the caller).
         model: the humanoid (default :func:`simdiff.sim.humanoid.load_model`); not modified.
-        retarget: :class:`simdiff.sim.convert.RetargetConfig` (default config).
+        retarget: :class:`simdiff.sim.convert.RetargetConfig`; default: the standard config
+            without support inference (``support_accel=0``), so that a foot hovering near
+            the floor is judged as the motion has it, not pulled down as the tracker's
+            reference repair would.
     Returns:
         (summary, series). Summary keys: ``force_mean_mg``, ``force_p90_mg``,
         ``force_peak_mg`` (fraction of m·|g_z|), ``torque_mean_nm``, ``torque_p90_nm``,
@@ -128,7 +131,7 @@ def reference_residual(joints: np.ndarray, env: Environment = Environment(), *, 
     m = copy.copy(base)  # the cached model stays at Earth gravity
     mass = model_index(m).mass
     env.apply(m, mass)
-    ref = make_reference(m, np.asarray(joints, dtype=np.float64), retarget or RetargetConfig())
+    ref = make_reference(m, np.asarray(joints, dtype=np.float64), retarget or RetargetConfig(support_accel=0.0))
     g = abs(env.gravity)
     force = np.linalg.norm(ref.root_residual[:, :3], axis=1) / (mass * g)
     torque = np.linalg.norm(ref.root_residual[:, 3:], axis=1)

@@ -56,6 +56,14 @@ class RetargetConfig:
         smooth_sigma: Gaussian filter σ in input frames (0 = off).
         stance_pass: run the second, stance-holding IK pass.
         friction: friction coefficient of the pyramid in the ID screen.
+        support_accel: infer support where the schedule has none: at frames whose COM
+            vertical acceleration is above ``-support_accel·g`` (the body is not falling
+            freely, so something holds it up) the lowest foot box is put in contact and
+            pulled to the floor by the stance pass (0 = off). It recovers the toe push of a
+            jump's take-off and the relevé of a dancer whose retargeted foot floats.
+        support_reach: ... if that box's sole is within this height (m) of the floor.
+        contact_spread: ridge weight that spreads the ID screen's contact forces over all
+            touching corners (see :func:`inverse_dynamics_screen`; 0: plain NNLS).
         spike_distance: isolated joint samples this far (m) from their neighbours are
             mocap glitches and get replaced (0 = off).
     """
@@ -71,6 +79,9 @@ class RetargetConfig:
     smooth_sigma: float = 1.0
     stance_pass: bool = True
     friction: float = 0.8
+    contact_spread: float = 1e-3
+    support_accel: float = 0.5
+    support_reach: float = 0.15
     spike_distance: float = 0.25
 
 
@@ -363,6 +374,37 @@ def contact_schedule(height: np.ndarray, xy: np.ndarray, fps: float, cfg: Retarg
     return c
 
 
+def infer_support(contact: np.ndarray, height: np.ndarray, xy: np.ndarray, com_z: np.ndarray, fps: float,
+                  accel: float, reach: float, max_speed: float = 0.6, gravity: float = 9.81) -> np.ndarray:
+    """(T, 4) bool: foot boxes that must carry the body although the schedule has none down.
+
+    A frame is *supported* when the smoothed COM vertical acceleration exceeds
+    ``-accel·gravity`` (m/s²): a body in free fall accelerates at -g, so anything clearly
+    above that needs a floor force. At supported frames without any scheduled contact, the
+    lowest box is added if its sole is below ``reach`` (m) and it moves slower than
+    ``max_speed`` (m/s, horizontal; a sliding foot is not a support). Contacts are only
+    added, never removed.
+
+    Args:
+        contact: (T, 4) schedule from heights; height: (T, 4) sole heights (m);
+        xy: (T, 4, 2) box centres (m); com_z: (T,) COM height (m); fps: frame rate.
+    """
+    if accel <= 0 or len(com_z) < 5:
+        return np.zeros_like(contact)
+    from scipy.signal import savgol_filter
+
+    # quadratic fits over 5 frames (0.25 s at 20 fps), also at the ends: exact for free fall
+    az = savgol_filter(com_z, 5, 2, deriv=2, delta=1.0 / fps, mode="interp")
+    need = (az > -accel * gravity) & ~contact.any(axis=1)
+    low = height.argmin(axis=1)
+    idx = np.arange(len(low))
+    speed = np.linalg.norm(np.gradient(xy, axis=0) * fps, axis=-1)[idx, low]
+    out = np.zeros_like(contact)
+    rows = np.flatnonzero(need & (height[idx, low] < reach) & (speed < max_speed))
+    out[rows, low[rows]] = True
+    return out
+
+
 def ground_level(height: np.ndarray, xy: np.ndarray, fps: float, still_speed: float = 0.3) -> float:
     """Floor height (m) of a motion from its foot-box sole heights (T, 4) and centres (T, 4, 2).
 
@@ -380,6 +422,21 @@ def ground_level(height: np.ndarray, xy: np.ndarray, fps: float, still_speed: fl
     return float(np.percentile(low, 10))
 
 
+def _com_height(model, qpos: np.ndarray) -> np.ndarray:
+    """(T,) whole-body COM height (m) of each pose."""
+    import mujoco
+
+    d = mujoco.MjData(model)
+    pelvis = model_index(model).pelvis
+    out = np.zeros(qpos.shape[0])
+    for t in range(qpos.shape[0]):
+        d.qpos[:] = qpos[t]
+        mujoco.mj_kinematics(model, d)
+        mujoco.mj_comPos(model, d)
+        out[t] = d.subtree_com[pelvis, 2]
+    return out
+
+
 def _intervals(mask: np.ndarray) -> list[tuple[int, int]]:
     """Half-open [start, end) runs of True."""
     out, start = [], None
@@ -395,13 +452,15 @@ def _intervals(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 20.0,
-                  max_tilt: float = np.deg2rad(12.0)) -> list[list[_Task]]:
+                  max_tilt: float = np.deg2rad(12.0), reach: np.ndarray | None = None) -> list[list[_Task]]:
     """Per-frame tasks that hold each touching foot box flat, on the floor, at a fixed xy.
 
     Only frames where the box is nearly flat already (tilt below ``max_tilt``) are held: a
     heel rising at toe-off or a toe coming down at heel strike keeps its own pitch (forcing
     it flat would pull the whole body out of shape). The hold's weight ramps over the first
-    and last 2 frames of an interval.
+    and last 2 frames of an interval. Boxes marked in ``reach`` (T, 4) (inferred support, see
+    :func:`infer_support`) get a position task that lowers them, tilt kept, until their lowest
+    corner touches the floor.
     """
     import mujoco
 
@@ -434,6 +493,13 @@ def _stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 
             for t in range(s, e):  # ramp in and out over 2 frames: no jump when a hold starts
                 ramp = min(1.0, (t - s + 1) / 2, (e - t) / 2)
                 tasks[t].append(_Task(b, p, R, weight * ramp))
+    if reach is not None:
+        for k, (b, g) in enumerate(zip(bodies, geoms)):
+            for t in np.flatnonzero(reach[:, k]):
+                d.qpos[:] = qpos[t]
+                mujoco.mj_kinematics(model, d)
+                drop = _box_bottom_corners(model, d, g)[:, 2].min()
+                tasks[t].append(_Task(b, d.xpos[b] - np.array([0.0, 0.0, drop]), None, weight))
     return tasks
 
 
@@ -447,7 +513,10 @@ def _despike(joints: np.ndarray, distance: float) -> np.ndarray:
 
     A joint sample farther than ``distance`` (m) from the median of its ±2-frame
     neighbourhood (itself excluded) while those neighbours agree with each other is an
-    outlier; it becomes the mean of the adjacent samples (or the nearest one at the ends).
+    outlier; it becomes the mean of the adjacent samples. The first and last frames have
+    neighbours on one side only: they are compared with the linear extrapolation of the
+    next two frames (which must themselves lie on a line with the third) and replaced by it,
+    so that a fast motion's first frame is not mistaken for a glitch and is not frozen.
     """
     T = joints.shape[0]
     if distance <= 0 or T < 5:
@@ -458,14 +527,15 @@ def _despike(joints: np.ndarray, distance: float) -> np.ndarray:
     med = np.median(nb, axis=0)
     far = np.linalg.norm(joints - med, axis=-1) > distance
     spread = np.linalg.norm(nb - med, axis=-1).max(0) < distance
-    for t, j in zip(*np.nonzero(far & spread)):
-        lo, hi = t - 1, t + 1
-        if lo < 0:
-            out[t, j] = joints[hi, j]
-        elif hi >= T:
-            out[t, j] = joints[lo, j]
-        else:
-            out[t, j] = 0.5 * (joints[lo, j] + joints[hi, j])
+    bad = far & spread
+    for t, a, b, c in ((0, 1, 2, 3), (T - 1, T - 2, T - 3, T - 4)):
+        pred = 2 * joints[a] - joints[b]
+        line = np.linalg.norm(joints[a] - (2 * joints[b] - joints[c]), axis=-1) < distance
+        bad[t] = (np.linalg.norm(joints[t] - pred, axis=-1) > distance) & line
+        out[t, bad[t]] = pred[bad[t]]
+    for t, j in zip(*np.nonzero(bad[1:-1])):
+        t += 1
+        out[t, j] = 0.5 * (joints[t - 1, j] + joints[t + 1, j])
     return out
 
 
@@ -528,7 +598,7 @@ def finite_velocity(model, qpos: np.ndarray, dt: float) -> np.ndarray:
 
 
 def inverse_dynamics_screen(model, qpos: np.ndarray, qvel: np.ndarray, qacc: np.ndarray, contact: np.ndarray,
-                            friction: float = 0.8) -> tuple[np.ndarray, np.ndarray]:
+                            friction: float = 0.8, spread: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Root residual wrench and joint feed-forward torques of a reference.
 
     At each frame the generalised force of the motion without contacts (``mj_inverse`` with
@@ -539,6 +609,9 @@ def inverse_dynamics_screen(model, qpos: np.ndarray, qvel: np.ndarray, qacc: np.
     Args:
         qpos, qvel, qacc: (K, nq/nv) reference.
         contact: (K, 4) touching foot boxes (L foot, L toe, R foot, R toe).
+        spread: weight of a ridge term ``spread·||f||²`` (f in N) added to the NNLS, which
+            spreads the load over every touching corner instead of the sparse split plain
+            NNLS returns (one foot carrying the body while the other carries nothing).
     Returns:
         root_residual (K, 6): force (N, world) and torque (N·m, pelvis frame) rows;
         tau_ff (K, 69): hinge torques (N·m) after subtracting the contact forces.
@@ -572,7 +645,11 @@ def inverse_dynamics_screen(model, qpos: np.ndarray, qvel: np.ndarray, qacc: np.
             if cols:
                 A = np.concatenate(cols, 1)
                 scale = np.array([1, 1, 1, 3, 3, 3], dtype=float)  # weigh torques (per 0.33 m)
-                f, _ = nnls(A[:6] * scale[:, None], b[:6] * scale, maxiter=200)
+                M, rhs = A[:6] * scale[:, None], b[:6] * scale
+                if spread > 0:
+                    M = np.vstack([M, np.sqrt(spread) * np.eye(A.shape[1])])
+                    rhs = np.concatenate([rhs, np.zeros(A.shape[1])])
+                f, _ = nnls(M, rhs, maxiter=200)
                 gen = A @ f
             else:
                 gen = np.zeros(m.nv)
@@ -588,12 +665,16 @@ def inverse_dynamics_screen(model, qpos: np.ndarray, qvel: np.ndarray, qacc: np.
 # --------------------------------------------------------------------------------------
 
 
-def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConfig()) -> Reference:
+def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConfig(),
+                   gravity: float | None = None) -> Reference:
     """HumanML3D joints → a tracking reference at the control rate.
 
     Args:
         model: the humanoid (:func:`simdiff.sim.humanoid.load_model`).
         joints: (T, 22, 3) HumanML3D joints, metres, Y-up, ``cfg.fps`` frames per second.
+        gravity: vertical gravity (m/s², negative) under which the inverse-dynamics screen and
+            the feed-forward torques are computed; None: the model's own ``opt.gravity``.
+            The tracker is told g_z (it plans with the world's gravity), not the wind.
     Returns:
         A :class:`Reference` (world frame, Z-up).
     Raises:
@@ -619,10 +700,15 @@ def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConf
     q1[:, 2] += shift
     h += shift
     contact = contact_schedule(h, xy, fps, cfg)
+    reach = None
+    if cfg.support_accel > 0:
+        reach = infer_support(contact, h, xy, _com_height(model, q1), fps, cfg.support_accel, cfg.support_reach,
+                              cfg.contact_speed)
+        contact = contact | reach
     q = q1
     # 3. stance pass
     if cfg.stance_pass and contact.any():
-        tasks = _stance_tasks(model, q1, contact)
+        tasks = _stance_tasks(model, q1, contact, reach=reach)
         q, err = ik_sequence(model, target + np.array([0.0, 0.0, shift]), cfg, tasks=tasks, init=q1)
     # 4. smoothing (before any cropping; odd-reflection keeps the boundary velocity)
     qs = q.copy()
@@ -652,7 +738,13 @@ def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConf
         body[t] = d.xpos[ix.hml_bodies]
     com_vel = np.gradient(com, dt, axis=0) if K > 1 else np.zeros_like(com)
     # 6. ID screen
-    res, tau = inverse_dynamics_screen(model, qpos, qvel, qacc, contact_k, cfg.friction)
+    saved = model.opt.gravity.copy()
+    if gravity is not None:
+        model.opt.gravity[:] = (0.0, 0.0, gravity)
+    try:
+        res, tau = inverse_dynamics_screen(model, qpos, qvel, qacc, contact_k, cfg.friction, cfg.contact_spread)
+    finally:
+        model.opt.gravity[:] = saved
     del t_in
     return Reference(
         qpos=qpos, qvel=qvel, qacc=qacc, contact=contact_k, com=com, com_vel=com_vel, body_pos=body,

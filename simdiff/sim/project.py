@@ -34,7 +34,8 @@ class ProjectionInfo:
         err_mm: mean joint position error (mm, world, over the returned frames).
         err_local_mm: same after removing the horizontal root offset per frame.
         residual: mean/peak residual force (fraction of m·g) and torque (N·m), airborne share.
-        feasibility: ID screen of the reference (root residual it needs, fraction of m·g).
+        feasibility: ID screen of the reference under φ's g_z (root residual it needs,
+            fraction of m·|g_z|).
         cpu_s: CPU seconds (retarget + rollout + metrics); sim_cpu_s: rollout only.
         duration_s: motion length (s); env: (g_z, w_x, w_y).
         violations: physics-invariant violations (only when audited).
@@ -123,7 +124,7 @@ def project(
     env.validate(force=force)
     model = model if model is not None else load_model(HumanoidConfig())
     joints = np.asarray(joints, dtype=np.float64)
-    ref = make_reference(model, joints, retarget)
+    ref = make_reference(model, joints, retarget, gravity=env.gravity)
     res = rollout(model, ref, env, tracker, residual, fall, audit=audit)
     out = rollout_joints(model, res, joints.shape[0], retarget.fps)
     ref_j = joints[: len(out)] + np.array([0.0, ref.ground_shift, 0.0])
@@ -137,7 +138,7 @@ def project(
     info = ProjectionInfo(
         success=res.success, status=res.status, fall_frame=fall_frame, n_frames=int(joints.shape[0]),
         n_out=int(len(out)), d_l2=dl2, err_mm=err, err_local_mm=err_local, residual=res.residual_stats(),
-        feasibility=ref.feasibility(ix.mass, 9.81), cpu_s=time.process_time() - t0, sim_cpu_s=res.cpu_s,
+        feasibility=ref.feasibility(ix.mass, env.gravity), cpu_s=time.process_time() - t0, sim_cpu_s=res.cpu_s,
         duration_s=ref.duration, env=env.as_tuple(), violations=res.violations,
     )
     return out, info

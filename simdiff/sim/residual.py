@@ -47,6 +47,8 @@ class ResidualConfig:
             it is never raised. A foot that the simulation lays flat where the mocap had it
             tilted on an edge lowers the body, and the residual must not hold it up at the
             mocap height (measured: the dancers' residual halves). 0: absolute height.
+        z_deadband: the vertical position term acts on the sag beyond this (m): heights
+            within it are the legs' business (0: off).
     """
 
     max_force: float = 0.5
@@ -58,6 +60,7 @@ class ResidualConfig:
     kd_rot: float = 150.0
     ref_window: int = 2
     support_shift_max: float = 0.05
+    z_deadband: float = 0.0
 
     @property
     def torque_bound(self) -> float:
@@ -135,7 +138,9 @@ class RootResidual:
             ankle_ref = (1 - a) * self.ref_ankle_z[k] + a * self.ref_ankle_z[k1]
             shift = data.xpos[self.ankles, 2].min() - ankle_ref
             z_ref += float(np.clip(shift, -c.support_shift_max, 0.0))
-        f[2] = max(0.0, self.mass * (c.kp_z * (z_ref - com[2]) + c.kd_z * (vel_ref[2] - vel[2])))
+        sag = z_ref - com[2]
+        sag = float(np.sign(sag) * max(abs(sag) - c.z_deadband, 0.0))
+        f[2] = max(0.0, self.mass * (c.kp_z * sag + c.kd_z * (vel_ref[2] - vel[2])))
         n = np.linalg.norm(f)
         if n > self.fmax:
             f *= self.fmax / max(n, 1e-12)

@@ -5,7 +5,7 @@ steps per control step). Each physics step is ``mj_step1`` (positions, contacts)
 wrench from the current contacts, ``mj_step2`` (forces, integration).
 
 Failure: a fall (head below ``head_ratio`` of the reference head height, or the mean joint
-error after removing the horizontal COM offset above ``max_error`` m), or MuJoCo
+error after removing the COM offset above ``max_error`` m), or MuJoCo
 instability (a warning or a non-finite state), in which case the rollout is marked failed
 and must not be used as data.
 
@@ -39,12 +39,17 @@ class FallConfig:
     Attributes:
         head_ratio: fall when head height < head_ratio × reference head height ...
         min_ref_head: ... and the reference head is above this (m) (lying motions excepted).
-        max_error: fall when the mean joint error, horizontal COM offset removed, exceeds this (m).
+        max_error: fall when the mean joint error, COM offset removed, exceeds this (m).
+        pose_only: remove the whole COM offset (also the vertical one) before that test, so
+            that it judges the pose; a body that flies lower or higher than the reference
+            (a weaker take-off, another gravity) is not a fall, a collapse still fails the
+            head test. False: remove the horizontal offset only.
     """
 
     head_ratio: float = 0.5
     min_ref_head: float = 0.6
     max_error: float = 0.35
+    pose_only: bool = True
 
 
 def _default_variants() -> tuple[PDTrackerConfig, ...]:
@@ -226,7 +231,8 @@ def rollout(
             status, fall_time = "fell", d.time
         else:
             off = d.subtree_com[p] - reference.com[kk]
-            off[2] = 0.0
+            if not fall.pose_only:
+                off[2] = 0.0
             err = np.linalg.norm(d.xpos[hml] - off - reference.body_pos[kk], axis=1).mean()
             if err > fall.max_error:
                 status, fall_time = "fell", d.time

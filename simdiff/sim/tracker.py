@@ -83,6 +83,14 @@ class PDTrackerConfig:
             while the simulated foot still touches the floor (toe-off / swing clearance).
         target_margin: targets are clipped to the joint range widened by this (rad).
         balance: the stance-leg balance layer (None: off).
+        landing_sync: landing synchronisation. The simulated flight is as long as φ and the
+            take-off make it, not as long as the reference's: when the simulated feet touch
+            down while the reference is still in the air (after the simulation flew), the
+            targets and the balance layer switch to the reference's touchdown frame, and
+            when the reference has landed but the simulation is still in the air they hold
+            that touchdown frame, at most ``max_hold`` control frames; then the reference
+            clock resumes (the tracker's frame index only; time is not warped).
+        max_hold: bound of that hold (control frames).
     """
 
     lead: float = 1.5
@@ -91,6 +99,57 @@ class PDTrackerConfig:
     clearance: float = 0.25
     target_margin: float = 0.3
     balance: BalanceConfig | None = BalanceConfig()
+    landing_sync: bool = True
+    max_hold: int = 12
+
+
+class LandingSync:
+    """The reference frame a tracker aims at around the reference's flight phases.
+
+    The simulated flight lasts as long as φ and the take-off make it. Once the simulation has
+    been airborne during a reference flight:
+
+    * it touches down while the reference is still descending in the air → aim at the
+      reference's touchdown frame (take the landing pose now);
+    * the reference has landed but the simulation still flies → keep aiming at that
+      touchdown frame (reach for the floor), for at most ``max_hold`` frames.
+
+    Otherwise frame k itself. The clock is never shifted: after the event the tracker is
+    back on frame k.
+
+    Args:
+        contact: (K, 4) reference foot contacts; com_vz: (K,) reference COM vertical velocity (m/s).
+        max_hold: bound of the reach-down hold (control frames).
+    """
+
+    def __init__(self, contact: np.ndarray, com_vz: np.ndarray, max_hold: int = 12) -> None:
+        K = contact.shape[0]
+        air = ~contact.any(axis=1)
+        self.air, self.com_vz, self.max_hold = air, com_vz, max_hold
+        self.next_land = np.arange(K)  # first stance frame after an airborne frame
+        for t in range(K - 2, -1, -1):
+            if air[t]:
+                self.next_land[t] = self.next_land[t + 1] if air[t + 1] else t + 1
+        self.stance_start = np.arange(K)  # first frame of the stance a frame belongs to
+        for t in range(1, K):
+            if not air[t] and not air[t - 1]:
+                self.stance_start[t] = self.stance_start[t - 1]
+        self.flew = False
+
+    def __call__(self, k: int, touching: bool) -> int:
+        """Frame to aim at in control period k; ``touching``: a simulated foot is on the floor."""
+        if self.air[k]:
+            if not touching:
+                self.flew = True
+            elif self.flew and self.com_vz[k] < 0:
+                return int(self.next_land[k])
+            return k
+        start = self.stance_start[k]
+        if self.flew and not touching and start > 0 and self.air[start - 1] and k - start < self.max_hold:
+            return int(start)
+        if touching:
+            self.flew = False
+        return k
 
 
 class PDTracker:
@@ -153,6 +212,7 @@ class PDTracker:
             mujoco.mj_kinematics(model, d)
             self.ref_box[t] = d.geom_xpos[self.foot_geoms]
         self.ref_box[:, :, 2] = 0.0
+        self.sync = LandingSync(reference.contact, reference.com_vel[:, 2], self.cfg.max_hold)
         self.swing_dofs = [
             np.array([names.index(f"{side}_Hip_{a}") for a in "xyz"] + [names.index(f"{side}_Knee_y")])
             for side in ("L", "R")
@@ -168,10 +228,29 @@ class PDTracker:
                 out[k] = bool(np.any(g == fg))
         return out
 
+    def phase(self, k: int, on: np.ndarray) -> int:
+        """The reference frame the tracker aims at in control period k (landing sync)."""
+        if not self.cfg.landing_sync:
+            return k
+        if self.ref_air[k]:
+            if not on.any():
+                self.flew = True
+            elif self.flew and self.ref.com_vel[k, 2] < 0:
+                return int(self.next_land[k])  # touched down early: take the landing pose
+            return k
+        start = self.stance_start[k]
+        if self.flew and not on.any() and start > 0 and self.ref_air[start - 1] and k - start < self.cfg.max_hold:
+            return int(start)  # the reference landed, the simulation still flies: reach down
+        if on.any():
+            self.flew = False
+        return k
+
     def act(self, data, k: int) -> np.ndarray:
         k = min(k, self.ref.num_frames - 1)
-        target = self.base[k].copy()
         on = self._contacts(data)
+        if self.cfg.landing_sync:
+            k = self.sync(k, bool(on.any()))
+        target = self.base[k].copy()
         c = self.cfg.clearance
         if c > 0:
             kn = min(k + 1, self.ref.num_frames - 1)

@@ -1,0 +1,111 @@
+"""Flight phases: landing synchronisation, support inference, falls judged on the pose, φ in the feed-forward."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from simdiff.sim import synthetic  # noqa: E402
+from simdiff.sim.convert import infer_support, make_reference  # noqa: E402
+from simdiff.sim.env import Environment  # noqa: E402
+from simdiff.sim.humanoid import load_model  # noqa: E402
+from simdiff.sim.rollout import rollout  # noqa: E402
+from simdiff.sim.tracker import LandingSync  # noqa: E402
+
+
+def _contacts(pattern: str) -> np.ndarray:
+    """'x' = both feet down, '.' = airborne."""
+    return np.array([[c == "x"] * 4 for c in pattern])
+
+
+def test_landing_sync_early_touchdown_takes_the_landing_pose():
+    c = _contacts("xxx.....xxx")
+    vz = np.array([0, 0, 1, 1, 0.5, 0, -0.5, -1, -1, 0, 0], dtype=float)
+    sync = LandingSync(c, vz, max_hold=4)
+    assert [sync(k, True) for k in range(3)] == [0, 1, 2]
+    assert sync(3, False) == 3 and sync(4, False) == 4  # flying with the reference
+    assert sync(5, True) == 5  # reference still rising (vz = 0): no early landing
+    assert sync(6, True) == 8  # simulation down while the reference descends: touchdown frame
+    assert sync(7, True) == 8
+    assert sync(8, True) == 8 and sync(9, True) == 9  # back on the clock
+
+
+def test_landing_sync_late_touchdown_holds_the_touchdown_frame_bounded():
+    c = _contacts("xx...xxxxxxxx")
+    sync = LandingSync(c, np.zeros(len(c)), max_hold=3)
+    assert sync(0, True) == 0
+    for k in (2, 3, 4):
+        assert sync(k, False) == k
+    assert [sync(k, False) for k in (5, 6, 7, 8, 9)] == [5, 5, 5, 8, 9]  # hold 3 frames, then the clock
+    assert sync(10, True) == 10
+    # a simulation that never left the floor is never held
+    sync = LandingSync(c, np.zeros(len(c)), max_hold=3)
+    assert [sync(k, True) for k in range(len(c))] == list(range(len(c)))
+
+
+def test_infer_support_only_where_the_body_is_held_up():
+    fps, T = 20.0, 40
+    t = np.arange(T) / fps
+    h = np.full((T, 4), 0.3)
+    h[:, 1] = 0.08  # left toe box 8 cm up, nothing scheduled
+    contact = np.zeros((T, 4), dtype=bool)
+    xy = np.zeros((T, 4, 2))
+    free_fall = 1.0 + 2.0 * t - 0.5 * 9.81 * t**2
+    assert not infer_support(contact, h, xy, free_fall, fps, 0.5, 0.15).any()
+    held = 0.9 + 0.02 * np.sin(2 * np.pi * t)  # slow bobbing: needs the floor
+    out = infer_support(contact, h, xy, held, fps, 0.5, 0.15)
+    assert out[:, 1].all() and not out[:, [0, 2, 3]].any()
+    assert not infer_support(contact, h + 0.2, xy, held, fps, 0.5, 0.15).any()  # out of reach
+    sched = contact.copy()
+    sched[:, 2] = True  # already supported by the schedule: nothing added
+    assert not infer_support(sched, h, xy, held, fps, 0.5, 0.15).any()
+    assert not infer_support(contact, h, xy, held, fps, 0.0, 0.15).any()  # off
+    sliding = xy.copy()
+    sliding[:, 1, 0] = 1.0 * t  # the toe slides at 1 m/s: not a support
+    assert not infer_support(contact, h, sliding, held, fps, 0.5, 0.15).any()
+
+
+def test_despike_keeps_a_fast_first_frame():
+    from simdiff.sim.convert import _despike
+
+    j = synthetic.walk_in_place(30).astype(float)
+    j[..., 2] += 4.3 * np.arange(30)[:, None] / 20.0  # a 4.3 m/s run: 0.21 m a frame
+    out = _despike(j, 0.25)
+    assert np.allclose(out, j)  # before: frame 0 was taken for a glitch and frozen
+    bad = j.copy()
+    bad[0, 20] += [0.0, 0.0, 0.7]
+    bad[-1, 10] += [0.5, 0.0, 0.0]
+    out = _despike(bad, 0.25)
+    assert np.linalg.norm(out[0, 20] - j[0, 20]) < 0.05
+    assert np.linalg.norm(out[-1, 10] - j[-1, 10]) < 0.05
+
+
+def test_feedforward_uses_the_gravity_of_phi():
+    m = load_model()
+    joints = synthetic.squat(40)
+    earth = make_reference(m, joints)
+    moon = make_reference(m, joints, gravity=-1.62)
+    assert np.allclose(m.opt.gravity, [0, 0, -9.81])  # the model is left as it was
+    ratio = np.abs(moon.tau_ff).sum() / np.abs(earth.tau_ff).sum()
+    assert 0.05 < ratio < 0.5  # holding the body up costs about g
+
+
+@pytest.fixture(scope="module")
+def jump():
+    return synthetic.vertical_jump(height=0.15)
+
+
+def test_jump_under_low_gravity_flies_higher_and_is_not_a_fall(jump):
+    m = load_model()
+    apex, air = {}, {}
+    for g in (-9.81, -3.0):
+        res = rollout(m, make_reference(m, jump, gravity=g), Environment(g), audit=True)
+        assert res.status == "ok", g
+        assert not res.violations
+        assert not np.any(res.residual[res.airborne])
+        apex[g] = res.qpos[:, 2].max()
+        air[g] = res.airborne.sum()
+    assert apex[-3.0] > apex[-9.81] + 0.05
+    assert air[-3.0] > air[-9.81]
