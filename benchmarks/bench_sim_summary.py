@@ -90,7 +90,10 @@ def main() -> int:
         for s in data["speed"]:
             lines.append(f"| {s['clip']} | {s['duration_s']:.2f} | {s['retarget_cpu_s']:.2f} | {s.get('sim_cpu_s', float('nan')):.2f} |")
         if "pool_wall_s" in data:
-            lines += ["", f"Pool ({data['pool_motion_s']:.1f} s of motion, 4 clips): wall s by workers {data['pool_wall_s']}"]
+            w = data["pool_wall_s"]
+            lines += ["", f"Pool ({data['pool_motion_s']:.1f} s of motion, {data.get('pool_clips', 4)} clips): wall s by "
+                      f"workers " + ", ".join(f"{k}: {v:.1f}" for k, v in w.items())
+                      + (f"; speed-up with 2 = {w['1'] / w['2']:.2f}×" if "1" in w and "2" in w else "")]
     (REP / "summary.md").write_text("\n".join(lines) + "\n")
     try:
         import matplotlib

@@ -150,6 +150,11 @@ def test_residual_follows_a_lower_stance_ankle(squat_ref):
         assert res.sim_support(d)
         return float(res.wrench(d, 0.0)[2])
 
-    shifted, absolute = fz(ResidualConfig(), -0.03), fz(ResidualConfig(support_shift_max=0.0), -0.03)
+    shifted = fz(ResidualConfig(z_deadband=0.0), -0.03)
+    absolute = fz(ResidualConfig(support_shift_max=0.0, z_deadband=0.0), -0.03)
     assert absolute > 0.2 * ix.mass * 9.81  # kp_z · 3 cm ≈ 0.3·m·g at the mocap height
     assert shifted < 0.1 * absolute
+    # the height deadband: a sag within it is left to the legs, beyond it only the excess counts
+    band = ResidualConfig(support_shift_max=0.0, z_deadband=0.01)
+    assert fz(band, -0.006) < 0.01 * ix.mass * 9.81
+    assert fz(band, -0.03) == pytest.approx(absolute * 2 / 3, rel=0.1)
