@@ -4,7 +4,9 @@ Forward (:func:`make_reference`), as the probes found necessary:
 
 1. closed-form IK (:mod:`simdiff.sim.ik`) of the 22 joint positions, polished by a few
    damped Gauss-Newton iterations per frame (joint ranges clamped, a small posture prior);
-2. ground alignment and a contact schedule per foot (heel box / toe box low and slow);
+2. ground alignment and a contact schedule per foot (heel box / toe box low and slow),
+   plus inferred support where the COM is held up but no foot is scheduled
+   (:func:`infer_support`: a jump's toe push, a relevé);
 3. a second IK pass that holds every stance foot (or toe, at toe-off) flat, at a fixed xy
    and on the floor;
 4. temporal Gaussian filtering **before** anything is cropped, with odd-reflection padding

@@ -158,7 +158,8 @@ class PDTracker:
     target = q_ref(k + lead) + (τ_ff + kd q̇_ref + τ_bal) / kp, plus a swing-clearance bias
     that flexes hip, knee and ankle of a leg whose reference foot is airborne but whose
     simulated foot is still on the floor. τ_bal is the stance-leg balance torque
-    (:class:`BalanceConfig`).
+    (:class:`BalanceConfig`). Around flight phases the frame k may be replaced by the
+    reference's touchdown frame (:class:`LandingSync`).
     """
 
     def __init__(self, config: PDTrackerConfig = PDTrackerConfig()) -> None:
