@@ -362,10 +362,14 @@ def foot_heights(model, qpos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return h, xy
 
 
+def _box_speed(xy: np.ndarray, fps: float) -> np.ndarray:
+    """(T, 4) horizontal speed (m/s) of the foot boxes from their centres (T, 4, 2)."""
+    return np.linalg.norm(np.gradient(xy, axis=0) * fps, axis=-1)
+
+
 def contact_schedule(height: np.ndarray, xy: np.ndarray, fps: float, cfg: RetargetConfig) -> np.ndarray:
     """(T, 4) bool: a foot box touches when low (< contact_height) and slow (< contact_speed)."""
-    vel = np.gradient(xy, axis=0) * fps
-    speed = np.linalg.norm(vel, axis=-1)
+    speed = _box_speed(xy, fps)
     c = (height < cfg.contact_height) & (speed < cfg.contact_speed)
     # a one-frame gap or blip is noise
     for k in range(4):
@@ -400,7 +404,7 @@ def infer_support(contact: np.ndarray, height: np.ndarray, xy: np.ndarray, com_z
     need = (az > -accel * gravity) & ~contact.any(axis=1)
     low = height.argmin(axis=1)
     idx = np.arange(len(low))
-    speed = np.linalg.norm(np.gradient(xy, axis=0) * fps, axis=-1)[idx, low]
+    speed = _box_speed(xy, fps)[idx, low]
     out = np.zeros_like(contact)
     rows = np.flatnonzero(need & (height[idx, low] < reach) & (speed < max_speed))
     out[rows, low[rows]] = True
@@ -417,7 +421,7 @@ def ground_level(height: np.ndarray, xy: np.ndarray, fps: float, still_speed: fl
     """
     low_box = height.argmin(axis=1)
     low = height[np.arange(len(height)), low_box]
-    speed = np.linalg.norm(np.gradient(xy, axis=0) * fps, axis=-1)[np.arange(len(height)), low_box]
+    speed = _box_speed(xy, fps)[np.arange(len(height)), low_box]
     still = speed < still_speed
     if still.sum() >= 5:
         return float(np.median(low[still]))
