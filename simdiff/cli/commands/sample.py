@@ -41,8 +41,7 @@ def run(args: argparse.Namespace) -> int:
     import torch
 
     from simdiff.errors import SimdiffError
-    from simdiff.model.generator import MotionGenerator
-    from simdiff.motion.skeleton import MAX_FRAMES
+    from simdiff.model.generator import MAX_FRAMES, MotionGenerator
 
     if not 1 <= args.length <= MAX_FRAMES:
         raise SimdiffError(f"--length must be 1..{MAX_FRAMES} frames (9.8 s at 20 fps), got {args.length}")
