@@ -41,7 +41,14 @@ from simdiff.motion.io.asf_amc import (
     read_amc,
     read_asf,
 )
-from simdiff.motion.io.bvh import KNOWN_SCALES, parse_bvh, read_bvh, rig_from_bvh, starts_with_tpose
+from simdiff.motion.io.bvh import (
+    KNOWN_SCALES,
+    leading_transient,
+    parse_bvh,
+    read_bvh,
+    rig_from_bvh,
+    starts_with_tpose,
+)
 from simdiff.motion.io.bvh_writer import write_bvh
 from simdiff.motion.io.deepmimic import read_deepmimic
 from simdiff.motion.io.npy import read_npy, save_npy
@@ -89,8 +96,10 @@ def load_rig(
             ``HDM_<actor>.asf`` beside it or in an ``asf/`` folder).
         fps: the file's frame rate, overriding the file's own (AMC default: from a
             ``CMU_data.csv`` beside the data, a ``_120`` name suffix, else 120).
-        drop_first: BVH only: skip frame 0; None drops it when the rig family always starts
-            with a T-pose (CMU Motionbuilder) or when it is detected as an added T-pose.
+        drop_first: BVH only: True skips frame 0, False keeps every frame; None drops it
+            when the rig family always starts with a T-pose (CMU Motionbuilder), then any
+            detected start-up transient (:func:`~simdiff.motion.io.bvh.leading_transient`:
+            an added T-pose and the blend out of it). ``meta["dropped_frames"]`` counts them.
         units: BVH only: file unit ("m", "cm", "mm", "inch", "cmu" or metres per unit);
             None: the rig family's unit, else detected from the body size.
     Returns:
@@ -146,11 +155,13 @@ def _load_bvh(path: Path, *, fps: float | None, drop_first: bool | None,
     rig = rig_from_bvh(bvh, scale=scale, fps=fps, drop_first=drop,
                        sites=spec.bvh_sites if spec else (),
                        rest_axes=spec.rest_axes if spec else ((1, 0, 0), (0, 1, 0), (0, 0, 1)))
-    if drop_first is None and not drop and starts_with_tpose(rig.positions):
-        rig = RigMotion(rig.names, rig.parents, rig.positions[1:], rig.fps, rig.source, rig.meta)
-        rig.meta["dropped_tpose"] = True
-    elif drop:
-        rig.meta["dropped_tpose"] = True
+    dropped = int(drop)
+    if drop_first is None:
+        skip = max(leading_transient(rig.positions, rig.fps), int(starts_with_tpose(rig.positions)))
+        if skip:
+            rig = RigMotion(rig.names, rig.parents, rig.positions[skip:], rig.fps, rig.source, rig.meta)
+            dropped += skip
+    rig.meta["dropped_frames"] = dropped
     if spec is not None:
         rig.meta["rig"] = spec
     return rig

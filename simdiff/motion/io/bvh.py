@@ -309,6 +309,37 @@ def starts_with_tpose(positions: np.ndarray) -> bool:
     return bool(steps[0] > 0.10 and steps[0] > 10.0 * np.median(steps[1:]))
 
 
+TRANSIENT_WINDOW: float = 0.1
+"""Seconds at the start of a clip searched by :func:`leading_transient`."""
+TRANSIENT_STEP: float = 0.02
+"""Metres: smallest per-frame step (median over joints) counted as a start-up jump."""
+TRANSIENT_FACTOR: float = 5.0
+"""A start-up jump is also this many times the clip's median step."""
+
+
+def leading_transient(positions: np.ndarray, fps: float) -> int:
+    """Number of leading frames to drop: an added rest pose and the blend out of it.
+
+    Several BVH conversions start with a T-pose, followed (Daz-style CMU files, the
+    acLSTM dances) by 3-5 frames interpolated from it into the motion, or (CMU
+    Motionbuilder 09_10) by frames left at the origin. Every frame before the last step
+    within the first :data:`TRANSIENT_WINDOW` s (at least 2 steps) whose median joint
+    displacement exceeds both :data:`TRANSIENT_STEP` and :data:`TRANSIENT_FACTOR` x the
+    clip's median step is dropped.
+
+    Args:
+        positions: (T, J, 3) joint positions in metres.
+        fps: frames per second.
+    """
+    if positions.shape[0] < 4:
+        return 0
+    steps = np.median(np.linalg.norm(np.diff(positions, axis=0), axis=-1), axis=-1)
+    limit = max(TRANSIENT_STEP, TRANSIENT_FACTOR * float(np.median(steps)))
+    window = min(len(steps) - 1, max(2, int(round(TRANSIENT_WINDOW * fps))))
+    jumps = np.flatnonzero(steps[:window] > limit)
+    return int(jumps[-1]) + 1 if jumps.size else 0
+
+
 def _to_y_up(positions: np.ndarray, up: str) -> np.ndarray:
     """Rotate positions whose up axis is ``up`` ("y", "z" or "-z"... ) so that up is +Y."""
     up = up.lower()

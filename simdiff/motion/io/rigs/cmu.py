@@ -5,6 +5,7 @@ conversion of it (``Hips``, ``LHipJoint``, ``LeftUpLeg``, ..., ``LowerBack``, ``
 from __future__ import annotations
 
 
+from simdiff.motion.io.ground import level_ground
 from simdiff.motion.io.rig import RigMotion
 from simdiff.motion.io.rigs.base import RigSpec, Source, sources_of, terms
 
@@ -118,6 +119,7 @@ CMU_MB: RigSpec = RigSpec(
     ),
     first_frame_tpose=True,
     prepare=restore_thorax,
+    finish=level_ground,
 )
 """CMU Motionbuilder BVH: lengths in the CMU ASF unit (inch / 0.45), 120 fps, rest pose as
 the ASF's (Y up, faces +Z, left +X); frame 0 is a T-pose (dropped by the reader)."""

@@ -7,6 +7,7 @@ joint: its End Site (12-13 cm ahead of and 4 cm below the ankle) is the ball of 
 
 from __future__ import annotations
 
+from simdiff.motion.io.ground import level_ground
 from simdiff.motion.io.rigs.base import RigSpec, Source
 
 DAZ_MAP: dict[str, Source] = {
@@ -40,5 +41,6 @@ DAZ: RigSpec = RigSpec(
     DAZ_MAP,
     units=0.01,
     bvh_sites=(("head_centre", "head", "head", (0.0, 0.0, 0.0)),),
+    finish=level_ground,
 )
 """CMU Daz-style BVH (also the acLSTM dance folders), centimetres."""
