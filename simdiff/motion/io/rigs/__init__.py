@@ -3,8 +3,9 @@
 Each family is a :class:`RigSpec` (joint map to HumanML3D, known BVH units, derived sites,
 optional clean-up before mapping / after retargeting), one module per family:
 
-- ``cmu``: CMU ASF/AMC (31 bones; HDM05 uses the same bone names) and the CMU
-  "Motionbuilder-friendly" BVH (its dropped thorax is restored);
+- ``cmu``: CMU ASF/AMC (31 bones; HDM05 uses the same bone names), the CMU
+  "Motionbuilder-friendly" BVH and the CMU BVH named after the ASF bones (both drop the
+  thorax bone: it is restored; the floor tilt is levelled);
 - ``cc``: the Character-Creator BVH rig (``CC_Base_*``);
 - ``deepmimic``: DeepMimic humanoid3d (:func:`simdiff.motion.io.ground.lift_penetrations`
   after retargeting);
@@ -22,13 +23,13 @@ from simdiff.motion.io.rigs.bandai import BANDAI, BANDAI_MAP
 from simdiff.motion.io.rigs.base import BvhSite, RigSpec, Source, sources_of, terms
 from simdiff.motion.io.rigs.biped import biped_map
 from simdiff.motion.io.rigs.cc import CC_BVH, CC_BVH_MAP
-from simdiff.motion.io.rigs.cmu import CMU_ASF, CMU_ASF_MAP, CMU_MB, CMU_MB_MAP
+from simdiff.motion.io.rigs.cmu import CMU_ASF, CMU_ASF_MAP, CMU_ASFBVH, CMU_MB, CMU_MB_MAP
 from simdiff.motion.io.rigs.daz import DAZ, DAZ_MAP
 from simdiff.motion.io.rigs.deepmimic import DEEPMIMIC, DEEPMIMIC_MAP
 from simdiff.motion.skeleton import JOINT_NAMES
 
 __all__ = [
-    "BANDAI", "BANDAI_MAP", "CC_BVH", "CC_BVH_MAP", "CMU_ASF", "CMU_ASF_MAP", "CMU_MB",
+    "BANDAI", "BANDAI_MAP", "CC_BVH", "CMU_ASFBVH", "CC_BVH_MAP", "CMU_ASF", "CMU_ASF_MAP", "CMU_MB",
     "CMU_MB_MAP", "DAZ", "DAZ_MAP", "DEEPMIMIC", "DEEPMIMIC_MAP", "HUMANML3D", "HUMANML3D_MAP",
     "RIGS", "BvhSite", "RigSpec", "Source", "detect_rig", "sources_of", "terms",
 ]
@@ -37,7 +38,7 @@ HUMANML3D_MAP: dict[str, Source] = {name: name for name in JOINT_NAMES}
 """Identity map for rigs already named like HumanML3D (e.g. our own BVH writer)."""
 HUMANML3D: RigSpec = RigSpec("humanml3d", HUMANML3D_MAP)
 
-RIGS: tuple[RigSpec, ...] = (HUMANML3D, CMU_ASF, CC_BVH, DEEPMIMIC, CMU_MB, BANDAI, DAZ)
+RIGS: tuple[RigSpec, ...] = (HUMANML3D, CMU_ASF, CC_BVH, DEEPMIMIC, CMU_MB, CMU_ASFBVH, BANDAI, DAZ)
 """Known families, in detection order (the generic biped map comes last)."""
 
 

@@ -19,20 +19,21 @@ BANDAI_MAP: dict[str, Source] = {
     "pelvis": ((_HL, 0.425), (_HR, 0.425), (_NECK, 0.15)),
     "left_hip": _HL,
     "right_hip": _HR,
-    # spine1/2/3 at 0.33/0.56/0.64 of hip centre -> neck (SMPL); Spine sits at 0.36,
-    # Chest at 0.57 of that line in the rest pose
-    "spine1": ((_SPINE, 0.917), (_HL, 0.0415), (_HR, 0.0415)),
+    # spine1/2/3 at 0.335/0.565/0.64 of hip centre -> neck (SMPL); Spine sits at 0.414,
+    # Chest at 0.622 of that line (measured, upright frames)
+    "spine1": ((_SPINE, 0.809), (_HL, 0.0955), (_HR, 0.0955)),
     "left_knee": "LowerLeg_L",
     "right_knee": "LowerLeg_R",
-    "spine2": (_CHEST, _SPINE, 0.05),
+    "spine2": (_SPINE, _CHEST, 0.726),
     "left_ankle": "Foot_L",
     "right_ankle": "Foot_R",
-    "spine3": (_CHEST, _NECK, 0.16),
+    "spine3": (_CHEST, _NECK, 0.05),
     "left_foot": "Toes_L",
     "right_foot": "Toes_R",
     "neck": _NECK,
-    "left_collar": (_NECK, "UpperArm_L", 0.45),
-    "right_collar": (_NECK, "UpperArm_R", 0.45),
+    # collar 0.45 of the way from the trunk line at 0.78 up to the shoulder (CMU_ASF_MAP)
+    "left_collar": ((_CHEST, 0.319), (_NECK, 0.231), ("UpperArm_L", 0.45)),
+    "right_collar": ((_CHEST, 0.319), (_NECK, 0.231), ("UpperArm_R", 0.45)),
     "head": "head_centre",
     "left_shoulder": "UpperArm_L",
     "right_shoulder": "UpperArm_R",
@@ -49,6 +50,7 @@ BANDAI: RigSpec = RigSpec(
     units=0.01,
     # rest pose: left +Z, up +X (spine), forward = left x up = +Y
     rest_axes=((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
-    bvh_sites=(("head_centre", "Head", "Head", (0.0, 0.0, 0.0)),),
+    # SMPL head: 3.7 cm in front of and 1.3 cm below the Head joint (top of the neck)
+    bvh_sites=(("head_centre", "Head", "Head", (0.0, -0.013, 0.037)),),
 )
 """Bandai-Namco BVH: centimetres (stated by the dataset; standing heights 1.5-1.8 m)."""

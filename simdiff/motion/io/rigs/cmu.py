@@ -76,18 +76,18 @@ THORAX_RATIO: float = 1.0
 files of ``../shared/data/cmu/asf``."""
 
 
-def restore_thorax(rig: RigMotion) -> RigMotion:
+def restore_thorax(rig: RigMotion, spine: str = "Spine", spine1: str = "Spine1") -> RigMotion:
     """Put back the CMU ``thorax`` bone that the Motionbuilder conversion drops.
 
     In these BVH files ``Neck`` has a zero OFFSET from ``Spine1`` (the ``upperback`` end)
     while every other bone matches the subject's ASF length, so neck, head and shoulders sit
-    one thorax length (about 11 cm) too low. Everything above ``Spine1`` is moved by
-    :data:`THORAX_RATIO` x (Spine1 - Spine): the thorax continues the upperback's direction
+    one thorax length (about 11 cm) too low. Everything above ``spine1`` is moved by
+    :data:`THORAX_RATIO` x (spine1 - spine): the thorax continues the upperback's direction
     (both point straight up in the CMU rest pose).
     """
-    spine1 = rig.index("Spine1")
-    moved = [j for j in range(len(rig.names)) if _descends(rig.parents, j, spine1)]
-    shift = THORAX_RATIO * (rig.positions[:, spine1] - rig.positions[:, rig.index("Spine")])
+    top = rig.index(spine1)
+    moved = [j for j in range(len(rig.names)) if _descends(rig.parents, j, top)]
+    shift = THORAX_RATIO * (rig.positions[:, top] - rig.positions[:, rig.index(spine)])
     positions = rig.positions.copy()
     positions[:, moved] += shift[:, None]
     meta = dict(rig.meta, thorax_restored=True)
@@ -124,3 +124,42 @@ CMU_MB: RigSpec = RigSpec(
 """CMU Motionbuilder BVH: lengths in the CMU ASF unit (inch / 0.45), 120 fps, rest pose as
 the ASF's (Y up, faces +Z, left +X); frame 0 is a T-pose (dropped by the reader)."""
 
+
+
+ASFBVH_FROM_MB: dict[str, str] = {
+    "LeftUpLeg": "lfemur", "RightUpLeg": "rfemur", "LeftLeg": "ltibia", "RightLeg": "rtibia",
+    "LeftFoot": "lfoot", "RightFoot": "rfoot", "LeftToeBase": "ltoes", "RightToeBase": "rtoes",
+    "Spine": "upperback", "Spine1": "thorax", "Neck": "lowerneck", "Neck1": "upperneck",
+    "Head": "head", "Head_End": "head_End", "LeftShoulder": "lclavicle",
+    "RightShoulder": "rclavicle", "LeftArm": "lhumerus", "RightArm": "rhumerus",
+    "LeftForeArm": "lradius", "RightForeArm": "rradius", "LeftHand": "lwrist",
+    "RightHand": "rwrist", "head_centre": "head_centre", "lshoulder_centre": "lshoulder_centre",
+    "rshoulder_centre": "rshoulder_centre",
+}
+"""CMU Motionbuilder joint -> the same joint of the CMU BVH named after the ASF bones
+(cgspeed-style ``hip``, ``lhipjoint``, ``lfemur``, ...: a joint named after a bone sits at
+that bone's start; the thorax is dropped in the same way)."""
+
+CMU_ASFBVH_MAP: dict[str, Source] = {
+    k: tuple((ASFBVH_FROM_MB[n], w) for n, w in terms(v)) for k, v in CMU_MB_MAP.items()
+}
+"""ASF-named CMU BVH joints -> HumanML3D joints (:data:`CMU_MB_MAP` renamed)."""
+
+
+def _restore_thorax_asfbvh(rig: RigMotion) -> RigMotion:
+    return restore_thorax(rig, "upperback", "thorax")
+
+
+CMU_ASFBVH: RigSpec = RigSpec(
+    "cmu_asf_bvh",
+    CMU_ASFBVH_MAP,
+    required=frozenset({"hip", "lhipjoint", "lfemur", "ltibia", "lfoot", "ltoes", "lowerback",
+                        "upperback", "thorax", "lowerneck", "upperneck", "head", "lclavicle",
+                        "lhumerus", "lradius", "lwrist", "rclavicle", "rhumerus", "rradius",
+                        "rwrist", "rfemur", "rtibia", "rfoot", "rtoes", "head_End"}),
+    units=0.0254 / 0.45,
+    bvh_sites=tuple((n, ASFBVH_FROM_MB[j], ASFBVH_FROM_MB[c], o) for n, j, c, o in CMU_MB.bvh_sites),
+    prepare=_restore_thorax_asfbvh,
+    finish=level_ground,
+)
+"""CMU BVH with ASF bone names (``daz/16_01.bvh`` of the extra set): as :data:`CMU_MB`."""

@@ -20,12 +20,13 @@ DAZ_MAP: dict[str, Source] = {
     "spine2": ("chest", "neck", 0.0),
     "left_ankle": "lFoot",
     "right_ankle": "rFoot",
-    "spine3": ("chest", "neck", 0.2),
+    "spine3": ("chest", "neck", 0.16),
     "left_foot": "lFoot_End",
     "right_foot": "rFoot_End",
     "neck": "neck",
-    "left_collar": ("neck", "lShldr", 0.45),
-    "right_collar": ("neck", "rShldr", 0.45),
+    # collar 0.45 of the way from the trunk line at 0.8 up to the shoulder (CMU_ASF_MAP)
+    "left_collar": (("chest", 0.25), ("neck", 0.30), ("lShldr", 0.45)),
+    "right_collar": (("chest", 0.25), ("neck", 0.30), ("rShldr", 0.45)),
     "head": "head_centre",
     "left_shoulder": "lShldr",
     "right_shoulder": "rShldr",
@@ -40,7 +41,8 @@ DAZ: RigSpec = RigSpec(
     "daz",
     DAZ_MAP,
     units=0.01,
-    bvh_sites=(("head_centre", "head", "head", (0.0, 0.0, 0.0)),),
+    # SMPL head: 2.8 cm in front of and 0.5 cm below the head joint (top of the neck)
+    bvh_sites=(("head_centre", "head", "head", (0.0, -0.005, 0.028)),),
     finish=level_ground,
 )
 """CMU Daz-style BVH (also the acLSTM dance folders), centimetres."""
