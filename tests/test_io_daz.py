@@ -108,6 +108,9 @@ def test_leading_transient_keeps_clean_starts() -> None:
     late = walk.copy()
     late[50:] += 0.5  # a jump after the first 0.1 s is motion, not a start-up transient
     assert leading_transient(late, 120.0) == 0
+    rising = walk.copy()
+    rising[:6, :, 1] += np.linspace(0.12, 0.0, 6)[:, None]  # real motion at 0.7 m/s, 30 fps
+    assert leading_transient(rising, 30.0) == 0
 
 
 def test_real_daz_file(shared_data: Path, tmp_path: Path) -> None:
