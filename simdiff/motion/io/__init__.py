@@ -8,13 +8,18 @@ Sources and what the readers do for them (rig families: :mod:`simdiff.motion.io.
 
 - CMU ASF/AMC and HDM05 ASF/AMC (``HDM_<actor>.asf`` found beside ``HDM_<actor>_*.amc``;
   rate from ``CMU_data.csv`` or a ``_120`` name suffix, else 120 fps);
-- BVH (rate: a folder ``readme.txt`` rate, e.g. acLSTM salsa 60 fps, else the header):
-  CMU Character-Creator (an added first T-pose is detected and dropped), CMU
-  Motionbuilder (CMU ASF units, first frame a T-pose: dropped; its missing thorax bone is
-  put back), Daz-style CMU/acLSTM (cm), Bandai-Namco (cm, 30 fps), generic bipeds;
+- BVH (rate: a folder ``readme.txt`` rate, e.g. acLSTM salsa 60 fps, else the header;
+  start-up frames dropped: the family's T-pose, then any T-pose / blend-out transient,
+  counted in ``meta["dropped_frames"]``): CMU Character-Creator, CMU Motionbuilder and the
+  ASF-named CMU BVH (CMU ASF units; the dropped thorax bone is put back; floor tilt
+  levelled), Daz-style CMU/acLSTM (cm; floor tilt levelled), Bandai-Namco (cm, 30 fps),
+  generic bipeds;
 - DeepMimic JSON (``.txt``): variable frame durations are resampled on their time stamps;
   :func:`retarget_rig` applies the DeepMimic ground clean-up ``lift_penetrations``;
 - ``.npy`` HumanML3D joints or features.
+
+Per-family clean-ups (``prepare`` before mapping, ``finish`` after retargeting) run inside
+:func:`retarget_rig` / :func:`load_joints` and are switched off with ``clean=False``.
 
 BVH units (file unit -> metres), in order: the ``units`` argument ("m", "cm", "mm",
 "inch", "cmu" or a factor); the rig family's known unit (Bandai, Daz: cm; Motionbuilder:
