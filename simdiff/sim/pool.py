@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -83,9 +83,13 @@ class ProjectionPool:
         self.cfg = config
 
     def map(
-        self, motions: Sequence[np.ndarray], envs: Iterable[Environment] | Environment = Environment()
+        self, motions: Sequence[np.ndarray], envs: Iterable[Environment] | Environment = Environment(),
+        progress: Callable[[Iterable], Iterable] | None = None,
     ) -> list[tuple[np.ndarray | None, ProjectionInfo | str]]:
-        """Project every motion under its environment (one env for all, or one per motion)."""
+        """Project every motion under its environment (one env for all, or one per motion).
+
+        ``progress`` wraps the in-order result iterator (e.g. ``tqdm``) of the serial and process backends.
+        """
         envs_list = [envs] * len(motions) if isinstance(envs, Environment) else list(envs)
         if len(envs_list) != len(motions):
             raise SimdiffError(f"{len(motions)} motions but {len(envs_list)} environments")
@@ -93,14 +97,15 @@ class ProjectionPool:
             e.validate(force=self.cfg.force)
         tasks = [(np.asarray(m, dtype=np.float32), e.as_tuple(), self.cfg) for m, e in zip(motions, envs_list)]
         workers = self.cfg.workers or os.cpu_count() or 1
+        wrap = progress if progress is not None else (lambda results: results)
         if self.cfg.backend == "serial" or (self.cfg.backend == "process" and workers == 1):
-            return [_run_one(t) for t in tasks]
+            return list(wrap(_run_one(t) for t in tasks))
         if self.cfg.backend == "process":
             import multiprocessing as mp
 
             ctx = mp.get_context("spawn")
             with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as ex:
-                return list(ex.map(_run_one, tasks, chunksize=1))
+                return list(wrap(ex.map(_run_one, tasks, chunksize=1)))
         return self._map_ray(tasks, workers)
 
     def _map_ray(self, tasks: list, workers: int) -> list:

@@ -35,21 +35,22 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from simdiff.motion.features import joints_to_features
-    from simdiff.motion.io import load_joints, save_npy, write_bvh
+    from simdiff.fsio import check_writable, save_npy
+    from simdiff.motion.io import load_joints, write_bvh
 
     suffix = args.output.suffix.lower()
     if suffix not in (".npy", ".bvh"):
         raise SimdiffError(f"unsupported output type {args.output.name!r}: use .npy or .bvh")
     if suffix == ".bvh" and args.to == "features":
         raise SimdiffError("--to features needs a .npy output, not .bvh")
+    check_writable(args.output)
     joints = load_joints(args.input, asf=args.asf, fps=args.fps)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
     if suffix == ".bvh":
         write_bvh(args.output, joints)
         what = f"BVH, {joints.shape[0]} frames"
     elif args.to == "features":
         feats = joints_to_features(joints)
-        np.save(args.output, feats.astype(np.float32))
+        save_npy(args.output, feats.astype(np.float32))
         what = f"features {feats.shape}"
     else:
         save_npy(args.output, joints)
