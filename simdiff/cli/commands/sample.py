@@ -42,6 +42,9 @@ def run(args: argparse.Namespace) -> int:
     from simdiff.fsio import check_writable, ensure_dir, save_npy, write_json
     from simdiff.model.generator import MAX_FRAMES, MotionGenerator
 
+    from simdiff.product.request import check_text
+
+    args.text = [check_text(t) for t in args.text]
     if not 1 <= args.length <= MAX_FRAMES:
         raise SimdiffError(f"--length must be 1..{MAX_FRAMES} frames (9.8 s at 20 fps), got {args.length}")
     if args.batch < 1:
