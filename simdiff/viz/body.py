@@ -14,8 +14,8 @@ and the render model has the same bodies and joints, so qpos carries over.
 Headless OpenGL: MuJoCo picks its GL backend from ``MUJOCO_GL`` when ``mujoco`` is first
 imported, and most processes here import it for simulation before they render. So this
 module does not rely on that choice: it creates the offscreen context itself with the
-backend :func:`gl_backend` picks (``$MUJOCO_GL`` when it is ``egl`` or ``osmesa``, else the
-first of EGL, OSMesa that works in a throw-away subprocess), and drives MuJoCo's renderer
+backend :func:`simdiff.viz.gl.gl_backend` picks (``$MUJOCO_GL`` when it is ``egl`` or ``osmesa``,
+else the first of EGL, OSMesa that works in a throw-away subprocess), and drives MuJoCo's renderer
 (``MjvScene``, ``MjrContext``, ``mjr_render``, ``mjr_readPixels``) as ``mujoco.Renderer``
 does.
 """
@@ -34,7 +34,7 @@ from simdiff.errors import SimdiffError
 from simdiff.fsio import atomic_path
 from simdiff.motion.skeleton import FPS, NUM_JOINTS
 from simdiff.viz._checks import ANIMATION_SUFFIXES, as_captions, output_path, positive_float, positive_int
-from simdiff.viz.gl import GL_BACKENDS, _gl_context, gl_backend  # noqa: F401  (re-exported)
+from simdiff.viz.gl import _gl_context, gl_backend
 from simdiff.viz.video import write_video
 
 
