@@ -124,6 +124,10 @@ def test_output_folder_is_a_file(joints_file, tmp_path, capsys):
     _one_line_error(capsys, "blocker")
     assert main(["render", str(joints_file), "--out", str(blocker / "r.gif")]) == 2
     _one_line_error(capsys, "blocker")
+    assert main(["track", str(joints_file), "--out", str(blocker / "t")]) == 2
+    _one_line_error(capsys, "blocker")
+    assert main(["generate", "a person walks", "--out", str(blocker / "g")]) == 2  # before loading the model
+    _one_line_error(capsys, "blocker")
 
 
 @pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0, reason="root ignores folder permissions")
