@@ -114,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
                   f"|wind| <= {MAX_WIND:g} N); the motion is an extrapolation", file=sys.stderr)
             break
     out_dir = prepare_out_dir(args.out if args.out is not None else fresh_dir(Path("out") / slug(request.text)))
+    from simdiff.fsio import check_writable
+
+    check_writable(out_dir / "generation.json")  # a read-only folder fails now, not after sampling
 
     import torch
 

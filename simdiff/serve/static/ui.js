@@ -63,7 +63,8 @@ function show(motion) {
     state.params = p;
     state.generation_id += 1;
     caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${p.alpha.toFixed(2)}` : "");
-    setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s.`);
+    const waited = meta.queue_position ? ` after waiting ${meta.waited_s.toFixed(1)} s behind ${meta.queue_position} request(s)` : "";
+    setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s${waited}.`);
   } else {
     state.params = null;
     caption = meta.name;
