@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
         args.out.write_text(json.dumps(out, indent=1))
         return 0
 
-    from simdiff.sim.convert import make_reference
+    from simdiff.sim.retarget import make_reference
     from simdiff.sim.env import Environment
     from simdiff.sim.humanoid import load_model
     from simdiff.sim.rollout import rollout

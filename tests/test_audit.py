@@ -51,7 +51,7 @@ def test_audit_synthetic_walk(walk_audit, walk40):
 
 def test_reference_residual_matches_the_simulators_screen(walk40):
     """Under Earth gravity the audit's screen is the one ``make_reference`` computes."""
-    from simdiff.sim.convert import make_reference
+    from simdiff.sim.retarget import make_reference
     from simdiff.sim.humanoid import load_model, model_index
 
     model = load_model()

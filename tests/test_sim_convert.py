@@ -9,14 +9,9 @@ pytest.importorskip("mujoco")
 
 from simdiff.errors import SimdiffError  # noqa: E402
 from simdiff.sim import synthetic  # noqa: E402
-from simdiff.sim.convert import (  # noqa: E402
-    RetargetConfig,
-    _smooth,
-    make_reference,
-    qpos_to_joints,
-    resample_qpos,
-)
 from simdiff.sim.humanoid import load_model, model_index  # noqa: E402
+from simdiff.sim.retarget import RetargetConfig, make_reference, qpos_to_joints  # noqa: E402
+from simdiff.sim.retarget.filtering import resample_qpos, smooth  # noqa: E402
 
 
 def test_roundtrip_synthetic_squat():
@@ -37,7 +32,7 @@ def test_roundtrip_synthetic_squat():
 def test_stance_feet_held_flat_on_floor():
     m = load_model()
     ref = make_reference(m, synthetic.walk_in_place(40))
-    from simdiff.sim.convert import foot_heights
+    from simdiff.sim.retarget.kinematics import foot_heights
 
     h, _ = foot_heights(m, ref.qpos)
     stance = h[ref.contact]
@@ -51,7 +46,7 @@ def test_stance_feet_held_flat_on_floor():
 def test_smoothing_keeps_boundary_velocity():
     t = np.arange(20, dtype=float)[:, None]
     x = 0.3 * t  # a ramp: odd-reflection padding leaves it unchanged
-    assert np.allclose(_smooth(x, 1.5), x)
+    assert np.allclose(smooth(x, 1.5), x)
 
 
 def test_resample_lengths():
@@ -77,7 +72,7 @@ def test_bad_input():
 
 def test_features_roundtrip_shape():
     pytest.importorskip("simdiff.motion.features")
-    from simdiff.sim.convert import joints_to_features
+    from simdiff.sim.retarget.kinematics import joints_to_features
 
     m = load_model()
     joints = synthetic.squat(30)
@@ -95,8 +90,8 @@ def test_real_clip_ik_error(shared_data):
 
 
 def test_analytic_ik_recovers_in_range_poses():
-    from simdiff.sim.convert import qpos_to_world
-    from simdiff.sim.ik import analytic_ik
+    from simdiff.sim.retarget.kinematics import qpos_to_world
+    from simdiff.sim.retarget.ik import analytic_ik
 
     m = load_model()
     rng = np.random.default_rng(0)
@@ -113,28 +108,28 @@ def test_analytic_ik_recovers_in_range_poses():
 
 def test_analytic_ik_continuous_on_synthetic_walk():
     from simdiff.sim.humanoid import hml_to_world
-    from simdiff.sim.ik import analytic_ik
+    from simdiff.sim.retarget.ik import analytic_ik
 
     m = load_model()
     q = analytic_ik(m, hml_to_world(synthetic.walk_in_place(40).astype(float)))
     assert np.abs(np.diff(q[:, 7:], axis=0)).max() < 1.0  # no Euler-branch / twist flips (≈ π)
 
 
-def test_despike_replaces_isolated_glitch_only():
-    from simdiff.sim.convert import _despike
+def testdespike_replaces_isolated_glitch_only():
+    from simdiff.sim.retarget.filtering import despike
 
     j = synthetic.walk_in_place(30).astype(float)
     bad = j.copy()
     bad[0, 20] += [0.0, 0.0, 0.7]  # first frame wrist glitch (seen in CMU 16_15)
     bad[12, 7] += [0.4, 0.0, 0.0]
-    out = _despike(bad, 0.25)
+    out = despike(bad, 0.25)
     assert np.linalg.norm(out[0, 20] - j[0, 20]) < 0.05
     assert np.linalg.norm(out[12, 7] - j[12, 7]) < 0.05
-    assert np.array_equal(_despike(j, 0.25), j)  # clean motion untouched
+    assert np.array_equal(despike(j, 0.25), j)  # clean motion untouched
 
 
 def test_ground_level_uses_planted_feet():
-    from simdiff.sim.convert import ground_level
+    from simdiff.sim.retarget.contacts import ground_level
 
     T = 60
     h = np.full((T, 4), 0.12)  # feet planted 12 cm above the capture's zero ...

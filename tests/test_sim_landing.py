@@ -8,7 +8,8 @@ import pytest
 pytest.importorskip("mujoco")
 
 from simdiff.sim import synthetic  # noqa: E402
-from simdiff.sim.convert import infer_support, make_reference  # noqa: E402
+from simdiff.sim.retarget import make_reference  # noqa: E402
+from simdiff.sim.retarget.contacts import infer_support  # noqa: E402
 from simdiff.sim.env import Environment  # noqa: E402
 from simdiff.sim.humanoid import load_model  # noqa: E402
 from simdiff.sim.rollout import rollout  # noqa: E402
@@ -68,16 +69,16 @@ def test_infer_support_only_where_the_body_is_held_up():
 
 
 def test_despike_keeps_a_fast_first_frame():
-    from simdiff.sim.convert import _despike
+    from simdiff.sim.retarget.filtering import despike
 
     j = synthetic.walk_in_place(30).astype(float)
     j[..., 2] += 4.3 * np.arange(30)[:, None] / 20.0  # a 4.3 m/s run: 0.21 m a frame
-    out = _despike(j, 0.25)
+    out = despike(j, 0.25)
     assert np.allclose(out, j)  # before: frame 0 was taken for a glitch and frozen
     bad = j.copy()
     bad[0, 20] += [0.0, 0.0, 0.7]
     bad[-1, 10] += [0.5, 0.0, 0.0]
-    out = _despike(bad, 0.25)
+    out = despike(bad, 0.25)
     assert np.linalg.norm(out[0, 20] - j[0, 20]) < 0.05
     assert np.linalg.norm(out[-1, 10] - j[-1, 10]) < 0.05
 

@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("mujoco")
 
 from simdiff.sim import synthetic  # noqa: E402
-from simdiff.sim.convert import make_reference  # noqa: E402
+from simdiff.sim.retarget import make_reference  # noqa: E402
 from simdiff.sim.env import Environment  # noqa: E402
 from simdiff.sim.humanoid import load_model  # noqa: E402
 from simdiff.sim.project import project  # noqa: E402

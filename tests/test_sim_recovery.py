@@ -8,7 +8,7 @@ import pytest
 pytest.importorskip("mujoco")
 
 from simdiff.sim import synthetic  # noqa: E402
-from simdiff.sim.convert import make_reference  # noqa: E402
+from simdiff.sim.retarget import make_reference  # noqa: E402
 from simdiff.sim.env import Environment  # noqa: E402
 from simdiff.sim.humanoid import load_model, model_index  # noqa: E402
 from simdiff.sim.rollout import FallConfig, RecoveryConfig, rollout  # noqa: E402

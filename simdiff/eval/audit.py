@@ -5,7 +5,7 @@ Three parts, all for joints (T, 22, 3) in metres, Y-up, 20 fps:
 1. kinematic physics metrics (:func:`simdiff.motion.metrics.physics_metrics`): penetration,
    floating, sliding (mm), skate ratio;
 2. the inverse-dynamics screen of the reference the tracker would follow
-   (:func:`simdiff.sim.convert.make_reference` on a humanoid whose gravity is φ's, i.e. g_z
+   (:func:`simdiff.sim.retarget.make_reference` on a humanoid whose gravity is φ's, i.e. g_z
    and the mass-distributed wind): per 30 Hz frame, the root wrench that gravity, wind and
    floor contacts in a friction pyramid cannot supply. Force is reported as a fraction of
    m·|g_z| (m = humanoid mass, 72 kg), torque in N·m. The reference is put on the floor
@@ -112,7 +112,7 @@ def reference_residual(joints: np.ndarray, env: Environment = Environment(), *, 
         joints: (T, 22, 3) HumanML3D joints, metres, Y-up, 20 fps (T ≥ 4).
         env: φ; gravity and wind enter the inverse dynamics (validated by the caller).
         model: the humanoid (default :func:`simdiff.sim.humanoid.load_model`); not modified.
-        retarget: :class:`simdiff.sim.convert.RetargetConfig`; default: the standard config
+        retarget: :class:`simdiff.sim.retarget.RetargetConfig`; default: the standard config
             without support inference (``support_accel=0``), so that a foot hovering near
             the floor is judged as the motion has it, not pulled down as the tracker's
             reference repair would.
@@ -124,7 +124,7 @@ def reference_residual(joints: np.ndarray, env: Environment = Environment(), *, 
         ``ground_shift_m`` (height added to put the stance feet on the floor), ``ik_error_mm``
         (mean joint error of the retargeting), ``mass_kg``.
     """
-    from simdiff.sim.convert import RetargetConfig, make_reference
+    from simdiff.sim.retarget import RetargetConfig, make_reference
     from simdiff.sim.humanoid import load_model, model_index
 
     base = model if model is not None else load_model()

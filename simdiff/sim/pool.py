@@ -15,7 +15,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from simdiff.errors import SimdiffError
-from simdiff.sim.convert import RetargetConfig
+from simdiff.sim.retarget.config import RetargetConfig
 from simdiff.sim.env import Environment
 from simdiff.sim.project import ProjectionInfo, project
 from simdiff.sim.residual import ResidualConfig

@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from simdiff.sim.convert import RetargetConfig, make_reference, qpos_to_world
+from simdiff.sim.retarget import RetargetConfig, make_reference, qpos_to_world
 from simdiff.sim.env import Environment
 from simdiff.sim.humanoid import HumanoidConfig, load_model, model_index, world_to_hml
 from simdiff.sim.residual import ResidualConfig
@@ -87,7 +87,7 @@ def d_l2(ref_joints: np.ndarray, out_joints: np.ndarray, normalizer) -> float:
     n = min(len(ref_joints), len(out_joints))
     if n < 2:
         return float("nan")
-    from simdiff.sim.convert import joints_to_features
+    from simdiff.sim.retarget.kinematics import joints_to_features
 
     fr = normalizer.normalize(joints_to_features(ref_joints[:n]))
     fo = normalizer.normalize(joints_to_features(out_joints[:n]))

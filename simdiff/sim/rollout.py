@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from simdiff.sim.convert import Reference
+from simdiff.sim.retarget.config import Reference
 from simdiff.sim.env import Environment
 from simdiff.sim.humanoid import ModelIndex, model_index
 from simdiff.sim.residual import ResidualConfig, RootResidual
@@ -152,7 +152,7 @@ def rollout(
 
     Args:
         model: the humanoid; it is copied, the caller's model is not modified.
-        reference: from :func:`simdiff.sim.convert.make_reference`.
+        reference: from :func:`simdiff.sim.retarget.make_reference`.
         env: φ (validated by the caller).
         tracker: default :class:`PDTracker`.
         residual: residual config (``max_force=0`` is strict).

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simdiff.sim.convert import qpos_to_joints
+from simdiff.sim.retarget.kinematics import qpos_to_joints
 from simdiff.sim.humanoid import load_model
 
 

@@ -15,7 +15,8 @@ import numpy as np
 
 from simdiff.motion.quaternion import quat_error
 
-from simdiff.sim.convert import Reference, _foot_geoms
+from simdiff.sim.retarget.config import Reference
+from simdiff.sim.retarget.kinematics import foot_geoms
 from simdiff.sim.humanoid import ModelIndex
 
 
@@ -175,7 +176,7 @@ class PDTracker:
         self.model = model
         self.lo = index.jnt_lo - self.cfg.target_margin
         self.hi = index.jnt_hi + self.cfg.target_margin
-        self.foot_geoms = _foot_geoms(model)
+        self.foot_geoms = foot_geoms(model)
         self.geom_side = np.full(model.ngeom, -1)
         for k, g in enumerate(self.foot_geoms):
             self.geom_side[g] = k // 2

@@ -1,4 +1,4 @@
-"""Analytic (closed-form) inverse kinematics: HumanML3D joint positions → humanoid qpos.
+"""Inverse kinematics: HumanML3D joint positions → humanoid qpos (closed form + Gauss-Newton).
 
 The generated humanoid's body origins *are* the HumanML3D joints and every body frame is
 world-aligned at rest, so each body's rotation follows from where its children must go:
@@ -15,18 +15,21 @@ world-aligned at rest, so each body's rotation follows from where its children m
 The local rotation is decomposed into the three hinge angles (intrinsic XYZ), choosing the
 Euler branch that fits the joint range best, and clamped to the range. The solve runs top
 down and is vectorised over frames; each body aims from its *achieved* (clamped) parent,
-so clamping errors do not propagate as offsets. A few Gauss-Newton iterations
-(:mod:`simdiff.sim.convert`) polish the result where clamping or bone lengths differ.
+so clamping errors do not propagate as offsets. A few damped Gauss-Newton iterations per
+frame (:class:`GaussNewtonIK`, :func:`ik_sequence`) polish the result where clamping or
+bone lengths differ, optionally with extra tasks (:class:`IKTask`: hold a foot flat).
 """
 
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from simdiff.sim.humanoid import BODY_NAMES, BODY_PARENT, BODY_TO_HML
+from simdiff.sim.humanoid import BODY_NAMES, BODY_PARENT, BODY_TO_HML, model_index
+from simdiff.sim.retarget.config import RetargetConfig
 
 # child body whose joint position fixes a single-child body's bone direction
 _AIM_CHILD: dict[str, str] = {
@@ -179,3 +182,153 @@ def analytic_ik(model, target: np.ndarray) -> np.ndarray:
         qpos[:, lay["cols"][body]] = ang
         Rw[body] = Rp @ Rotation.from_euler("XYZ", ang).as_matrix()
     return qpos
+
+
+# IK weight of each HumanML3D joint (feet and pelvis matter most for dynamics).
+_IK_WEIGHTS = np.ones(22)
+_IK_WEIGHTS[[0]] = 3.0
+_IK_WEIGHTS[[7, 8, 10, 11]] = 3.0
+_IK_WEIGHTS[[12, 15]] = 0.5
+
+
+@dataclass
+class IKTask:
+    """An extra IK task: hold body ``body`` at ``pos`` (world) and, if given, at rotation ``rot``."""
+
+    body: int
+    pos: np.ndarray
+    rot: np.ndarray | None
+    weight: float
+
+
+class GaussNewtonIK:
+    """Damped Gauss-Newton IK of one frame's 22 joint positions (+ extra tasks), hinges clamped."""
+
+    def __init__(self, model, cfg: RetargetConfig) -> None:
+        import mujoco
+
+        self.mj = mujoco
+        self.m = model
+        self.d = mujoco.MjData(model)
+        self.ix = model_index(model)
+        self.cfg = cfg
+        self.nv = model.nv
+        self.jacp = np.zeros((3, model.nv))
+        self.jacr = np.zeros((3, model.nv))
+        self.lo = model.jnt_range[1:, 0]
+        self.hi = model.jnt_range[1:, 1]
+        self.posture = _posture_weights(model)
+        # dof d moves HumanML3D joint i iff the dof's body is the joint's body or an ancestor
+        self.mask = np.zeros((22, model.nv))
+        for i, b in enumerate(self.ix.hml_bodies):
+            chain = set()
+            while b > 0:
+                chain.add(b)
+                b = model.body_parentid[b]
+            self.mask[i] = [model.dof_bodyid[v] in chain for v in range(model.nv)]
+        self.hinge_jnt = np.arange(1, model.njnt)
+        self.w = np.repeat(_IK_WEIGHTS, 3)
+
+    def _joint_jacobian(self) -> np.ndarray:
+        """(66, nv) position Jacobian of the 22 HumanML3D joints at the current kinematics.
+
+        Hinge column: axis × (p − anchor); free-joint columns: identity (translation) and the
+        body-frame rotation axes × (p − root); zero where the dof is not an ancestor.
+        """
+        d = self.d
+        p = d.xpos[self.ix.hml_bodies]  # (22, 3)
+        axes = np.empty((self.nv, 3))
+        anchors = np.empty((self.nv, 3))
+        root = self.ix.pelvis
+        axes[3:6] = d.xmat[root].reshape(3, 3).T
+        anchors[3:6] = d.xpos[root]
+        axes[6:] = d.xaxis[self.hinge_jnt]
+        anchors[6:] = d.xanchor[self.hinge_jnt]
+        J = np.cross(axes[None, 3:], p[:, None, :] - anchors[None, 3:])  # (22, nv-3, 3)
+        out = np.zeros((22, 3, self.nv))
+        out[:, :, 3:] = np.swapaxes(J, 1, 2) * self.mask[:, None, 3:]
+        out[:, [0, 1, 2], [0, 1, 2]] = 1.0
+        return out.reshape(66, self.nv)
+
+    def solve(self, q: np.ndarray, target: np.ndarray, iters: int, tasks: list[IKTask] = ()) -> tuple[np.ndarray, float]:
+        """Gauss-Newton on the 22 joint positions ``target`` (22, 3) world + extra tasks.
+
+        Returns the solution and its mean joint error (m).
+        """
+        mj, m, d = self.mj, self.m, self.d
+        nv = self.nv
+        lam = self.cfg.ik_damping
+        pw = self.cfg.posture_weight * self.posture
+        q = q.copy()
+        diag = np.arange(nv)
+        for _ in range(iters):
+            d.qpos[:] = q
+            mj.mj_kinematics(m, d)
+            J = self._joint_jacobian()
+            if tasks:
+                mj.mj_comPos(m, d)  # cdof for mj_jacBody
+            e = (target - d.xpos[self.ix.hml_bodies]).ravel()
+            H = J.T @ (J * self.w[:, None])
+            g = J.T @ (self.w * e)
+            for task in tasks:
+                mj.mj_jacBody(m, d, self.jacp, self.jacr, task.body)
+                H += task.weight * (self.jacp.T @ self.jacp)
+                g += task.weight * (self.jacp.T @ (task.pos - d.xpos[task.body]))
+                if task.rot is not None:
+                    cur = d.xmat[task.body].reshape(3, 3)
+                    H += 0.3 * task.weight * (self.jacr.T @ self.jacr)
+                    E = task.rot @ cur.T  # small-angle rotation error: vee(E - Eᵀ) / 2
+                    rv = 0.5 * np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
+                    g += 0.3 * task.weight * (self.jacr.T @ rv)
+            H[diag, diag] += lam
+            H[diag[6:], diag[6:]] += pw
+            g[6:] -= pw * q[7:]
+            dq = np.linalg.solve(H, g)
+            mj.mj_integratePos(m, q, dq, 1.0)
+            q[7:] = np.clip(q[7:], self.lo, self.hi)
+            if np.max(np.abs(dq)) < 1e-5:
+                break
+        d.qpos[:] = q
+        mj.mj_kinematics(m, d)
+        err = float(np.linalg.norm(target - d.xpos[self.ix.hml_bodies], axis=1).mean())
+        return q, err
+
+
+def _posture_weights(model) -> np.ndarray:
+    """(69,) relative posture-prior weight per hinge: secondary axes (knee and elbow
+    side-bend and twist) are discouraged so that IK bends them like hinges."""
+    import mujoco
+
+    w = np.ones(model.njnt - 1)
+    for i in range(1, model.njnt):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, i)
+        if name.endswith(("Knee_x", "Knee_z", "Elbow_x")):
+            w[i - 1] = 50.0
+        elif name.endswith(("Elbow_z", "Ankle_z", "Ankle_x", "Toe_x", "Toe_z", "Hand_x", "Hand_y", "Hand_z")):
+            w[i - 1] = 5.0
+    return w
+
+
+def ik_sequence(model, target: np.ndarray, cfg: RetargetConfig, tasks: list[list[IKTask]] | None = None,
+                init: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame IK: closed-form, then Gauss-Newton polishing.
+
+    Args:
+        target: (T, 22, 3) world joint positions.
+        tasks: optional per-frame extra tasks.
+        init: optional (T, nq) starting solution; default the closed-form IK of ``target``
+            (:func:`analytic_ik`).
+    Returns:
+        qpos (T, nq) and the mean joint error per frame (T,) in metres.
+    """
+    ik = GaussNewtonIK(model, cfg)
+    if init is None:
+        init, iters = analytic_ik(model, target), cfg.ik_polish_iters
+    else:
+        iters = cfg.ik_iters
+    T = target.shape[0]
+    qs = np.zeros((T, model.nq))
+    errs = np.zeros(T)
+    for t in range(T):
+        qs[t], errs[t] = ik.solve(init[t], target[t], iters, tasks[t] if tasks is not None else [])
+    return qs, errs

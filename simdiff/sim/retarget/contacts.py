@@ -1,0 +1,146 @@
+"""Contact schedule, inferred support, floor level and the stance-holding IK tasks.
+
+Heights in metres (world Z-up), speeds in m/s, schedules (T, 4) bool per foot box
+(L heel box, L toe, R heel box, R toe) at the input rate.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from simdiff.sim.retarget.config import RetargetConfig
+from simdiff.sim.retarget.ik import IKTask
+from simdiff.sim.retarget.kinematics import box_bottom_corners, foot_geoms
+
+
+def _box_speed(xy: np.ndarray, fps: float) -> np.ndarray:
+    """(T, 4) horizontal speed (m/s) of the foot boxes from their centres (T, 4, 2)."""
+    return np.linalg.norm(np.gradient(xy, axis=0) * fps, axis=-1)
+
+
+def contact_schedule(height: np.ndarray, xy: np.ndarray, fps: float, cfg: RetargetConfig) -> np.ndarray:
+    """(T, 4) bool: a foot box touches when low (< contact_height) and slow (< contact_speed)."""
+    speed = _box_speed(xy, fps)
+    c = (height < cfg.contact_height) & (speed < cfg.contact_speed)
+    # a one-frame gap or blip is noise
+    for k in range(4):
+        col = c[:, k]
+        for t in range(1, len(col) - 1):
+            if col[t - 1] == col[t + 1] != col[t]:
+                col[t] = col[t - 1]
+    return c
+
+
+def infer_support(contact: np.ndarray, height: np.ndarray, xy: np.ndarray, com_z: np.ndarray, fps: float,
+                  accel: float, reach: float, max_speed: float = 0.6, gravity: float = 9.81) -> np.ndarray:
+    """(T, 4) bool: foot boxes that must carry the body although the schedule has none down.
+
+    A frame is *supported* when the smoothed COM vertical acceleration exceeds
+    ``-accel·gravity`` (m/s²): a body in free fall accelerates at -g, so anything clearly
+    above that needs a floor force. At supported frames without any scheduled contact, the
+    lowest box is added if its sole is below ``reach`` (m) and it moves slower than
+    ``max_speed`` (m/s, horizontal; a sliding foot is not a support). Contacts are only
+    added, never removed.
+
+    Args:
+        contact: (T, 4) schedule from heights; height: (T, 4) sole heights (m);
+        xy: (T, 4, 2) box centres (m); com_z: (T,) COM height (m); fps: frame rate.
+    """
+    if accel <= 0 or len(com_z) < 5:
+        return np.zeros_like(contact)
+    from scipy.signal import savgol_filter
+
+    # quadratic fits over 5 frames (0.25 s at 20 fps), also at the ends: exact for free fall
+    az = savgol_filter(com_z, 5, 2, deriv=2, delta=1.0 / fps, mode="interp")
+    need = (az > -accel * gravity) & ~contact.any(axis=1)
+    low = height.argmin(axis=1)
+    idx = np.arange(len(low))
+    speed = _box_speed(xy, fps)[idx, low]
+    out = np.zeros_like(contact)
+    rows = np.flatnonzero(need & (height[idx, low] < reach) & (speed < max_speed))
+    out[rows, low[rows]] = True
+    return out
+
+
+def ground_level(height: np.ndarray, xy: np.ndarray, fps: float, still_speed: float = 0.3) -> float:
+    """Floor height (m) of a motion from its foot-box sole heights (T, 4) and centres (T, 4, 2).
+
+    The median sole height of the lowest box over the frames where that box is still
+    (horizontal speed below ``still_speed``): a planted foot is on the floor, whatever the
+    capture's own zero. Falls back to the 10th percentile of the lowest sole when fewer than
+    5 frames are still (a motion that never plants a foot).
+    """
+    low_box = height.argmin(axis=1)
+    low = height[np.arange(len(height)), low_box]
+    speed = _box_speed(xy, fps)[np.arange(len(height)), low_box]
+    still = speed < still_speed
+    if still.sum() >= 5:
+        return float(np.median(low[still]))
+    return float(np.percentile(low, 10))
+
+
+def _intervals(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Half-open [start, end) runs of True."""
+    out, start = [], None
+    for t, v in enumerate(mask):
+        if v and start is None:
+            start = t
+        elif not v and start is not None:
+            out.append((start, t))
+            start = None
+    if start is not None:
+        out.append((start, len(mask)))
+    return out
+
+
+def stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 20.0,
+                  max_tilt: float = np.deg2rad(12.0), reach: np.ndarray | None = None) -> list[list[IKTask]]:
+    """Per-frame tasks that hold each touching foot box flat, on the floor, at a fixed xy.
+
+    Only frames where the box is nearly flat already (tilt below ``max_tilt``) are held: a
+    heel rising at toe-off or a toe coming down at heel strike keeps its own pitch (forcing
+    it flat would pull the whole body out of shape). The hold's weight ramps over the first
+    and last 2 frames of an interval. Boxes marked in ``reach`` (T, 4) (inferred support, see
+    :func:`infer_support`) get a position task that lowers them, tilt kept, until their lowest
+    corner touches the floor.
+    """
+    import mujoco
+
+    d = mujoco.MjData(model)
+    names = ("L_Ankle", "L_Toe", "R_Ankle", "R_Toe")
+    bodies = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in names]
+    # flat-pose height of each body origin above the floor
+    d.qpos[:] = model.qpos0
+    mujoco.mj_kinematics(model, d)
+    geoms = foot_geoms(model)
+    rest_h = [d.xpos[b][2] - box_bottom_corners(model, d, g)[:, 2].min() for b, g in zip(bodies, geoms)]
+    pos = np.zeros((qpos.shape[0], 4, 3))
+    yaw = np.zeros((qpos.shape[0], 4))
+    flat = np.zeros((qpos.shape[0], 4), dtype=bool)
+    for t in range(qpos.shape[0]):
+        d.qpos[:] = qpos[t]
+        mujoco.mj_kinematics(model, d)
+        for k, b in enumerate(bodies):
+            pos[t, k] = d.xpos[b]
+            R = d.xmat[b].reshape(3, 3)
+            yaw[t, k] = np.arctan2(R[1, 0], R[0, 0])
+            flat[t, k] = R[2, 2] > np.cos(max_tilt)
+    tasks: list[list[IKTask]] = [[] for _ in range(qpos.shape[0])]
+    for k, b in enumerate(bodies):
+        for s, e in _intervals(contact[:, k] & flat[:, k]):
+            p = np.median(pos[s:e, k], axis=0)
+            p[2] = rest_h[k]
+            y = float(np.angle(np.mean(np.exp(1j * yaw[s:e, k]))))
+            R = Rotation.from_euler("z", y).as_matrix()
+            for t in range(s, e):  # ramp in and out over 2 frames: no jump when a hold starts
+                ramp = min(1.0, (t - s + 1) / 2, (e - t) / 2)
+                tasks[t].append(IKTask(b, p, R, weight * ramp))
+    if reach is not None:
+        for k, (b, g) in enumerate(zip(bodies, geoms)):
+            for t in np.flatnonzero(reach[:, k]):
+                d.qpos[:] = qpos[t]
+                mujoco.mj_kinematics(model, d)
+                drop = box_bottom_corners(model, d, g)[:, 2].min()
+                tasks[t].append(IKTask(b, d.xpos[b] - np.array([0.0, 0.0, drop]), None, weight))
+    return tasks
