@@ -35,6 +35,8 @@ class FlightConfig:
 
     Attributes:
         min_frames: reference airborne runs shorter than this (control frames) are not flights.
+        lookahead: a simulated take-off up to this many control frames before a reference
+            flight starts belongs to that flight (the clock moves to its first frame).
         min_takeoff_vz: below this simulated take-off speed (m/s) the flight progress is
             counted in control steps instead of by the COM velocity.
         hold_after: control steps the simulation must be airborne while the reference stands
@@ -44,6 +46,7 @@ class FlightConfig:
     """
 
     min_frames: int = 2
+    lookahead: int = 4
     min_takeoff_vz: float = 0.2
     hold_after: int = 2
     max_wait_s: float = 6.0
@@ -98,6 +101,7 @@ class FlightClock:
         self.air_steps = 0  # control steps the simulation has been airborne in a row
         self.v0 = 0.0  # COM v_z at the first airborne step
         self.waited = 0  # control steps held in the current event
+        self.current = -1  # the reference flight the simulated flight belongs to
         self.log: list[int] = [0]
 
     @property
@@ -117,15 +121,17 @@ class FlightClock:
     def advance(self, touching: bool, com_vz: float) -> int:
         """Move to the next control step given the simulation at the end of this one; returns the frame."""
         r, cfg = self.frame, self.cfg
-        fl = self.flight_of[r]
         nxt = r + 1
         if not touching:
             if self.air_steps == 0:
                 self.v0 = float(com_vz)
                 self.waited = 0
+                self.current = self._flight_ahead(r)
             self.air_steps += 1
+            fl = self.current
             if fl >= 0:  # flying through a reference flight: follow the simulated flight's progress
                 s, e = self.flights[fl]
+                nxt = max(r + 1, s)
                 if self.v0 >= cfg.min_takeoff_vz:
                     f = (self.v0 - float(com_vz)) / (2.0 * self.v0)
                     nxt = max(r, s + int(np.floor(f * (e - s))))
@@ -139,14 +145,25 @@ class FlightClock:
                     nxt = r + 1
         else:
             landed = self.air_steps > 0 and com_vz < 0
-            if landed and fl >= 0:
-                nxt = max(r + 1, self.flights[fl][1])  # early touchdown: resume from the landing pose
+            if landed and self.current >= 0:
+                nxt = max(r + 1, self.flights[self.current][1])  # touchdown: resume from the landing pose
+            if landed or self.air_steps == 0:
+                self.current = -1
             self.air_steps = 0
             self.waited = 0
         self.frame = int(min(nxt, self.K - 1))
         self.steps += 1
         self.log.append(self.frame)
         return self.frame
+
+    def _flight_ahead(self, r: int) -> int:
+        """The reference flight frame r is in, or that starts within ``lookahead`` frames; else −1."""
+        if self.flight_of[r] >= 0:
+            return int(self.flight_of[r])
+        for i, (s, _) in enumerate(self.flights):
+            if r < s <= r + self.cfg.lookahead:
+                return i
+        return -1
 
     def _after_flight(self, r: int) -> bool:
         """Frame r is the landing frame of a reference flight (the reference has just landed)."""
