@@ -57,7 +57,6 @@ def clip_list(n: int | None) -> list[str]:
 def run_clip(task: tuple) -> list[dict]:
     """Project one clip under every residual bound; one record per bound (or an error record)."""
     clip, todo, max_frames, gravity, fps = task
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
     from simdiff.motion.normalize import Normalizer
     from simdiff.sim.env import Environment
     from simdiff.sim.project import project
@@ -105,7 +104,10 @@ def main(argv: list[str] | None = None) -> int:
         import multiprocessing as mp
         from concurrent.futures import ProcessPoolExecutor
 
-        ex = ProcessPoolExecutor(max_workers=args.workers, mp_context=mp.get_context("spawn"))
+        from simdiff.sim.pool import limit_threads
+
+        ex = ProcessPoolExecutor(max_workers=args.workers, mp_context=mp.get_context("spawn"),
+                                 initializer=limit_threads, initargs=(1,))
         results = ex.map(run_clip, tasks, chunksize=1)
     else:
         ex, results = None, map(run_clip, tasks)

@@ -55,7 +55,8 @@ def test_pool_serial_and_process():
     motions = [synthetic.standing(12), synthetic.squat(12)]
     envs = [Environment(), Environment(-3.0)]
     serial = ProjectionPool(PoolConfig(backend="serial")).map(motions, envs)
-    par = ProjectionPool(PoolConfig(workers=2)).map(motions, envs)
+    with ProjectionPool(PoolConfig(workers=2)) as pool:
+        par = pool.map(motions, envs)
     for (a, ia), (b, ib) in zip(serial, par):
         assert ia.success == ib.success
         assert np.allclose(a, b)  # deterministic across processes

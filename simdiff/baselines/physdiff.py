@@ -34,11 +34,10 @@ from simdiff.diffusion.sampling import make_scheduler
 from simdiff.errors import SimdiffError
 from simdiff.motion.normalize import Normalizer
 from simdiff.sim.env import Environment
+from simdiff.sim.pool import Projector
 
 PHYSDIFF_TIMESTEPS: tuple[int, ...] = (60, 40, 20, 0)
 """End4/Space1 in original timestep indices (the last four DDIM-50 steps)."""
-
-Projector = Callable[[Sequence[np.ndarray], Sequence[Environment]], Iterable[tuple[np.ndarray | None, Any]]]
 
 
 @dataclass

@@ -2,15 +2,24 @@
 
 Each task is one ``(joints, env)`` pair; the result is ``(rollout_joints, ProjectionInfo)``
 in input order. A task that raises (bad input, MuJoCo error) yields ``(None, error string)``
-instead of stopping the batch. Workers build the humanoid once (cached per process).
+instead of stopping the batch. The local process pool is kept alive across calls (close it
+with :meth:`ProjectionPool.close` or use the pool as a context manager); each worker caps
+its BLAS / OpenMP / torch threads to one (:func:`limit_threads`) before its first task.
+
+A *projector* (:data:`Projector`) is any callable ``(motions, envs) -> iterable of
+(rollout | None, info)`` in input order; a :class:`ProjectionPool`'s :meth:`~ProjectionPool.imap`
+is one, the augmentation and the PhysDiff baseline take any (tests inject fakes).
 """
 
 from __future__ import annotations
 
+import functools
 import os
+import sys
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from typing import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -44,7 +53,34 @@ class PoolConfig:
     extra: dict = field(default_factory=dict)
 
 
+Result = tuple[np.ndarray | None, Any]
+Projector = Callable[[Sequence[np.ndarray], Sequence[Environment]], Iterable[Result]]
+
+_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 _NORMALIZER_CACHE: dict[str, object] = {}
+
+
+def limit_threads(n: int = 1) -> None:
+    """Cap this process's BLAS / OpenMP thread pools and torch's intra-op threads to ``n``.
+
+    Setting ``OMP_NUM_THREADS`` only works before numpy or torch load their thread pools, and a
+    worker has imported numpy by the time its initializer runs; so the already loaded pools are
+    resized through threadpoolctl (and ``torch.set_num_threads`` when torch is loaded), and the
+    variables are set too for libraries loaded later.
+    """
+    from threadpoolctl import threadpool_limits
+
+    for var in _THREAD_VARS:
+        os.environ[var] = str(n)
+    threadpool_limits(limits=n)
+    if "torch" in sys.modules:
+        sys.modules["torch"].set_num_threads(n)
+
+
+@functools.lru_cache(maxsize=1)
+def _single_threaded_worker() -> None:
+    """:func:`limit_threads` once per worker process (Ray workers have no initializer)."""
+    limit_threads(1)
 
 
 def _normalizer(stats_dir: str | None):
@@ -59,7 +95,6 @@ def _normalizer(stats_dir: str | None):
 
 def _run_one(args: tuple[np.ndarray, tuple[float, float, float], PoolConfig]) -> tuple[np.ndarray | None, ProjectionInfo | str]:
     joints, phi, cfg = args
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
     try:
         return project(
             joints, Environment(*phi), residual=cfg.residual, retarget=cfg.retarget,
@@ -69,39 +104,72 @@ def _run_one(args: tuple[np.ndarray, tuple[float, float, float], PoolConfig]) ->
         return None, f"{type(exc).__name__}: {exc}"
 
 
+def _run_one_pooled(args: tuple[np.ndarray, tuple[float, float, float], PoolConfig]) -> Result:
+    """:func:`_run_one` in a pool worker: single-threaded BLAS / OpenMP / torch first."""
+    _single_threaded_worker()
+    return _run_one(args)
+
+
 class ProjectionPool:
     """Run :func:`project` over many motions.
 
     Example:
-        >>> pool = ProjectionPool(PoolConfig(workers=2))
-        >>> results = pool.map([joints_a, joints_b], [Environment(), Environment(-3.0)])
+        >>> with ProjectionPool(PoolConfig(workers=2)) as pool:
+        ...     results = pool.map([joints_a, joints_b], [Environment(), Environment(-3.0)])
     """
 
     def __init__(self, config: PoolConfig = PoolConfig()) -> None:
         if config.backend not in ("process", "ray", "serial"):
             raise SimdiffError(f"unknown pool backend {config.backend!r} (process, ray, serial)")
         self.cfg = config
+        self._executor: ProcessPoolExecutor | None = None
+
+    def __enter__(self) -> "ProjectionPool":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __call__(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:
+        """:meth:`imap`: a pool is a :data:`Projector`."""
+        return self.imap(motions, envs)
 
     def map(
         self, motions: Sequence[np.ndarray], envs: Iterable[Environment] | Environment = Environment()
     ) -> list[tuple[np.ndarray | None, ProjectionInfo | str]]:
-        """Project every motion under its environment (one env for all, or one per motion)."""
+        """Project every motion under its environment (one env for all, or one per motion).
+
+        Every environment is validated first (``SimdiffError`` names a bad one).
+        """
         envs_list = [envs] * len(motions) if isinstance(envs, Environment) else list(envs)
         if len(envs_list) != len(motions):
             raise SimdiffError(f"{len(motions)} motions but {len(envs_list)} environments")
         for e in envs_list:
             e.validate(force=self.cfg.force)
-        tasks = [(np.asarray(m, dtype=np.float32), e.as_tuple(), self.cfg) for m, e in zip(motions, envs_list)]
+        return list(self.imap(motions, envs_list))
+
+    def imap(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:
+        """Results in input order as they arrive; a bad environment is that pair's error string."""
+        if len(envs) != len(motions):
+            raise SimdiffError(f"{len(motions)} motions but {len(envs)} environments")
+        tasks = [(np.asarray(m, dtype=np.float32), e.as_tuple(), self.cfg) for m, e in zip(motions, envs)]
         workers = self.cfg.workers or os.cpu_count() or 1
         if self.cfg.backend == "serial" or (self.cfg.backend == "process" and workers == 1):
-            return [_run_one(t) for t in tasks]
-        if self.cfg.backend == "process":
+            return (_run_one(t) for t in tasks)
+        if self.cfg.backend == "ray":
+            return iter(self._map_ray(tasks, workers))
+        if self._executor is None:
             import multiprocessing as mp
 
-            ctx = mp.get_context("spawn")
-            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as ex:
-                return list(ex.map(_run_one, tasks, chunksize=1))
-        return self._map_ray(tasks, workers)
+            self._executor = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                                                 initializer=limit_threads, initargs=(1,))
+        return self._executor.map(_run_one, tasks, chunksize=1)
+
+    def close(self) -> None:
+        """Shut the worker processes down (a later call starts new ones)."""
+        if self._executor is not None:
+            self._executor.shutdown(wait=True, cancel_futures=True)
+            self._executor = None
 
     def _map_ray(self, tasks: list, workers: int) -> list:
         try:
@@ -110,7 +178,7 @@ class ProjectionPool:
             raise SimdiffError("the ray backend needs Ray: pip install 'simdiff[cluster]'") from exc
         if not ray.is_initialized():
             ray.init(address=self.cfg.ray_address, ignore_reinit_error=True, log_to_driver=False)
-        remote = ray.remote(num_cpus=1)(_run_one)
+        remote = ray.remote(num_cpus=1)(_run_one_pooled)
         pending = []
         results: list = [None] * len(tasks)
         refs = {}

@@ -5,10 +5,10 @@ Modules: ``conditions`` (binary / random φ), ``filter`` (pure keep rule), ``pro
 driver and report), ``dataset`` (items with ``env`` / ``env_index`` for adapter training).
 """
 
-from simdiff.data.augment.conditions import Condition, binary_conditions, make_conditions, random_conditions
+from simdiff.data.augment.conditions import AugmentEnv, binary_conditions, make_conditions, random_conditions
 from simdiff.data.augment.dataset import AugmentedHumanML3D, open_training_dataset, read_env_table
 from simdiff.data.augment.filter import FilterConfig, keep_pair
 from simdiff.data.augment.run import AugmentConfig, augment
 
-__all__ = ["AugmentConfig", "AugmentedHumanML3D", "Condition", "FilterConfig", "augment", "binary_conditions",
+__all__ = ["AugmentConfig", "AugmentEnv", "AugmentedHumanML3D", "FilterConfig", "augment", "binary_conditions",
            "keep_pair", "make_conditions", "open_training_dataset", "random_conditions", "read_env_table"]

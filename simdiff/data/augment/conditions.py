@@ -22,7 +22,7 @@ FACTORS: tuple[str, ...] = ("gravity", "wind_x", "wind_y")
 
 
 @dataclass(frozen=True)
-class Condition:
+class AugmentEnv:
     """One environment of the augmentation.
 
     Attributes:
@@ -39,22 +39,22 @@ class Condition:
         return {"index": self.index, "factor": self.factor, "env": list(self.env.as_tuple())}
 
     @classmethod
-    def from_dict(cls, data: dict) -> "Condition":
+    def from_dict(cls, data: dict) -> "AugmentEnv":
         return cls(int(data["index"]), str(data["factor"]), Environment(*map(float, data["env"])))
 
 
-def binary_conditions() -> list[Condition]:
+def binary_conditions() -> list[AugmentEnv]:
     """The single Earth condition of the binary setting."""
-    return [Condition(0, "earth", Environment(EARTH_GRAVITY, 0.0, 0.0))]
+    return [AugmentEnv(0, "earth", Environment(EARTH_GRAVITY, 0.0, 0.0))]
 
 
-def random_conditions(n: int = 30, seed: int = 0) -> list[Condition]:
+def random_conditions(n: int = 30, seed: int = 0) -> list[AugmentEnv]:
     """``n`` one-factor-at-a-time environments, deterministic under ``seed`` (values rounded to 1e-4)."""
     if n < 1:
         raise SimdiffError(f"--conditions must be at least 1, got {n}")
     rng = np.random.default_rng([seed, 0xA06])
     lo, hi = GRAVITY_RANGE
-    out: list[Condition] = []
+    out: list[AugmentEnv] = []
     for i in range(n):
         factor = FACTORS[i % 3]
         if factor == "gravity":
@@ -63,11 +63,11 @@ def random_conditions(n: int = 30, seed: int = 0) -> list[Condition]:
             env = Environment(EARTH_GRAVITY, round(float(rng.uniform(-MAX_WIND, MAX_WIND)), 4), 0.0)
         else:
             env = Environment(EARTH_GRAVITY, 0.0, round(float(rng.uniform(-MAX_WIND, MAX_WIND)), 4))
-        out.append(Condition(i, factor, env.validate()))
+        out.append(AugmentEnv(i, factor, env.validate()))
     return out
 
 
-def make_conditions(mode: str, n: int = 30, seed: int = 0) -> list[Condition]:
+def make_conditions(mode: str, n: int = 30, seed: int = 0) -> list[AugmentEnv]:
     """Conditions of ``mode`` (``binary`` ignores ``n`` and ``seed``)."""
     if mode == "binary":
         return binary_conditions()

@@ -36,7 +36,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from simdiff.data.augment.conditions import Condition, make_conditions
+from simdiff.data.augment.conditions import AugmentEnv, make_conditions
 from simdiff.data.augment.filter import REASONS, FilterConfig, keep_pair
 from simdiff.data.augment.projector import Projector, SimProjector
 from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_npy
@@ -88,8 +88,8 @@ class AugmentConfig:
         return settings
 
 
-def assign_conditions(clips: Sequence[str], conditions: Sequence[Condition], per_clip: int | None
-                      ) -> dict[str, list[Condition]]:
+def assign_conditions(clips: Sequence[str], conditions: Sequence[AugmentEnv], per_clip: int | None
+                      ) -> dict[str, list[AugmentEnv]]:
     """Conditions each clip is projected under: all, or ``per_clip`` of them round-robin.
 
     Clip ``k`` of the split gets conditions ``k·per_clip … k·per_clip + per_clip − 1`` (mod the number
@@ -103,12 +103,12 @@ def assign_conditions(clips: Sequence[str], conditions: Sequence[Condition], per
     return {c: [conditions[(k * per_clip + j) % n] for j in range(per_clip)] for k, c in enumerate(clips)}
 
 
-def clip_id_for(clip: str, condition: Condition) -> str:
+def clip_id_for(clip: str, condition: AugmentEnv) -> str:
     """Id of the augmented copy of ``clip`` under ``condition``."""
     return f"{clip}_e{condition.index:02d}"
 
 
-def env_index_for(mode: str, condition: Condition) -> int:
+def env_index_for(mode: str, condition: AugmentEnv) -> int:
     """Categorical label of a simulated clip (see module docstring)."""
     return BINARY_SIM_INDEX if mode == "binary" else condition.index
 
@@ -161,7 +161,7 @@ def _read_json(path: Path) -> Any:
         raise SimdiffError(f"cannot read {path}: {exc}") from None
 
 
-def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[Condition], list[list[str]]]:
+def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[AugmentEnv], list[list[str]]]:
     """(clip ids, conditions, shards as lists of clip ids) for a run; validates the corpus."""
     from simdiff.data.humanml3d import read_split
 
@@ -186,7 +186,7 @@ def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[Condition
     return clips, conditions, shards
 
 
-def _check_settings(out: Path, config: AugmentConfig, conditions: list[Condition]) -> None:
+def _check_settings(out: Path, config: AugmentConfig, conditions: list[AugmentEnv]) -> None:
     settings = {**config.settings(), "condition_list": [c.to_dict() for c in conditions]}
     path = out / SETTINGS_NAME
     if path.is_file():
@@ -198,7 +198,7 @@ def _check_settings(out: Path, config: AugmentConfig, conditions: list[Condition
         write_json(path, settings)
 
 
-def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[Condition]],
+def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[AugmentEnv]],
                config: AugmentConfig, projector: Projector, tick: Callable[[int], None]) -> dict[str, Any]:
     """Project, filter and write one shard; returns its record (written by the caller)."""
     motions, envs, pairs, load_errors = [], [], [], {}
@@ -285,7 +285,7 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
     return finalize(corpus, out, config, conditions, len(shards), wall_s=time.time() - start)
 
 
-def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequence[Condition], n_shards: int,
+def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequence[AugmentEnv], n_shards: int,
              wall_s: float = 0.0) -> dict[str, Any]:
     """Write splits, env.json, Mean/Std and the report from the finished shards; drop orphan files."""
     records: list[dict[str, Any]] = []
@@ -326,7 +326,7 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
     return report
 
 
-def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Condition], config: AugmentConfig) -> dict[str, Any]:
+def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[AugmentEnv], config: AugmentConfig) -> dict[str, Any]:
     """Kept fraction and reasons per condition and overall, and the simulator CPU time."""
     rows = []
     for cond in conditions:
