@@ -96,3 +96,52 @@ def test_aligned_source_holds_the_source_while_the_clock_waits():
     assert np.allclose(src[:2], [0.0, 1.0])  # 0.05 s → control step 1.5 → reference 0.05 s → source frame 1
     assert np.allclose(src[2:5], 2.0)  # 0.10–0.20 s: held at reference frame 3 (0.1 s → source frame 2)
     assert np.allclose(src[5:], [3.0, 4.0])  # then on at the normal rate
+
+
+def _longest_flight(res) -> tuple[int, int]:
+    air = np.append(res.airborne, False)
+    runs, start = [], None
+    for i, a in enumerate(air):
+        if a and start is None:
+            start = i
+        elif not a and start is not None:
+            runs.append((start, i))
+            start = None
+    return max(runs, key=lambda r: r[1] - r[0]) if runs else (0, 0)
+
+
+def test_synthetic_jump_follows_ballistics_at_three_gravities_and_lands():
+    pytest.importorskip("mujoco")
+    import mujoco
+
+    from simdiff.sim import synthetic
+    from simdiff.sim.env import Environment
+    from simdiff.sim.humanoid import load_model
+    from simdiff.sim.retarget import make_reference
+    from simdiff.sim.rollout import rollout
+
+    m = load_model()
+    jump = synthetic.vertical_jump(height=0.3)
+    d = mujoco.MjData(m)
+    norm, flight = {}, {}
+    for g in (-1.6, -3.0, -9.81):
+        ref = make_reference(m, jump, gravity=g)
+        res = rollout(m, ref, Environment(g), flight=FlightConfig(), audit=True)
+        assert res.status == "ok", g  # lands without a fall and finishes the motion
+        assert not res.violations and not np.any(res.residual[res.airborne])
+        assert res.ref_frames[-1] == ref.num_frames - 1
+        s, e = _longest_flight(res)
+        com = []
+        for q in res.qpos[s : s + 2]:
+            d.qpos[:] = q
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            com.append(d.subtree_com[1, 2])
+        v = (com[1] - com[0]) / res.timestep  # simulated take-off speed (m/s)
+        assert v > 0.3, g
+        flight[g] = (e - s) * res.timestep
+        norm[g] = flight[g] * abs(g) / v  # ballistic: 2 for a landing at the take-off height
+    assert flight[-1.6] > 3 * flight[-9.81]  # the clock let the long flight happen
+    vals = np.array(list(norm.values()))
+    assert vals.max() / vals.min() < 1.1, norm  # same take-off speed → flight time ∝ 1/|g|, within 10 %
+    assert np.all(np.abs(vals / 2 - 1) < 0.2), norm

@@ -123,15 +123,16 @@ class RolloutResult:
         return self.status == "ok"
 
     def residual_stats(self) -> dict[str, float]:
-        """Mean/peak residual force as a fraction of m·g, and torque in N·m (over all steps)."""
+        """Mean/peak residual force as a fraction of m·g and in N, and torque in N·m (over all steps)."""
         if self.residual.shape[0] == 0:
-            return {"force_mean_mg": 0.0, "force_peak_mg": 0.0, "torque_mean_nm": 0.0, "torque_peak_nm": 0.0,
+            return {"force_mean_mg": 0.0, "force_mean_n": 0.0, "force_peak_mg": 0.0, "torque_mean_nm": 0.0, "torque_peak_nm": 0.0,
                     "airborne_frac": 0.0, "airborne_force_max_n": 0.0}
         f = np.linalg.norm(self.residual[:, :3], axis=1) / (self.mass * self.gravity)
         t = np.linalg.norm(self.residual[:, 3:], axis=1)
         air = self.airborne
         return {
             "force_mean_mg": float(f.mean()),
+            "force_mean_n": float(f.mean() * self.mass * self.gravity),
             "force_peak_mg": float(f.max()),
             "torque_mean_nm": float(t.mean()),
             "torque_peak_nm": float(t.max()),
