@@ -20,6 +20,8 @@ FEET: tuple[int, ...] = (7, 10, 8, 11)
 """HumanML3D left ankle, left foot, right ankle, right foot."""
 LIFT: float = 0.05
 """m: a foot joint this far above its own low level (5th percentile) is off the floor."""
+LIFT_EDGE: float = 0.01
+"""m: a flight found with :data:`LIFT` extends to the frames where every foot joint is this far up."""
 GRAVITY_EDGES: tuple[float, ...] = (-20.0, -15.0, -11.0, -8.5, -5.0, -3.0, -1.0)
 WIND_EDGES: tuple[float, ...] = (-10.0, -5.0, 0.0, 5.0, 10.0)
 
@@ -55,9 +57,18 @@ def measure(joints: np.ndarray, fps: float = 20.0) -> dict[str, float]:
         raise SimdiffError(f"expected joints of shape (T>=2, 22, 3), got {j.shape}")
     T = j.shape[0]
     h = j[:, FEET, 1]
-    up = h > np.percentile(h, 5, axis=0) + LIFT
+    low = np.percentile(h, 5, axis=0)
+    up = h > low + LIFT
     air = up.all(axis=1)
-    flights = [(s, e) for s, e in _runs(air) if e - s >= 2 and s > 0]
+    edge = (h > low + LIFT_EDGE).all(axis=1)
+    flights = []
+    for s, e in _runs(air):
+        while s > 1 and edge[s - 1]:
+            s -= 1
+        while e < T and edge[e]:
+            e += 1
+        if e - s >= 2 and s > 0 and (not flights or s >= flights[-1][1]):
+            flights.append((s, e))
     root = j[:, 0]
     out: dict[str, float] = {"duration_s": (T - 1) / fps, "flights": float(len(flights)),
                              "flight_s": 0.0, "flight_total_s": float(sum(e - s for s, e in flights) / fps),
