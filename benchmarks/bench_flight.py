@@ -61,7 +61,7 @@ def flight_record(model, res, g: float) -> dict:
     z = _com(model, res.qpos[s : e + 1])
     vz = float((z[1] - z[0]) / dt) if len(z) > 1 else 0.0
     rec.update(flight_s=float((e - s) * dt), takeoff_vz=vz, apex_gain_m=float(z.max() - z[0]),
-               landing_drop_m=float(z[0] - z[-1]))
+               landing_drop_m=float(z[0] - z[-1]), flight_start_s=float(s * dt), flight_end_s=float(e * dt))
     if vz > 0:
         rec.update(pred_flight_s=2 * vz / abs(g), pred_apex_gain_m=vz**2 / (2 * abs(g)))
     return rec
@@ -90,6 +90,9 @@ def run_task(task: tuple) -> dict:
            "residual_mean_mg": res.residual_stats()["force_mean_mg"],
            "airborne_force_max_n": res.residual_stats()["airborne_force_max_n"]}
     rec.update(flight_record(m, res, g))
+    # landed: the longest flight ended on the floor and the rollout went on ≥ 0.5 s to its end without a fall
+    rec["landed_ok"] = bool(res.status == "ok" and rec.get("flight_end_s") is not None
+                            and rec["sim_s"] - rec["flight_end_s"] >= 0.5)
     rec["cpu_s"] = time.process_time() - t0
     return rec
 
@@ -105,13 +108,15 @@ def summary(path: Path) -> dict:
         for g in sorted({r["g"] for r in mine}):
             rs = [r for r in mine if r["g"] == g]
             ok = [r for r in rs if r["status"] == "ok"]
+            landed = [r for r in rs if r.get("landed_ok")]
             ratio = [r["flight_s"] / by[(r["clip"], -9.81)]["flight_s"] for r in rs
                      if (r["clip"], -9.81) in by and by[(r["clip"], -9.81)]["flight_s"] > 0]
             fit_t = [r["flight_s"] / r["pred_flight_s"] for r in rs if r.get("pred_flight_s") and r["takeoff_vz"] > 0.5]
             fit_h = [r["apex_gain_m"] / r["pred_apex_gain_m"] for r in rs if r.get("pred_apex_gain_m") and r["takeoff_vz"] > 0.5]
             vz = [r["takeoff_vz"] for r in rs if r["takeoff_vz"] is not None]
             rows[str(g)] = {
-                "clips": len(rs), "landed_ok": len(ok), "ok_rate": len(ok) / len(rs) if rs else None,
+                "clips": len(rs), "ok": len(ok), "ok_rate": len(ok) / len(rs) if rs else None,
+                "landed_ok": len(landed) if all("landed_ok" in r for r in rs) else None,
                 "flight_s_median": float(np.median([r["flight_s"] for r in rs])) if rs else None,
                 "flight_ratio_vs_earth_median": float(np.median(ratio)) if ratio else None,
                 "flight_ratio_ge3": int(sum(x >= 3 for x in ratio)),
