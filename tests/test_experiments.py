@@ -16,12 +16,19 @@ from simdiff.eval.experiments.runner import Runner
 from simdiff.eval.experiments.table2 import select_alpha
 from simdiff.eval.experiments.testing import EchoProjector, write_tiny_setup
 from simdiff.motion.synthetic import jump, walk
+from simdiff.text.base import text_dim
+from simdiff.train.testing import HashTextEncoder
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 PROTO = {"replications": 2, "batch_size": 8, "samples_limit": 0, "diversity_times": 8, "mm_prompts": 2, "mm_repeats": 2,
          "mm_times": 1, "seed": 0}
 FAST = {"steps": 2, "ddpm_steps": 5}
 PHYS = {"project_at": [500, 0]}  # steps of both DDIM-2 and DDPM-5
+
+
+def hash_text(name: str) -> HashTextEncoder:
+    """The injected stand-in for each model's own text encoder (right size, no weights)."""
+    return HashTextEncoder(text_dim(name))
 
 
 @pytest.fixture(autouse=True, scope="module")
@@ -42,7 +49,7 @@ def setup(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 
 def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -> Path:
-    """A config of ``kind`` over the tiny setup (hash text encoder, tiny protocol)."""
+    """A config of ``kind`` over the tiny setup (tiny protocol; run it with ``text_encoder=hash_text``)."""
     models = extra.pop("models", None) or {
         "table1": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                    {"name": "SimDiff", "model": "adapters_binary", "env_index": 1, **FAST}],
@@ -56,7 +63,7 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
     cfg = {"name": name or kind, "kind": kind, "corpus": str(setup["corpus"]),
            "paths": {r: str(setup[r]) for r in ("backbone", "adapters", "adapters_binary")},
            "evaluator": {"kind": "ours", "path": str(setup["evaluator"])}, "protocol": PROTO, "models": models,
-           "out_dir": str(setup["root"] / "reports"), "text_encoder": "hash", **extra}
+           "out_dir": str(setup["root"] / "reports"), **extra}
     path = setup["root"] / f"eval_{name or kind}.json"
     path.write_text(json.dumps(cfg))
     return path
@@ -122,7 +129,7 @@ def test_motion_stats_apex_and_drift() -> None:
 
 def test_table2_then_table1_best_alpha_reuse_and_resume(setup: dict[str, Path], monkeypatch: pytest.MonkeyPatch) -> None:
     sim = EchoProjector()
-    t2 = run_experiment(write(setup, "table2", alphas=[0.1, 1.0]), projector=sim, progress=False, command=["simdiff", "t2"])
+    t2 = run_experiment(write(setup, "table2", alphas=[0.1, 1.0]), projector=sim, progress=False, command=["simdiff", "t2"], text_encoder=hash_text)
     assert [r["alpha"] for r in t2["rows"]] == [0.1, 1.0]
     assert t2["rows"][0]["summary"]["fid"]["mean"] != t2["rows"][1]["summary"]["fid"]["mean"]  # α reaches the model
     best = t2["best_alpha"]["alpha"]
@@ -130,7 +137,7 @@ def test_table2_then_table1_best_alpha_reuse_and_resume(setup: dict[str, Path], 
 
     t1_path = write(setup, "table1", samplers=["ddpm", "ddim"], alphas=[0.1, "best"], reuse_rows_from=["table2"],
                     ddpm_samples=3)
-    t1 = run_experiment(t1_path, projector=sim, progress=False, command=["simdiff", "t1"])
+    t1 = run_experiment(t1_path, projector=sim, progress=False, command=["simdiff", "t1"], text_encoder=hash_text)
     keys = [r["key"] for r in t1["rows"]]
     expect = ["ground_truth", "MDM_ddpm", "MDM_ddim", "PhysDiff_ddpm", "PhysDiff_ddim", "SimDiff_ddpm_alpha0.1"]
     if best == 1.0:
@@ -167,7 +174,7 @@ def test_table2_then_table1_best_alpha_reuse_and_resume(setup: dict[str, Path], 
     monkeypatch.setattr(Runner, "protocol_measure", boom)
     monkeypatch.setattr(Runner, "subset_measure", boom)
     monkeypatch.setattr(Runner, "gt_measure", boom)
-    again = run_experiment(t1_path, projector=sim, progress=False)
+    again = run_experiment(t1_path, projector=sim, progress=False, text_encoder=hash_text)
     assert [r["summary"] if "summary" in r else r["physics"] for r in again["rows"]] == \
            [r["summary"] if "summary" in r else r["physics"] for r in t1["rows"]]
     assert [p["state"] for p in plan_experiment(t1_path)] == ["cached"] * len(keys)
@@ -179,7 +186,7 @@ def test_fig4_times_every_method_and_sampler(setup: dict[str, Path]) -> None:
     sim = EchoProjector()
     report = run_experiment(write(setup, "fig4", samplers=["ddpm", "ddim"],
                                   timing={"text": "a person jumps", "length": 24, "repeats": 3, "ddpm_repeats": 1, "warmup": 1}),
-                            projector=sim, progress=False)
+                            projector=sim, progress=False, text_encoder=hash_text)
     cells = {(r["method"], r["sampler"]): r for r in report["rows"]}
     assert set(cells) == {(m, s) for m in ("MDM", "PhysDiff", "SimDiff") for s in ("ddpm", "ddim")}
     assert len(cells["MDM", "ddim"]["times_s"]) == 3 and len(cells["MDM", "ddpm"]["times_s"]) == 1
@@ -193,7 +200,7 @@ def test_fig4_times_every_method_and_sampler(setup: dict[str, Path]) -> None:
 def test_fig5_sweeps_combination_and_filmstrips(setup: dict[str, Path]) -> None:
     control = {"prompts": ["a person jumps"], "seeds": 2, "length": 20, "gravity": [-1.0, -9.81], "wind": [0.0, 10.0],
                "combos": [[-3.0, 7.0, 7.0]], "alpha": 1.0, "filmstrip_frames": 2}
-    report = run_experiment(write(setup, "fig5", env_control=control), progress=False)
+    report = run_experiment(write(setup, "fig5", env_control=control), progress=False, text_encoder=hash_text)
     envs = [(r["method"], r["factor"], tuple(r["env"]) if r["env"] else None) for r in report["rows"]]
     assert envs == [("MDM", "reference", None), ("SimDiff", "gravity", (-1.0, 0.0, 0.0)), ("SimDiff", "gravity", (-9.81, 0.0, 0.0)),
                     ("SimDiff", "wind_x", (-9.81, 10.0, 0.0)), ("SimDiff", "wind_y", (-9.81, 0.0, 10.0)),
@@ -211,7 +218,7 @@ def test_fig5_sweeps_combination_and_filmstrips(setup: dict[str, Path]) -> None:
 
 def test_retrack_reports_tracked_fraction_per_method_and_env(setup: dict[str, Path]) -> None:
     sim = EchoProjector(fail_every=2)
-    report = run_experiment(write(setup, "retrack", envs=[[-3.0, 0.0, 0.0]], retrack_samples=4), projector=sim, progress=False)
+    report = run_experiment(write(setup, "retrack", envs=[[-3.0, 0.0, 0.0]], retrack_samples=4), projector=sim, progress=False, text_encoder=hash_text)
     rows = {r["method"]: r for r in report["rows"]}
     assert set(rows) == {"Ground truth", "MDM", "PhysDiff", "SimDiff"}
     for r in rows.values():
@@ -231,7 +238,7 @@ def test_run_all_only_and_missing_model(setup: dict[str, Path], tmp_path: Path) 
         (configs / f"eval_{kind}.json").write_text(path.read_text())
     logs: list[str] = []
     reports = run_all(configs, only=["fig4", "table2"], overrides=[("samplers", ["ddim"])], projector=EchoProjector(),
-                      progress=False, log=logs.append)
+                      progress=False, log=logs.append, text_encoder=hash_text)
     assert [r["kind"] for r in reports] == ["table2", "fig4"]  # dependency order, not the order asked
     assert "estimated" in logs[0] and len(logs) == 4
     with pytest.raises(SimdiffError, match="unknown experiment 'fig9'"):
@@ -274,3 +281,8 @@ def test_table1_uses_the_best_alpha_known_when_it_started(setup: dict[str, Path]
     value, source = table1.best_alpha(runner)  # the report appeared mid-run: this run keeps what it planned with
     assert value is None and "run table2 first" in source
     assert [p.key for p in table1.plan(Runner(config, progress=False))][-1] == "SimDiff_ddim_alpha0.5"
+
+
+def test_config_refuses_a_text_encoder_stand_in(setup: dict[str, Path]) -> None:
+    with pytest.raises(SimdiffError, match="text_encoder 'hash' must be \"auto\""):
+        load_config(write(setup, "fig4", name="hash_encoder", text_encoder="hash"))

@@ -67,6 +67,8 @@ def test_imap_reports_a_bad_environment_per_pair_and_map_refuses_it():
     assert out[0][0] is None and "-50" in out[0][1]
     with pytest.raises(SimdiffError, match="-50"):
         pool.map([synthetic.standing(12)], [Environment(-50.0)])
+    bad = pool.map([np.zeros((3, 22, 3))])  # a bad motion is that pair's error, not the batch's
+    assert bad[0][0] is None and "too short" in bad[0][1]
     with pytest.raises(SimdiffError, match="2 motions but 1"):
         list(pool.imap([synthetic.standing(12)] * 2, [Environment()]))
 

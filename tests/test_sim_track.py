@@ -46,19 +46,3 @@ def test_track_bad_phi(motion_file, capsys, argv):
 
 def test_track_missing_file(tmp_path, capsys):
     assert main(["track", str(tmp_path / "nope.npy")]) == 2
-
-
-def test_pool_serial_and_process():
-    from simdiff.sim.env import Environment
-    from simdiff.sim.pool import PoolConfig, ProjectionPool
-
-    motions = [synthetic.standing(12), synthetic.squat(12)]
-    envs = [Environment(), Environment(-3.0)]
-    serial = ProjectionPool(PoolConfig(backend="serial")).map(motions, envs)
-    with ProjectionPool(PoolConfig(workers=2)) as pool:
-        par = pool.map(motions, envs)
-    for (a, ia), (b, ib) in zip(serial, par):
-        assert ia.success == ib.success
-        assert np.allclose(a, b)  # deterministic across processes
-    bad = ProjectionPool(PoolConfig(backend="serial")).map([np.zeros((3, 22, 3))])
-    assert bad[0][0] is None and "too short" in bad[0][1]

@@ -117,3 +117,46 @@ def test_cache_encodes_each_caption_once(tmp_path) -> None:
     other.load(tmp_path / "cache.safetensors")
     assert len(other) == 3 and torch.equal(other.encode(["jump"]), b[1:])
     assert other.encoder.seen == []
+
+
+def _torchscript_archive(state: dict, path) -> None:
+    """A TorchScript archive holding ``state`` under OpenAI's key names (as ViT-B-32.pt does)."""
+    root = torch.nn.Module()
+    for key, value in state.items():
+        *parents, leaf = key.split(".")
+        mod = root
+        for name in parents:
+            if not hasattr(mod, name):
+                mod.add_module(name, torch.nn.Module())
+            mod = getattr(mod, name)
+        mod.register_parameter(leaf, torch.nn.Parameter(value))
+    torch.jit.save(torch.jit.script(root), str(path))
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")  # torch.jit is deprecated; OpenAI ships TorchScript
+def test_clip_refuses_torchscript_and_converts_a_trusted_copy(tmp_path, capsys) -> None:
+    from safetensors.torch import load_file
+
+    from simdiff.text.clip import is_torchscript
+    from simdiff.text.clip_convert import main as convert_main
+
+    weights = _tiny_clip(tmp_path)
+    state = load_file(str(weights))
+    archive = tmp_path / "ViT-B-32.pt"
+    _torchscript_archive(state, archive)
+    assert is_torchscript(archive) and not is_torchscript(weights)
+    with pytest.raises(SimdiffError, match="TorchScript archive.*clip_convert"):
+        load_text_encoder("clip", weights=str(archive))
+    assert convert_main([str(archive), str(tmp_path / "converted.safetensors")]) == 0
+    converted = load_file(str(tmp_path / "converted.safetensors"))
+    assert "visual.proj" not in converted and set(converted) == set(state) - {"visual.proj"}
+    captions = ["walk", "jump walk"]
+    ref = load_text_encoder("clip", weights=str(weights)).encode(captions)
+    assert torch.equal(load_text_encoder("clip", weights=str(tmp_path / "converted.safetensors")).encode(captions), ref)
+    torch.save(state, tmp_path / "plain.pt")  # a plain state dict is read with weights_only=True
+    assert torch.equal(load_text_encoder("clip", weights=str(tmp_path / "plain.pt")).encode(captions), ref)
+    (tmp_path / "junk.pt").write_bytes(b"not a checkpoint")
+    with pytest.raises(SimdiffError, match="junk.pt: not a CLIP state dict"):
+        load_text_encoder("clip", weights=str(tmp_path / "junk.pt"))
+    assert convert_main([str(tmp_path / "plain.pt"), str(tmp_path / "x.safetensors")]) == 2
+    assert "not a TorchScript archive" in capsys.readouterr().err

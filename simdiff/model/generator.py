@@ -18,9 +18,7 @@ from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
 from simdiff.model.condition import Condition
 from simdiff.model.config import ModelConfig
-
-MAX_FRAMES = 196
-"""Longest motion (9.8 s at 20 fps)."""
+from simdiff.motion.skeleton import MAX_FRAMES
 
 
 @dataclass

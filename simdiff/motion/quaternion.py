@@ -9,6 +9,16 @@ from __future__ import annotations
 import numpy as np
 
 
+def wxyz_to_xyzw(q: np.ndarray) -> np.ndarray:
+    """Scalar-first (w, x, y, z: ours, MuJoCo's) → scalar-last (x, y, z, w: scipy's ``Rotation``), (..., 4)."""
+    return np.asarray(q)[..., [1, 2, 3, 0]]
+
+
+def xyzw_to_wxyz(q: np.ndarray) -> np.ndarray:
+    """Scalar-last (x, y, z, w: scipy's ``Rotation``) → scalar-first (w, x, y, z), (..., 4)."""
+    return np.asarray(q)[..., [3, 0, 1, 2]]
+
+
 def qnormalize(q: np.ndarray) -> np.ndarray:
     """Unit quaternions, (..., 4)."""
     return q / np.linalg.norm(q, axis=-1, keepdims=True)

@@ -9,11 +9,9 @@ import math
 from dataclasses import dataclass, replace
 
 from simdiff.errors import SimdiffError
-from simdiff.motion.skeleton import FPS
+from simdiff.motion.skeleton import FPS, MAX_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, Environment
 
-MAX_FRAMES: int = 196
-"""Longest motion in frames (9.8 s at 20 fps); equals :data:`simdiff.model.generator.MAX_FRAMES`."""
 MAX_STEPS: int = 1000
 """Diffusion steps the models are trained with (the most a sampler can take)."""
 MAX_SAMPLES: int = 64

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from simdiff.motion.quaternion import quat_error
+from simdiff.motion.quaternion import quat_error, wxyz_to_xyzw
 
 
 @dataclass(frozen=True)
@@ -112,8 +112,7 @@ class RootResidual:
         # reference pelvis world angular velocity
         from scipy.spatial.transform import Rotation
 
-        quat = reference.qpos[:, 3:7]
-        R = Rotation.from_quat(quat[:, [1, 2, 3, 0]])
+        R = Rotation.from_quat(wxyz_to_xyzw(reference.qpos[:, 3:7]))
         self.ref_omega = R.apply(reference.qvel[:, 3:6])
         # height of the lower ankle of the reference (the stance side), per frame
         self.ankles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"{s}_Ankle") for s in ("L", "R")]

@@ -13,7 +13,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from simdiff.motion.quaternion import quat_error
+from simdiff.motion.quaternion import quat_error, wxyz_to_xyzw
 
 from simdiff.sim.retarget.config import Reference
 from simdiff.sim.retarget.kinematics import foot_geoms
@@ -202,7 +202,7 @@ class PDTracker:
         if self.cfg.velocity_ff:
             off += index.kd * reference.qvel[:, 6:]
         self.base = self.q_target + off / index.kp
-        R = Rotation.from_quat(reference.qpos[:, [4, 5, 6, 3]])
+        R = Rotation.from_quat(wxyz_to_xyzw(reference.qpos[:, 3:7]))
         self.ref_omega = R.apply(reference.qvel[:, 3:6])
         self.foot_body = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"{s}_Ankle") for s in ("L", "R")]
         self.jacp = np.zeros((3, model.nv))

@@ -2,10 +2,12 @@
 
 CLIP weights cannot be downloaded at run time; the user supplies them:
 
-* ``weights``: OpenAI's ``ViT-B-32.pt`` (a TorchScript archive), or a ``.safetensors`` /
-  plain ``.pt`` state dict with OpenAI's key names (``token_embedding.weight``,
+* ``weights``: a ``.safetensors`` or plain ``.pt`` state dict with OpenAI's key names (``token_embedding.weight``,
   ``positional_embedding``, ``transformer.resblocks.i.*``, ``ln_final.*``, ``text_projection``;
-  ``visual.*`` keys are ignored).
+  ``visual.*`` keys are ignored). Plain ``.pt`` files are read with ``weights_only=True``.
+  OpenAI's own ``ViT-B-32.pt`` is a TorchScript archive, and loading one runs code stored in
+  the file, so it is refused; convert a copy you trust once with
+  ``python -m simdiff.text.clip_convert ViT-B-32.pt ViT-B-32.safetensors``.
 * the BPE vocabulary ``bpe_simple_vocab_16e6.txt.gz`` beside the weights file (or at
   ``$SIMDIFF_CLIP_BPE``).
 
@@ -192,14 +194,34 @@ class CLIPTextEncoder(nn.Module):
         return x[torch.arange(len(texts), device=device), eot] @ self.text_projection
 
 
+def is_torchscript(path: str | os.PathLike[str]) -> bool:
+    """True for a TorchScript archive (a zip holding ``code/`` or ``constants.pkl``), which only
+    ``torch.jit.load`` reads, running the code it carries."""
+    import zipfile
+
+    if not zipfile.is_zipfile(path):
+        return False
+    with zipfile.ZipFile(path) as archive:
+        return any("/code/" in n or n.endswith("/constants.pkl") for n in archive.namelist())
+
+
 def _read_state(path: Path) -> dict[str, Tensor]:
-    """Weights from a safetensors file, a TorchScript archive, or a plain state-dict ``.pt``."""
+    """Weights from a safetensors file or a plain state-dict ``.pt`` (never a TorchScript archive)."""
     if path.suffix == ".safetensors":
         from safetensors.torch import load_file
 
-        return load_file(str(path))
+        try:
+            return load_file(str(path))
+        except Exception as exc:  # noqa: BLE001 - safetensors raises several kinds
+            raise SimdiffError(f"{path}: not a readable safetensors file ({exc})") from None
+    if is_torchscript(path):
+        raise SimdiffError(f"{path} is a TorchScript archive, whose loading runs code from the file; convert a copy you "
+                           f"trust once: python -m simdiff.text.clip_convert {path} {path.with_suffix('.safetensors')}")
     try:
-        return dict(torch.jit.load(str(path), map_location="cpu").state_dict())
-    except RuntimeError:
         raw = torch.load(str(path), map_location="cpu", weights_only=True)
-        return dict(raw.get("state_dict", raw)) if isinstance(raw, dict) else dict(raw)
+    except Exception as exc:  # noqa: BLE001 - pickle / zip errors of a damaged or foreign file
+        raise SimdiffError(f"{path}: not a CLIP state dict readable with weights_only=True ({type(exc).__name__})") from None
+    raw = raw.get("state_dict", raw) if isinstance(raw, dict) else raw
+    if not isinstance(raw, dict):
+        raise SimdiffError(f"{path}: holds a {type(raw).__name__}, not a state dict")
+    return dict(raw)

@@ -13,10 +13,11 @@ from simdiff.train.config import OptimConfig, RunConfig, TrainConfig
 class HashTextEncoder:
     """Deterministic pseudo-embeddings (unit-variance Gaussian per caption), independent of PYTHONHASHSEED.
 
-    Stands in for MiniLM (``name`` ``minilm``, 384-d) where real text semantics do not matter.
+    Stands in for a real encoder (MiniLM's 384-d by default) where text semantics do not matter;
+    its ``name`` is ``hash``, so that nothing it produces (a caption cache) passes for MiniLM's.
     """
 
-    name = "minilm"
+    name = "hash"
 
     def __init__(self, dim: int = 384) -> None:
         self.dim = dim

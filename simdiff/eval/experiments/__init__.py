@@ -78,10 +78,14 @@ def budget_info(config: ExperimentConfig) -> dict[str, Any]:
 
 
 def run_experiment(path: str | os.PathLike[str], *, budget: str | None = None, overrides: list[tuple[str, Any]] | None = None,
-                   projector: Any = None, command: list[str] | None = None, progress: bool = True) -> dict[str, Any]:
-    """Load a config (budget, overrides), run it, write the report; returns the report."""
+                   projector: Any = None, command: list[str] | None = None, progress: bool = True,
+                   text_encoder: Any = None) -> dict[str, Any]:
+    """Load a config (budget, overrides), run it, write the report; returns the report.
+
+    ``projector`` and ``text_encoder`` (encoder name → encoder) are injected stand-ins (see :class:`Runner`).
+    """
     config = load_config(path, budget, overrides)
-    return run(Runner(config, projector=projector, command=command, progress=progress))
+    return run(Runner(config, projector=projector, command=command, progress=progress, text_encoder=text_encoder))
 
 
 def plan_experiment(path: str | os.PathLike[str], *, budget: str | None = None,
@@ -108,7 +112,8 @@ def config_path(configs: str | os.PathLike[str], kind: str) -> Path:
 
 def run_all(configs: str | os.PathLike[str] = "configs", *, budget: str | None = None,
             overrides: list[tuple[str, Any]] | None = None, only: list[str] | None = None, projector: Any = None,
-            command: list[str] | None = None, progress: bool = True, log: Any = print) -> list[dict[str, Any]]:
+            command: list[str] | None = None, progress: bool = True, log: Any = print,
+            text_encoder: Any = None) -> list[dict[str, Any]]:
     """Run table2, table1, fig4, fig5 and retrack (or ``only`` those) in order; returns their reports.
 
     An override whose first key an experiment's config does not use (``env_control`` for table1) is
@@ -124,7 +129,7 @@ def run_all(configs: str | os.PathLike[str] = "configs", *, budget: str | None =
         est = sum(r["estimate_s"] for r in plan_experiment(path, budget=budget, overrides=overrides))
         log(f"[{i}/{len(kinds)}] {kind}: {path} (estimated {duration(est)} to measure)")
         report = run_experiment(path, budget=budget, overrides=overrides, projector=projector, command=command,
-                                progress=progress)
+                                progress=progress, text_encoder=text_encoder)
         log(f"[{i}/{len(kinds)}] {kind}: {len(report['rows'])} rows → {Path(report['config']['out_dir']) / report['name'] / 'report.md'}")
         reports.append(report)
     return reports

@@ -167,7 +167,8 @@ class ExperimentConfig:
         envs: φ list (retrack); retrack_samples: motions per (method, φ);
         include_ground_truth: retrack also re-tracks the test motions themselves.
         budgets: named override sets, e.g. ``{"quick": {"about": "...", "set": {"protocol.replications": 3}}}``.
-        text_encoder: ``auto`` (each model's own) or ``hash`` (deterministic stand-in; tests only).
+        text_encoder: ``auto``, each model's own (the only value; tests inject a stand-in through
+            :class:`~simdiff.eval.experiments.runner.Runner`'s ``text_encoder``).
         threads: torch CPU threads while the experiment runs (0: torch's default). On a machine whose
             cores are busy with other jobs, 1 avoids spinning threads slowing everything down.
     """
@@ -325,5 +326,7 @@ def check(config: ExperimentConfig, origin: str | os.PathLike[str] = "config") -
         raise SimdiffError(f"{origin}: ddpm_samples must be >= 0 and ddpm_replications >= 1")
     if config.threads < 0:
         raise SimdiffError(f"{origin}: threads must be >= 0, got {config.threads}")
+    if config.text_encoder != "auto":
+        raise SimdiffError(f"{origin}: text_encoder {config.text_encoder!r} must be \"auto\" (each model's own encoder)")
     if config.projector.backend not in ("process", "serial"):
         raise SimdiffError(f"{origin}: projector backend {config.projector.backend!r} must be process or serial")

@@ -73,8 +73,11 @@ class Runner:
     """Loads models/evaluator/corpus once and measures an experiment's rows into ``<out_dir>/<name>/``."""
 
     def __init__(self, config: ExperimentConfig, *, projector: Any = None, command: list[str] | None = None,
-                 progress: bool = True) -> None:
+                 progress: bool = True, text_encoder: Callable[[str], Any] | None = None) -> None:
+        """``projector`` and ``text_encoder`` (a factory: encoder name → encoder) replace the simulator
+        and the models' own text encoders (tests); neither enters the rows' fingerprints."""
         self.config = config
+        self._text_factory = text_encoder
         self.out = Path(config.out_dir) / config.name
         self.rows_dir = self.out / "rows"
         self.progress = progress
@@ -93,12 +96,10 @@ class Runner:
 
     # --- resources ------------------------------------------------------------------------
     def text_encoder(self, name: str) -> Any:
-        """The sentence encoder ``name`` (one instance per run), or the hash stand-in in tests."""
+        """The sentence encoder ``name`` (one instance per run), or the injected stand-in's."""
         if name not in self._encoders:
-            if self.config.text_encoder == "hash":
-                from simdiff.train.testing import HashTextEncoder
-
-                self._encoders[name] = HashTextEncoder()
+            if self._text_factory is not None:
+                self._encoders[name] = self._text_factory(name)
             else:
                 from simdiff.text.base import load_text_encoder
 

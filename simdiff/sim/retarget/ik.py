@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from simdiff.motion.quaternion import xyzw_to_wxyz
 from simdiff.sim.humanoid import BODY_NAMES, BODY_PARENT, BODY_TO_HML, model_index
 from simdiff.sim.retarget.config import RetargetConfig
 
@@ -135,7 +136,7 @@ def analytic_ik(model, target: np.ndarray) -> np.ndarray:
     kids = _KABSCH["Pelvis"]
     Rw["Pelvis"] = _kabsch(np.stack([off[c] for c in kids]), np.stack([P[c] - P["Pelvis"] for c in kids], 1))
     qpos[:, :3] = P["Pelvis"]
-    qpos[:, 3:7] = Rotation.from_matrix(Rw["Pelvis"]).as_quat()[:, [3, 0, 1, 2]]
+    qpos[:, 3:7] = xyzw_to_wxyz(Rotation.from_matrix(Rw["Pelvis"]).as_quat())
     y_pelvis = Rw["Pelvis"][:, :, 1]
     y_chest = _unit(P["L_Thorax"] - P["R_Thorax"])
 
