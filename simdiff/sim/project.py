@@ -46,8 +46,6 @@ class ProjectionInfo:
         d_l2_pose: :func:`simdiff.sim.faithfulness.pose_d_l2` against the re-timed source
             (pose channels only); NaN without a normaliser.
         time_warp: rollout length / source length (1 without a flight clock).
-        signal: physical measurements of the rollout
-            (:func:`simdiff.data.augment.signal.measure`), filled by callers that ask.
     """
 
     success: bool
@@ -67,7 +65,6 @@ class ProjectionInfo:
     violations: list[str] = field(default_factory=list)
     d_l2_pose: float = float("nan")
     time_warp: float = 1.0
-    signal: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         return asdict(self)

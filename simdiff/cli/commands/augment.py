@@ -6,9 +6,6 @@ import argparse
 from pathlib import Path
 
 from simdiff.cli.main import command_group
-from simdiff.data.augment.filter import FilterConfig
-
-FILTER_DEFAULTS = FilterConfig()
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -31,10 +28,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=0, help="parallel simulations (default: all cores)")
     p.add_argument("--backend", choices=["process", "ray", "serial"], default="process", help="parallel backend (default process)")
     p.add_argument("--seed", type=int, default=0, help="seed of the environment draw (default 0)")
-    p.add_argument("--max-pose-d-l2", type=float, default=FILTER_DEFAULTS.max_pose_d_l2,
-                   help=f"largest pose d_L2 against the re-timed source (default {FILTER_DEFAULTS.max_pose_d_l2})")
-    p.add_argument("--max-residual-n", type=float, default=FILTER_DEFAULTS.max_residual_n,
-                   help=f"largest mean root residual force kept, newtons, any gravity (default {FILTER_DEFAULTS.max_residual_n})")
+    p.add_argument("--max-pose-d-l2", type=float,
+                   help="largest pose d_L2 against the re-timed source (default: FilterConfig's, 5.2)")
+    p.add_argument("--max-residual-n", type=float,
+                   help="largest mean root residual force kept, newtons, at any gravity (default: FilterConfig's, 70.6)")
     p.add_argument("--max-d-l2", type=float, help="also require the paper's d_L2 <= this (e.g. 7.0; default off)")
     p.add_argument("--max-residual", type=float, help="also require the residual <= this fraction of m*|g_z| (default off)")
     p.add_argument("--residual-bound", type=float, default=0.5,
@@ -54,8 +51,10 @@ def run(args: argparse.Namespace) -> int:
 
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
-                           filter=FilterConfig(max_pose_d_l2=args.max_pose_d_l2, max_residual_n=args.max_residual_n,
-                                               max_d_l2=args.max_d_l2, max_residual=args.max_residual),
+                           filter=FilterConfig(
+                               max_pose_d_l2=FilterConfig.max_pose_d_l2 if args.max_pose_d_l2 is None else args.max_pose_d_l2,
+                               max_residual_n=FilterConfig.max_residual_n if args.max_residual_n is None else args.max_residual_n,
+                               max_d_l2=args.max_d_l2, max_residual=args.max_residual),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)
