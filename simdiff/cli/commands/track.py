@@ -32,6 +32,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--stats", type=Path, default=None, metavar="DIR",
                    help="folder with Mean.npy/Std.npy for d_L2 (default: $SIMDIFF_STATS, else the statistics shipped with simdiff)")
     p.add_argument("--force", action="store_true", help="allow φ outside the validated ranges")
+    p.add_argument("--follow-flights", action="store_true",
+                   help="let flights last as long as gravity makes them (the rollout may be longer than the input)")
     p.add_argument("--fps", type=float, default=None, help="source frame rate when the file does not say")
     p.set_defaults(func=run)
 
@@ -49,6 +51,7 @@ def run(args: argparse.Namespace) -> int:
 
     from simdiff.sim.env import Environment
     from simdiff.sim.project import project
+    from simdiff.sim.flight import FlightConfig
     from simdiff.sim.residual import ResidualConfig
 
     if args.residual < 0:
@@ -63,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     for path in args.files:
         joints = np.asarray(load_joints(path, fps=args.fps), dtype=np.float64)
         out, info = project(joints, env, residual=ResidualConfig(max_force=args.residual), normalizer=normalizer,
-                            force=args.force)
+                            force=args.force, flight=FlightConfig() if args.follow_flights else None)
         n_ok += info.success
         written = None
         if args.out is not None:
