@@ -40,7 +40,9 @@ class FlightConfig:
         min_takeoff_vz: below this simulated take-off speed (m/s) the flight progress is
             counted in control steps instead of by the COM velocity.
         hold_after: control steps the simulation must be airborne while the reference stands
-            before the clock holds (a one-step foot bounce never stops the clock).
+            before the clock holds (a foot bounce or a run's short flight never stops the
+            clock). 2 made the Earth runs 16_45 and 49_04 fall (the clock held while the runner
+            was between steps); 4 tracks both, as without the clock.
         max_wait_s: longest wait per flight (s); then the clock resumes.
         max_extra_s: longest total extension of a rollout (s).
     """
@@ -48,7 +50,7 @@ class FlightConfig:
     min_frames: int = 2
     lookahead: int = 4
     min_takeoff_vz: float = 0.2
-    hold_after: int = 2
+    hold_after: int = 4
     max_wait_s: float = 6.0
     max_extra_s: float = 20.0
 
