@@ -145,3 +145,21 @@ def test_synthetic_jump_follows_ballistics_at_three_gravities_and_lands():
     vals = np.array(list(norm.values()))
     assert vals.max() / vals.min() < 1.1, norm  # same take-off speed → flight time ∝ 1/|g|, within 10 %
     assert np.all(np.abs(vals / 2 - 1) < 0.2), norm
+
+
+def test_clock_log_matches_the_states_also_with_recovery():
+    pytest.importorskip("mujoco")
+    from simdiff.sim import synthetic
+    from simdiff.sim.env import Environment
+    from simdiff.sim.humanoid import load_model
+    from simdiff.sim.retarget import make_reference
+    from simdiff.sim.rollout import RecoveryConfig, rollout
+
+    m = load_model()
+    ref = make_reference(m, synthetic.vertical_jump(height=0.3), gravity=-3.0)
+    for recovery in (None, RecoveryConfig()):
+        res = rollout(m, ref, Environment(-3.0), flight=FlightConfig(), recovery=recovery)
+        n_sub = round(res.control_dt / res.timestep)
+        assert len(res.ref_frames) == (len(res.qpos) - 1) // n_sub + 1
+        assert np.all(np.diff(res.ref_frames) >= 0) and res.ref_frames[0] == 0
+        assert len(res.ref_frames) > ref.num_frames  # the low-g flight made the rollout longer
