@@ -73,3 +73,13 @@ def test_track_bad_workers(motion_file, capsys):
 
 def test_track_missing_file(tmp_path, capsys):
     assert main(["track", str(tmp_path / "nope.npy")]) == 2
+
+
+def test_track_follow_flights_lets_a_moon_jump_run_longer(tmp_path, capsys):
+    path = tmp_path / "jump.npy"
+    np.save(path, synthetic.vertical_jump(height=0.3))
+    n_in = len(np.load(path))
+    assert main(["track", str(path), "--json", "--gravity", "-1.6", "--follow-flights", "--out", str(tmp_path / "o")]) == 0
+    rec = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert rec["success"] is True and rec["time_warp"] > 1.3
+    assert len(np.load(tmp_path / "o" / "jump.npy")) == rec["n_out"] > n_in

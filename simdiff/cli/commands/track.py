@@ -32,6 +32,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--stats", type=Path, default=None, metavar="DIR",
                    help="folder with Mean.npy/Std.npy for d_L2 (default: $SIMDIFF_STATS, else the statistics shipped with simdiff)")
     p.add_argument("--force", action="store_true", help="allow φ outside the validated ranges")
+    p.add_argument("--follow-flights", action="store_true",
+                   help="let flights last as long as gravity makes them (the rollout may be longer than the input)")
     p.add_argument("--fps", type=float, default=None, help="source frame rate when the file does not say")
     p.add_argument("--workers", type=int, default=1, metavar="N",
                    help="motions tracked in parallel processes; 0 = one per CPU core (default 1); results do not depend on N")
@@ -62,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
 
     from simdiff.motion.io import load_joints
     from simdiff.sim.env import Environment
+    from simdiff.sim.flight import FlightConfig
     from simdiff.sim.pool import PoolConfig, ProjectionPool
     from simdiff.sim.residual import ResidualConfig
 
@@ -79,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
         check_writable(args.out / f"{args.files[0].stem}.npy")
     motions = [np.asarray(load_joints(path, fps=args.fps), dtype=np.float32) for path in args.files]
     pool = ProjectionPool(PoolConfig(workers=args.workers, residual=ResidualConfig(max_force=args.residual),
-                                     stats_dir=str(stats), force=args.force))
+                                     stats_dir=str(stats), force=args.force,
+                                     flight=FlightConfig() if args.follow_flights else None))
 
     def progress(results):
         return tqdm(results, total=len(motions), desc=f"tracking ({pool_workers(args.workers, len(motions))} workers)",
