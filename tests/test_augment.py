@@ -17,6 +17,7 @@ import pytest
 from simdiff.data.augment import (AugmentConfig, AugmentedHumanML3D, FilterConfig, augment, keep_pair, make_conditions,
                                   open_training_dataset, random_conditions)
 from simdiff.data.augment.run import load_source_joints
+from simdiff.data.augment.filter import rejections, residual_newtons
 from simdiff.errors import SimdiffError
 from simdiff.eval.testing import write_tiny_corpus
 from simdiff.sim.env import Environment
@@ -24,9 +25,9 @@ from simdiff.train.data import collate
 
 
 def fake_info(env: Environment, i: int) -> dict:
-    """Deterministic outcome: walks on condition 1 fall, condition 2 has d_L2 8, wind_y > 5 needs much residual."""
+    """Deterministic outcome: g > −5 falls, w_x > 5 is unfaithful, w_y > 5 needs much residual."""
     g, wx, wy = env.as_tuple()
-    return {"success": not (g != -9.81 and g > -5.0), "d_l2": 8.0 if wx > 5 else 3.0 + 0.01 * i,
+    return {"success": not (g != -9.81 and g > -5.0), "d_l2_pose": 10.0 if wx > 5 else 1.0 + 0.01 * i, "d_l2": 5.0,
             "residual": {"force_mean_mg": 0.3 if wy > 5 else 0.05}, "cpu_s": 0.0}
 
 
@@ -62,17 +63,41 @@ def test_conditions_are_one_factor_balanced_and_seeded() -> None:
 
 
 def test_keep_filter_is_pure_and_ordered() -> None:
-    ok = {"success": True, "d_l2": 6.9, "residual": {"force_mean_mg": 0.05}}
-    assert keep_pair(ok) == (True, "kept")
-    assert keep_pair("RuntimeError: boom") == (False, "error")
-    assert keep_pair(None) == (False, "error")
-    assert keep_pair({**ok, "success": False, "d_l2": 99}) == (False, "failed")
-    assert keep_pair({**ok, "d_l2": 7.01}) == (False, "d_l2")
-    assert keep_pair({**ok, "d_l2": 7.0}) == (True, "kept")
-    assert keep_pair({**ok, "d_l2": float("nan")}) == (False, "d_l2")
-    assert keep_pair({**ok, "residual": {"force_mean_mg": 0.2}}) == (False, "residual")
-    assert keep_pair({**ok, "residual": {"force_mean_mg": 0.2}}, FilterConfig(max_residual=0.25)) == (True, "kept")
-    assert ok == {"success": True, "d_l2": 6.9, "residual": {"force_mean_mg": 0.05}}  # untouched
+    cfg = FilterConfig(max_pose_d_l2=3.0, max_residual_n=70.0)
+    ok = {"success": True, "d_l2_pose": 2.9, "d_l2": 9.0, "env": [-9.81, 0, 0], "residual": {"force_mean_n": 30.0}}
+    assert keep_pair(ok, cfg) == (True, "kept")  # the paper's d_L2 is off by default
+    assert keep_pair("RuntimeError: boom", cfg) == (False, "error")
+    assert keep_pair(None, cfg) == (False, "error")
+    assert keep_pair({**ok, "success": False, "d_l2_pose": 99}, cfg) == (False, "failed")
+    assert keep_pair({**ok, "d_l2_pose": 3.01}, cfg) == (False, "faithfulness")
+    assert keep_pair({**ok, "d_l2_pose": 3.0}, cfg) == (True, "kept")
+    assert keep_pair({**ok, "d_l2_pose": float("nan")}, cfg) == (False, "faithfulness")
+    assert keep_pair({k: v for k, v in ok.items() if k != "d_l2_pose"}, cfg) == (False, "faithfulness")
+    assert keep_pair({**ok, "residual": {"force_mean_n": 70.5}}, cfg) == (False, "residual")
+    assert keep_pair(ok, FilterConfig(max_pose_d_l2=3.0, max_residual_n=70.0, max_d_l2=7.0)) == (False, "faithfulness")
+    assert ok["d_l2_pose"] == 2.9 and ok["residual"] == {"force_mean_n": 30.0}  # untouched
+
+
+def test_residual_budget_is_absolute_in_newtons() -> None:
+    """The same 40 N passes at every gravity; a budget relative to m·|g_z| would reject it on the Moon."""
+    cfg = FilterConfig(max_pose_d_l2=None, max_residual_n=70.6)
+    for g in (-1.6, -9.81, -20.0):
+        info = {"success": True, "env": [g, 0, 0], "residual": {"force_mean_mg": 40.0 / (72.0 * abs(g))}}
+        assert residual_newtons(info) == pytest.approx(40.0)
+        assert keep_pair(info, cfg) == (True, "kept"), g
+    moon = {"success": True, "env": [-1.6, 0, 0], "residual": {"force_mean_mg": 40.0 / (72.0 * 1.6)}}
+    assert keep_pair(moon, FilterConfig(max_pose_d_l2=None, max_residual_n=None, max_residual=0.1)) == (False, "residual")
+
+
+def test_rejections_judge_each_criterion_on_its_own() -> None:
+    cfg = FilterConfig(max_pose_d_l2=3.0, max_residual_n=70.0)
+    bad = {"success": False, "d_l2_pose": 5.0, "residual": {"force_mean_n": 100.0}}
+    assert rejections(bad, cfg) == {"failed": True, "faithfulness": True, "residual": True}
+    assert keep_pair(bad, cfg) == (False, "failed")  # the reason is the first, the report counts all three
+    assert rejections({**bad, "success": True, "d_l2_pose": 1.0}, cfg) == {"failed": False, "faithfulness": False,
+                                                                          "residual": True}
+    assert all(rejections("boom", cfg).values())
+
 
 
 def test_source_joints_have_one_more_frame(tmp_path: Path) -> None:

@@ -26,6 +26,7 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.sim.retarget.config import RetargetConfig
 from simdiff.sim.env import Environment
+from simdiff.sim.flight import FlightConfig
 from simdiff.sim.project import ProjectionInfo, project
 from simdiff.sim.residual import ResidualConfig
 
@@ -41,6 +42,7 @@ class PoolConfig:
         stats_dir: folder with Mean.npy/Std.npy for d_L2 (None: d_L2 is NaN).
         force: skip φ range validation.
         ray_address: address for ``ray.init`` (None: local or RAY_ADDRESS).
+        flight: the flight clock passed to :func:`project` (None: the reference's own clock).
     """
 
     workers: int = 0
@@ -51,6 +53,7 @@ class PoolConfig:
     force: bool = False
     ray_address: str | None = None
     extra: dict = field(default_factory=dict)
+    flight: FlightConfig | None = None
 
 
 Result = tuple[np.ndarray | None, Any]
@@ -98,7 +101,7 @@ def _run_one(args: tuple[np.ndarray, tuple[float, float, float], PoolConfig]) ->
     try:
         return project(
             joints, Environment(*phi), residual=cfg.residual, retarget=cfg.retarget,
-            normalizer=_normalizer(cfg.stats_dir), force=cfg.force,
+            normalizer=_normalizer(cfg.stats_dir), force=cfg.force, flight=cfg.flight,
         )
     except Exception as exc:  # one bad motion must not stop the batch
         return None, f"{type(exc).__name__}: {exc}"

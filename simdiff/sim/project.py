@@ -2,7 +2,9 @@
 
 ``project(joints, env) -> (rollout_joints, info)``; ``rollout_joints`` is (T', 22, 3)
 float32 HumanML3D joints (Y-up, metres, 20 fps, same frame as the input) with T' = T on
-success and the frames up to the fall otherwise. ``info`` is a :class:`ProjectionInfo`.
+success and the frames up to the fall otherwise. With a flight clock (``flight``) T' is what
+the simulation needed: longer when a low-g flight outlasted the mocap's, shorter when a
+high-g flight landed early; distances are then taken against the re-timed source. ``info`` is a :class:`ProjectionInfo`.
 """
 
 from __future__ import annotations
@@ -14,6 +16,8 @@ import numpy as np
 
 from simdiff.sim.retarget import RetargetConfig, make_reference, qpos_to_world
 from simdiff.sim.env import Environment
+from simdiff.sim.faithfulness import pose_d_l2
+from simdiff.sim.flight import FlightConfig, aligned_source
 from simdiff.sim.humanoid import HumanoidConfig, load_model, model_index, world_to_hml
 from simdiff.sim.residual import ResidualConfig
 from simdiff.sim.rollout import FallConfig, RolloutResult, rollout
@@ -39,6 +43,11 @@ class ProjectionInfo:
         cpu_s: CPU seconds (retarget + rollout + metrics); sim_cpu_s: rollout only.
         duration_s: motion length (s); env: (g_z, w_x, w_y).
         violations: physics-invariant violations (only when audited).
+        d_l2_pose: :func:`simdiff.sim.faithfulness.pose_d_l2` against the re-timed source
+            (pose channels only); NaN without a normaliser.
+        time_warp: rollout length / source length (1 without a flight clock).
+        signal: physical measurements of the rollout
+            (:func:`simdiff.data.augment.signal.measure`), filled by callers that ask.
     """
 
     success: bool
@@ -56,17 +65,23 @@ class ProjectionInfo:
     duration_s: float
     env: tuple[float, float, float]
     violations: list[str] = field(default_factory=list)
+    d_l2_pose: float = float("nan")
+    time_warp: float = 1.0
+    signal: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         return asdict(self)
 
 
-def rollout_joints(model, result: RolloutResult, n_frames: int, fps: float = 20.0) -> np.ndarray:
-    """HumanML3D joints (T', 22, 3) float32 at ``fps`` from the per-step states of a rollout."""
+def rollout_joints(model, result: RolloutResult, n_frames: int | None, fps: float = 20.0) -> np.ndarray:
+    """HumanML3D joints (T', 22, 3) float32 at ``fps`` from the per-step states of a rollout
+    (at most ``n_frames``; None: every frame the rollout covers)."""
     dt = result.timestep
     S = result.qpos.shape[0] - 1
     t_end = S * dt
-    n = min(n_frames, int(np.floor(t_end * fps + 1e-6)) + 1)
+    n = int(np.floor(t_end * fps + 1e-6)) + 1
+    if n_frames is not None:
+        n = min(n_frames, n)
     idx = np.arange(n) / fps / dt
     lo = np.clip(np.floor(idx + 1e-9).astype(int), 0, S)
     hi = np.clip(lo + 1, 0, S)
@@ -106,6 +121,7 @@ def project(
     normalizer=None,
     force: bool = False,
     audit: bool = False,
+    flight: FlightConfig | None = None,
 ) -> tuple[np.ndarray, ProjectionInfo]:
     """P_φ,π(τ): replay ``joints`` in MuJoCo under ``env`` and return the rollout.
 
@@ -117,6 +133,8 @@ def project(
         residual: ``ResidualConfig(max_force=0)`` is the strict setting.
         normalizer: a :class:`simdiff.motion.normalize.Normalizer` for d_L2 (NaN if None).
         audit: check the physics invariants at every step (slower).
+        flight: follow the simulated flights (:class:`simdiff.sim.flight.FlightClock`);
+            None: the reference's own clock (output at most as long as the input).
     Returns:
         (rollout joints (T', 22, 3) float32, :class:`ProjectionInfo`).
     """
@@ -125,20 +143,26 @@ def project(
     model = model if model is not None else load_model(HumanoidConfig())
     joints = np.asarray(joints, dtype=np.float64)
     ref = make_reference(model, joints, retarget, gravity=env.gravity)
-    res = rollout(model, ref, env, tracker, residual, fall, audit=audit)
-    out = rollout_joints(model, res, joints.shape[0], retarget.fps)
-    ref_j = joints[: len(out)] + np.array([0.0, ref.ground_shift, 0.0])
+    res = rollout(model, ref, env, tracker, residual, fall, audit=audit, flight=flight)
+    out = rollout_joints(model, res, joints.shape[0] if flight is None else None, retarget.fps)
+    if flight is None:
+        source = joints[: len(out)]
+    else:
+        source = aligned_source(joints, res.ref_frames, 1.0 / res.control_dt, retarget.fps, len(out))
+    ref_j = source + np.array([0.0, ref.ground_shift, 0.0])
     diff = out - ref_j
     err = float(np.linalg.norm(diff, axis=-1).mean() * 1e3)
     local = diff - diff[:, :1] * np.array([1.0, 0.0, 1.0])
     err_local = float(np.linalg.norm(local, axis=-1).mean() * 1e3)
     fall_frame = None if res.fall_time is None else int(np.floor(res.fall_time * retarget.fps))
-    dl2 = d_l2(joints, out, normalizer)
+    dl2 = d_l2(source, out, normalizer)
+    dl2_pose = pose_d_l2(source, out, normalizer)
     ix = model_index(model)
     info = ProjectionInfo(
         success=res.success, status=res.status, fall_frame=fall_frame, n_frames=int(joints.shape[0]),
         n_out=int(len(out)), d_l2=dl2, err_mm=err, err_local_mm=err_local, residual=res.residual_stats(),
         feasibility=ref.feasibility(ix.mass, env.gravity), cpu_s=time.process_time() - t0, sim_cpu_s=res.cpu_s,
-        duration_s=ref.duration, env=env.as_tuple(), violations=res.violations,
+        duration_s=ref.duration, env=env.as_tuple(), violations=res.violations, d_l2_pose=dl2_pose,
+        time_warp=float(len(out) / max(joints.shape[0], 1)),
     )
     return out, info

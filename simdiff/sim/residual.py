@@ -12,7 +12,10 @@ pelvis is computed:
   ≥ 0 (push-only), where the target height is the reference COM height lowered by as much
   as the simulated stance (lower) ankle sits below the reference's (bounded, never raised);
   then ``|F| ≤ max_force·m·|g_z|``;
-* torque: ``τ = kp_rot·e_rot + kd_rot·Δω`` on the pelvis orientation, ``|τ| ≤ max_torque``.
+* torque: ``τ = kp_rot·e_rot + kd_rot·Δω`` on the pelvis orientation, ``|τ| ≤ max_torque``;
+  under a gravity weaker than Earth's also ``momentum_gain·(s·L_ref − L)`` on the horizontal
+  axes, L the whole-body angular momentum about the COM and s = |g_z|/9.81 (see
+  :class:`ResidualConfig`).
 
 It is written to ``data.xfrc_applied[pelvis]`` (applied at the pelvis COM), logged per step
 and summarised per rollout. ``max_force = 0`` gives the strict (paper) setting: no residual.
@@ -53,6 +56,16 @@ class ResidualConfig:
             standing on a flat foot where the mocap had it tilted. Measured on the first 40
             CMU clips (R = 0.5, ≤ 0.1·m·g): 0 / 0.01 / 0.02 / 0.03 m → 26 / 30 / 30 / 31;
             0.01 is the smallest on the plateau.
+        momentum_gain: under |g_z| < 9.81, while in contact, steer the whole-body angular
+            momentum about the COM (horizontal axes) to the reference's scaled by
+            s = |g_z|/9.81 (1/s; 0: off). A flight with the mocap's take-off speed lasts 1/s
+            times longer, so the mocap's take-off momentum would turn the body 1/s times as far;
+            with s·L_ref it turns about as far as the mocap did. Measured on 16_05 at
+            g = −1.6 with the flight clock: without it the body pitched 57° over the 2.4 s flight
+            and fell on landing; the stance legs alone could not remove the momentum (their
+            moment is bounded by the centre of pressure under a 1/6 weight). With 150 the
+            forward jumps 16_05, 13_11, 105_39 land and finish at −1.6. Inactive at
+            |g_z| ≥ 9.81 (Earth rollouts are unchanged).
     """
 
     max_force: float = 0.5
@@ -65,6 +78,7 @@ class ResidualConfig:
     ref_window: int = 2
     support_shift_max: float = 0.05
     z_deadband: float = 0.01
+    momentum_gain: float = 150.0
 
     @property
     def torque_bound(self) -> float:
@@ -108,6 +122,10 @@ class RootResidual:
             d.qpos[:] = reference.qpos[k]
             mujoco.mj_kinematics(model, d)
             self.ref_ankle_z[k] = d.xpos[self.ankles, 2].min()
+        self.momentum_scale = min(1.0, abs(gravity) / 9.81)
+        self.ref_angmom = None
+        if config.momentum_gain > 0 and self.momentum_scale < 1.0:
+            self.ref_angmom = reference_angular_momentum(model, reference, index)
 
     def sim_support(self, data) -> bool:
         """True when a foot or hand geom touches the floor (contacts of the current step)."""
@@ -151,7 +169,25 @@ class RootResidual:
         e = quat_error(q_ref, data.xquat[p])
         omega = data.cvel[p, :3]
         tau = c.kp_rot * e + c.kd_rot * (self.ref_omega[k] - omega)
+        if self.ref_angmom is not None:  # subtree velocities are current (mj_subtreeVel above)
+            dL = self.momentum_scale * self.ref_angmom[k] - data.subtree_angmom[p]
+            tau[:2] += c.momentum_gain * dL[:2]
         n = np.linalg.norm(tau)
         if n > self.tmax:
             tau *= self.tmax / max(n, 1e-12)
         return np.concatenate([f, tau])
+
+
+def reference_angular_momentum(model, reference, index) -> np.ndarray:
+    """(K, 3) whole-body angular momentum about the COM (kg·m²/s, world) of each reference frame."""
+    import mujoco
+
+    d = mujoco.MjData(model)
+    out = np.zeros((reference.num_frames, 3))
+    for k in range(reference.num_frames):
+        d.qpos[:] = reference.qpos[k]
+        d.qvel[:] = reference.qvel[k]
+        mujoco.mj_forward(model, d)
+        mujoco.mj_subtreeVel(model, d)
+        out[k] = d.subtree_angmom[index.pelvis]
+    return out

@@ -15,18 +15,25 @@ re-simulates from there with the next alternative tracker setting for ``hold`` f
 hands back to the main tracker. Only the committed trajectory is returned (states, residual
 log); the discarded attempts count in ``cpu_s``. No force is added: the alternatives only
 choose other PD targets, so every physics invariant holds as without recovery.
+
+Flights that follow gravity (``flight``, :mod:`simdiff.sim.flight`): the reference frame of
+each control step comes from a :class:`FlightClock`, which waits while the simulation flies
+longer than the mocap (low g) and jumps to the landing frame when it lands early (high g);
+the rollout then has as many control steps as it needs (``ref_frames`` logs the alignment).
+Without it the clock is the reference's own (one frame per control step).
 """
 
 from __future__ import annotations
 
 import copy
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from simdiff.sim.retarget.config import Reference
 from simdiff.sim.env import Environment
+from simdiff.sim.flight import FlightClock, FlightConfig
 from simdiff.sim.humanoid import ModelIndex, model_index
 from simdiff.sim.residual import ResidualConfig, RootResidual
 from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig, Tracker
@@ -91,6 +98,9 @@ class RolloutResult:
         cpu_s: CPU seconds of the stepping loop (rewound attempts included).
         timestep: physics step (s); mass: kg; gravity: |g_z|.
         recoveries: how many times the rollout rewound after a fall.
+        ref_frames: (N+1,) reference frame aimed at by each control step of the committed
+            trajectory (the identity without a flight clock).
+        control_dt: control period (s).
     """
 
     status: str
@@ -105,21 +115,24 @@ class RolloutResult:
     mass: float = 72.0
     gravity: float = 9.81
     recoveries: int = 0
+    ref_frames: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    control_dt: float = 1.0 / 30.0
 
     @property
     def success(self) -> bool:
         return self.status == "ok"
 
     def residual_stats(self) -> dict[str, float]:
-        """Mean/peak residual force as a fraction of m·g, and torque in N·m (over all steps)."""
+        """Mean/peak residual force as a fraction of m·g and in N, and torque in N·m (over all steps)."""
         if self.residual.shape[0] == 0:
-            return {"force_mean_mg": 0.0, "force_peak_mg": 0.0, "torque_mean_nm": 0.0, "torque_peak_nm": 0.0,
+            return {"force_mean_mg": 0.0, "force_mean_n": 0.0, "force_peak_mg": 0.0, "torque_mean_nm": 0.0, "torque_peak_nm": 0.0,
                     "airborne_frac": 0.0, "airborne_force_max_n": 0.0}
         f = np.linalg.norm(self.residual[:, :3], axis=1) / (self.mass * self.gravity)
         t = np.linalg.norm(self.residual[:, 3:], axis=1)
         air = self.airborne
         return {
             "force_mean_mg": float(f.mean()),
+            "force_mean_n": float(f.mean() * self.mass * self.gravity),
             "force_peak_mg": float(f.max()),
             "torque_mean_nm": float(t.mean()),
             "torque_peak_nm": float(t.max()),
@@ -147,6 +160,7 @@ def rollout(
     stop_on_fall: bool = True,
     audit: bool = False,
     recovery: RecoveryConfig | None = None,
+    flight: FlightConfig | None = None,
 ) -> RolloutResult:
     """Simulate the reference under ``env`` with ``tracker`` and the gated residual.
 
@@ -159,6 +173,9 @@ def rollout(
         stop_on_fall: stop at the first fall (otherwise simulate to the end).
         audit: check the physics invariants at every step (see :func:`_audit`).
         recovery: rewind-and-retry on a fall (default None: off; also off without ``stop_on_fall``).
+        flight: follow the simulated flights with a :class:`FlightClock` (None: the reference's
+            own clock). The default tracker then runs without its landing sync (the clock
+            does that job); the rollout may be longer or shorter than the reference.
     Returns:
         A :class:`RolloutResult`.
     """
@@ -171,12 +188,14 @@ def rollout(
     d.qpos[:] = reference.qpos[0]
     d.qvel[:] = reference.qvel[0]
     mujoco.mj_forward(m, d)
-    tracker = tracker or PDTracker()
+    clock = FlightClock(reference.contact, 1.0 / reference.dt, flight) if flight is not None else None
+    tracker = tracker or PDTracker(PDTrackerConfig(landing_sync=clock is None))
     tracker.reset(m, d, reference, ix)
     res = RootResidual(residual, m, reference, ix, env.gravity)
     n_sub = int(round(reference.dt / m.opt.timestep))
     K = reference.num_frames
-    S = (K - 1) * n_sub
+    N = clock.max_steps if clock is not None else K - 1  # most control steps
+    S = N * n_sub
     qpos = np.zeros((S + 1, m.nq))
     qpos[0] = d.qpos
     wrench = np.zeros((S, 6))
@@ -190,28 +209,36 @@ def rollout(
     rec = recovery if (recovery is not None and stop_on_fall and recovery.max_retries > 0
                        and recovery.variants) else None
     spec = int(mujoco.mjtState.mjSTATE_INTEGRATION)
-    states = np.zeros((K, mujoco.mj_stateSize(m, spec))) if rec is not None else None
+    states = np.zeros((N + 1, mujoco.mj_stateSize(m, spec))) if rec is not None else None
+    clocks: dict[int, FlightClock] = {}
     alternates: dict[int, Tracker] = {}
     override: tuple[int, int, int] | None = None  # (first frame, end frame, variant)
     retries = 0
     step = 0
-    k = 0
+    k = 0  # reference frame
+    n = 0  # control step
+    frames = [0]
     t0 = time.process_time()
-    while k < K - 1:
+    while (clock is None and k < K - 1) or (clock is not None and not clock.done):
         if states is not None:
-            mujoco.mj_getState(m, d, states[k], spec)
+            mujoco.mj_getState(m, d, states[n], spec)
+            if clock is not None:
+                clocks[n] = clock.snapshot()
         active = tracker
-        if override is not None and override[0] <= k < override[1]:
+        if override is not None and override[0] <= n < override[1]:
             v = override[2]
             if v not in alternates:
-                alternates[v] = PDTracker(rec.variants[v])
+                cfg = rec.variants[v]
+                if clock is not None:
+                    cfg = replace(cfg, landing_sync=False)
+                alternates[v] = PDTracker(cfg)
                 alternates[v].reset(m, d, reference, ix)
             active = alternates[v]
         d.ctrl[:] = active.act(d, k)
-        step = k * n_sub
-        for _ in range(n_sub):
+        step = n * n_sub
+        for j in range(n_sub):
             mujoco.mj_step1(m, d)
-            w = res.wrench(d, d.time)
+            w = res.wrench(d, d.time if clock is None else k * reference.dt + j * m.opt.timestep)
             d.xfrc_applied[p] = w
             wrench[step] = w
             airborne[step] = d.ncon == 0
@@ -224,8 +251,12 @@ def rollout(
         if _unstable(mujoco, d):
             status, fall_time = "unstable", d.time
             break
-        # fall detection at the control rate
-        kk = k + 1
+        # fall detection at the control rate, against the frame of the next step
+        if clock is not None:
+            mujoco.mj_subtreeVel(m, d)
+            kk = clock.advance(d.ncon > 0, float(d.subtree_linvel[p, 2]))
+        else:
+            kk = k + 1
         head = d.xpos[ix.head, 2]
         if ref_head[kk] > fall.min_ref_head and head < fall.head_ratio * ref_head[kk]:
             status, fall_time = "fell", d.time
@@ -237,24 +268,32 @@ def rollout(
             if err > fall.max_error:
                 status, fall_time = "fell", d.time
         if status == "fell" and rec is not None and retries < rec.max_retries:
-            start = max(0, kk - rec.window)
+            start = max(0, n + 1 - rec.window)
             override = (start, start + rec.hold, retries % len(rec.variants))
             retries += 1
             mujoco.mj_setState(m, d, states[start], spec)
             mujoco.mj_forward(m, d)
             status, fall_time = "ok", None
-            k = start
+            n = start
+            del frames[start + 1:]
+            k = frames[start]
+            if clock is not None:
+                clock = clocks[start].snapshot()
             continue
         if status != "ok" and stop_on_fall:
+            frames.append(kk)
             break
-        k += 1
+        n += 1
+        k = kk
+        frames.append(k)
     cpu = time.process_time() - t0
     if status == "fell" and not stop_on_fall:
         pass
     return RolloutResult(
         status=status, fall_time=fall_time, qpos=qpos[: step + 1], residual=wrench[:step], support=support[:step],
         airborne=airborne[:step], violations=violations, cpu_s=cpu, timestep=float(m.opt.timestep), mass=ix.mass,
-        gravity=abs(env.gravity), recoveries=retries,
+        gravity=abs(env.gravity), recoveries=retries, ref_frames=np.asarray(frames[: step // n_sub + 1], dtype=int),
+        control_dt=float(reference.dt),
     )
 
 

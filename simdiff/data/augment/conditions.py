@@ -6,10 +6,17 @@
   gravity ``g_z ~ U[−20, −1]`` m/s² with no wind, or wind ``w_x ~ U[−10, 10]`` N or
   ``w_y ~ U[−10, 10]`` N at Earth gravity. The same ``n`` conditions are applied to every
   clip, so the kept fraction per condition is comparable across clips.
+* ``paper``: the paper's full grid: every clip under all ``n`` (30) random conditions.
+* ``paired`` (default): every clip at Earth (index 0) and under ``k`` conditions of its own
+  (indices 1..k), drawn one factor at a time from a generator seeded by (seed, clip id) and
+  nothing else, so φ is independent of the clip's content; the factors cycle gravity,
+  wind_x, wind_y from a per-clip random start (k = 6 gives each factor twice). Each clip's
+  Earth rollout is the baseline its physics signal is measured against.
 """
 
 from __future__ import annotations
 
+import zlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,7 +24,9 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND, Environment
 
-MODES: tuple[str, ...] = ("binary", "random")
+MODES: tuple[str, ...] = ("binary", "random", "paper", "paired")
+DEFAULT_PAIRED_K: int = 6
+"""Conditions drawn per clip in paired mode (besides Earth)."""
 FACTORS: tuple[str, ...] = ("gravity", "wind_x", "wind_y")
 
 
@@ -67,10 +76,42 @@ def random_conditions(n: int = 30, seed: int = 0) -> list[AugmentEnv]:
     return out
 
 
+def _draw(rng: np.random.Generator, factor: str) -> Environment:
+    lo, hi = GRAVITY_RANGE
+    if factor == "gravity":
+        return Environment(round(float(rng.uniform(lo, hi)), 4), 0.0, 0.0)
+    w = round(float(rng.uniform(-MAX_WIND, MAX_WIND)), 4)
+    return Environment(EARTH_GRAVITY, w, 0.0) if factor == "wind_x" else Environment(EARTH_GRAVITY, 0.0, w)
+
+
+def paired_conditions(clip: str, k: int = DEFAULT_PAIRED_K, seed: int = 0) -> list[AugmentEnv]:
+    """Earth and ``k`` one-factor conditions of one clip, seeded by (seed, clip id) only.
+
+    Args:
+        clip: the clip id (its bytes seed the draw, through CRC-32; its content never does).
+        k: conditions besides Earth.
+        seed: run seed.
+    Returns:
+        ``[Earth (index 0), draw 1, …, draw k]``, values rounded to 1e-4.
+    """
+    if k < 1:
+        raise SimdiffError(f"--conditions must be at least 1 in paired mode, got {k}")
+    rng = np.random.default_rng([seed, 0xA13, zlib.crc32(clip.encode("utf-8"))])
+    start = int(rng.integers(3))
+    out = [AugmentEnv(0, "earth", Environment(EARTH_GRAVITY, 0.0, 0.0))]
+    for i in range(k):
+        factor = FACTORS[(start + i) % 3]
+        out.append(AugmentEnv(i + 1, factor, _draw(rng, factor).validate()))
+    return out
+
+
 def make_conditions(mode: str, n: int = 30, seed: int = 0) -> list[AugmentEnv]:
-    """Conditions of ``mode`` (``binary`` ignores ``n`` and ``seed``)."""
+    """The shared condition list of ``mode`` (``binary`` ignores ``n`` and ``seed``; ``paired``
+    draws per clip, see :func:`paired_conditions`, and returns the Earth condition here)."""
     if mode == "binary":
         return binary_conditions()
-    if mode == "random":
+    if mode in ("random", "paper"):
         return random_conditions(n, seed)
+    if mode == "paired":
+        return binary_conditions()
     raise SimdiffError(f"unknown augmentation mode {mode!r}; choose one of {', '.join(MODES)}")

@@ -1,23 +1,27 @@
 """Which simulated pairs enter the augmented corpus (a pure function of the projection result).
 
-A pair (source clip, φ) is kept when the rollout
+A pair (source clip, φ) is kept when the rollout passes every criterion:
 
-1. tracked to the end (``success``: no fall, no instability, all frames returned);
-2. stays close to the source: ``d_L2 ≤ 7.0`` (paper eq. 13, mean per-frame L2 distance of
-   normalised 263-d features; NaN fails);
-3. was not carried by the tracker's root residual: the mean residual force over the rollout
-   ``residual.force_mean_mg`` (a fraction of the character's weight m·|g_z| under φ) is at
-   most ``max_residual``.
+1. ``failed``: it tracked to the end (no fall, no instability);
+2. ``faithfulness``: it still performs the source's motion, measured so that what φ changes
+   (timing, flight height and length, speed) is not punished: ``d_l2_pose`` (pose channels
+   of the 263-d features against the source re-timed onto the rollout's flight clock, see
+   :mod:`simdiff.sim.faithfulness`) at most ``max_pose_d_l2``. The paper's d_L2 ≤ 7 rejected
+   exactly the rollouts gravity changed (Earth motions re-tracked at g = −3: median d_L2 9.7);
+   it stays available as ``max_d_l2`` (off by default);
+3. ``residual``: it was not carried by the tracker's root residual: the mean residual force
+   over the rollout at most ``max_residual_n`` **newtons**, the same for every φ.
 
-Why a residual budget, and why 0.1 by default: the PD tracker may push the pelvis with a
-contact-gated, non-physical wrench (up to 0.5·m·g by default, see
-:mod:`simdiff.sim.residual`). A rollout that leans on it is not a motion that obeys φ: in
-particular the residual can cancel the wind (10 N is only 0.014·m·g for 72 kg). On the 40
-CMU clips of ``reports/sim/summary.md`` the tracked jumps and jacks, which look physical,
-use 0.06–0.13·m·g on average, walks and runs that the residual props up 0.15–0.25·m·g;
-0.1·m·g separates the two groups (7 of the 40 clips, 18 %, track at Earth gravity within it
-with the first-pass tracker). Raise it (``--max-residual``) for more data of
-lower physical fidelity; 0 keeps only residual-free rollouts (the paper's strict setting).
+Why an absolute budget: the residual corrects the tracker's stance errors (foot placement,
+retargeting), whose size does not scale with g. A budget of 0.1·m·|g_z| (the previous rule)
+is 71 N on Earth but 11.5 N at g = −1.6, below what the stance correction needs on any
+motion, so it rejected nearly every low-gravity pair (5 of 97 at g ≥ −3.2). The default,
+70.6 N = 0.1·72 kg·9.81 m/s², keeps the Earth threshold where it was (so the Earth keep rate
+does not move) and applies it unchanged at every g. The residual is zero in the air (gated,
+audited), so it never carries a flight; against the wind it is velocity-only in xy.
+
+Calibration of ``max_pose_d_l2``: chosen so that, on Earth rollouts, it keeps the same share
+of tracked pairs as d_L2 ≤ 7 did (see ``reports/augment/README.md``).
 """
 
 from __future__ import annotations
@@ -26,27 +30,69 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-REASONS: tuple[str, ...] = ("kept", "error", "failed", "d_l2", "residual")
+REASONS: tuple[str, ...] = ("kept", "error", "failed", "faithfulness", "residual")
 """Outcome labels, in the order the checks are applied."""
+CRITERIA: tuple[str, ...] = ("failed", "faithfulness", "residual")
+"""The criteria, each also judged on its own by :func:`rejections`."""
+HUMANOID_MASS: float = 72.0
+"""kg; converts records that only carry the relative residual (``force_mean_mg``) to newtons."""
 
 
 @dataclass(frozen=True)
 class FilterConfig:
-    """Thresholds of :func:`keep_pair`.
+    """Thresholds of :func:`keep_pair` (None switches a criterion off).
 
     Attributes:
-        max_d_l2: largest d_L2 (normalised feature units) kept; the paper uses 7.0.
-        max_residual: largest mean root residual force as a fraction of m·|g_z| (see module docstring).
+        max_pose_d_l2: largest pose d_L2 against the re-timed source (normalised feature units).
+        max_residual_n: largest mean root residual force (N), for every φ.
+        max_d_l2: largest paper d_L2 (eq. 13; the paper's 7.0), off by default.
+        max_residual: largest mean residual force as a fraction of m·|g_z| (the previous
+            rule), off by default.
     """
 
-    max_d_l2: float = 7.0
-    max_residual: float = 0.1
+    max_pose_d_l2: float | None = 3.3
+    max_residual_n: float | None = 70.6
+    max_d_l2: float | None = None
+    max_residual: float | None = None
 
 
 def _get(info: Any, key: str, default: Any = None) -> Any:
     if isinstance(info, dict):
         return info.get(key, default)
     return getattr(info, key, default)
+
+
+def _over(value: Any, bound: float | None) -> bool:
+    """True when a bound is set and the value is missing, not finite, or above it."""
+    if bound is None:
+        return False
+    if value is None:
+        return True
+    v = float(value)
+    return not math.isfinite(v) or v > bound
+
+
+def residual_newtons(info: Any) -> float:
+    """Mean residual force (N) of a projection record (also from the older relative field)."""
+    residual = _get(info, "residual", {}) or {}
+    if "force_mean_n" in residual:
+        return float(residual["force_mean_n"])
+    env = _get(info, "env", None)
+    g = abs(float(env[0])) if env else 9.81
+    return float(residual.get("force_mean_mg", 0.0)) * HUMANOID_MASS * g
+
+
+def rejections(info: Any, config: FilterConfig = FilterConfig()) -> dict[str, bool]:
+    """Each criterion judged on its own: ``{criterion: rejects}`` (an error rejects all)."""
+    if info is None or isinstance(info, str):
+        return {c: True for c in CRITERIA}
+    residual = _get(info, "residual", {}) or {}
+    return {
+        "failed": not bool(_get(info, "success", False)),
+        "faithfulness": _over(_get(info, "d_l2_pose"), config.max_pose_d_l2) or _over(_get(info, "d_l2"), config.max_d_l2),
+        "residual": _over(residual_newtons(info), config.max_residual_n)
+        or _over(residual.get("force_mean_mg", 0.0), config.max_residual),
+    }
 
 
 def keep_pair(info: Any, config: FilterConfig = FilterConfig()) -> tuple[bool, str]:
@@ -57,17 +103,12 @@ def keep_pair(info: Any, config: FilterConfig = FilterConfig()) -> tuple[bool, s
             string (a projection that raised).
         config: thresholds.
     Returns:
-        (kept, reason) with reason one of :data:`REASONS`.
+        (kept, reason) with reason one of :data:`REASONS` (the first criterion that rejects).
     """
     if info is None or isinstance(info, str):
         return False, "error"
-    if not bool(_get(info, "success", False)):
-        return False, "failed"
-    d = _get(info, "d_l2", float("nan"))
-    if d is None or not math.isfinite(float(d)) or float(d) > config.max_d_l2:
-        return False, "d_l2"
-    residual = _get(info, "residual", {}) or {}
-    force = float(residual.get("force_mean_mg", 0.0))
-    if not math.isfinite(force) or force > config.max_residual:
-        return False, "residual"
+    rej = rejections(info, config)
+    for c in CRITERIA:
+        if rej[c]:
+            return False, c
     return True, "kept"

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simdiff.sim.env import Environment
+from simdiff.sim.flight import FlightConfig
 from simdiff.sim.pool import PoolConfig, ProjectionPool, Projector, Result
 from simdiff.sim.residual import ResidualConfig
 
@@ -28,6 +29,8 @@ class SimProjector:
         workers: processes (``process``) or concurrent tasks (``ray``); 0 = all cores.
         backend: ``process`` (a pool kept alive across shards), ``ray`` or ``serial``.
         max_force: root residual bound (fraction of m·|g_z|) passed to the tracker.
+        flight: the flight clock (default on: flights last as long as φ makes them, the
+            rollout may be longer than its source); None: the reference's own clock.
     Raises:
         SimdiffError: an unknown backend.
     """
@@ -36,10 +39,11 @@ class SimProjector:
     workers: int = 0
     backend: str = "process"
     max_force: float = 0.5
+    flight: FlightConfig | None = FlightConfig()
 
     def __post_init__(self) -> None:
         self._pool = ProjectionPool(PoolConfig(workers=self.workers, backend=self.backend, stats_dir=self.stats_dir,
-                                               residual=ResidualConfig(max_force=self.max_force)))
+                                               residual=ResidualConfig(max_force=self.max_force), flight=self.flight))
 
     def __call__(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:
         return self._pool.imap(motions, envs)

@@ -36,11 +36,13 @@ from typing import Any, Callable
 
 import numpy as np
 
-from simdiff.data.augment.conditions import AugmentEnv, make_conditions
-from simdiff.data.augment.filter import REASONS, FilterConfig, keep_pair
+from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
+from simdiff.data.augment.filter import FilterConfig, keep_pair
+from simdiff.data.augment.report import build_report, report_markdown
 from simdiff.data.augment.projector import Projector, SimProjector
 from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_npy
 from simdiff.errors import SimdiffError
+from simdiff.sim.env import Environment
 
 BINARY_SIM_INDEX: int = 1
 """``env_index`` of simulated clips in binary mode (0 = source clips)."""
@@ -64,10 +66,16 @@ class AugmentConfig:
         workers, backend: parallelism of the default projector.
         per_clip: random mode only: project each clip under this many of the conditions
             (balanced round-robin over the split order) instead of all of them; None = all.
+            Round-robin ties each condition to a fixed group of clips (φ confounded with
+            content); ``paired`` mode draws per clip instead.
+
+    Modes (:mod:`simdiff.data.augment.conditions`): ``paired`` (default; Earth + ``conditions``
+    (default 6) draws per clip), ``paper`` (every clip under all ``conditions`` (30) random
+    conditions), ``random`` (the same list, optionally ``per_clip``), ``binary`` (Earth).
     """
 
-    mode: str = "random"
-    conditions: int = 30
+    mode: str = "paired"
+    conditions: int | None = None
     seed: int = 0
     split: str = "train"
     shard_size: int = 4
@@ -78,9 +86,18 @@ class AugmentConfig:
     backend: str = "process"
     per_clip: int | None = None
 
+    @property
+    def n_conditions(self) -> int:
+        """``conditions`` with its mode's default (paired: 6 per clip; random/paper: 30; binary: 1)."""
+        if self.mode == "binary":
+            return 1
+        if self.conditions is not None:
+            return self.conditions
+        return DEFAULT_PAIRED_K if self.mode == "paired" else 30
+
     def settings(self) -> dict[str, Any]:
         """The options a resumed run must share (parallelism and limit may change)."""
-        settings = {"mode": self.mode, "conditions": self.conditions if self.mode == "random" else 1,
+        settings = {"mode": self.mode, "conditions": self.n_conditions,
                     "seed": self.seed, "split": self.split, "shard_size": self.shard_size,
                     "filter": dataclasses.asdict(self.filter), "residual_bound": self.residual_bound}
         if self.per_clip is not None:
@@ -101,6 +118,14 @@ def assign_conditions(clips: Sequence[str], conditions: Sequence[AugmentEnv], pe
         raise SimdiffError(f"--per-clip must be at least 1, got {per_clip}")
     n = len(conditions)
     return {c: [conditions[(k * per_clip + j) % n] for j in range(per_clip)] for k, c in enumerate(clips)}
+
+
+def conditions_for(clips: Sequence[str], conditions: Sequence[AugmentEnv], config: AugmentConfig
+                   ) -> dict[str, list[AugmentEnv]]:
+    """Conditions of every clip under ``config``'s mode (paired: drawn per clip)."""
+    if config.mode == "paired":
+        return {c: paired_conditions(c, config.n_conditions, config.seed) for c in clips}
+    return assign_conditions(clips, conditions, config.per_clip if config.mode == "random" else None)
 
 
 def clip_id_for(clip: str, condition: AugmentEnv) -> str:
@@ -181,7 +206,7 @@ def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[AugmentEn
         clips = clips[: config.limit]
     if not clips:
         raise SimdiffError(f"{corpus / (config.split + '.txt')}: no clips to augment")
-    conditions = make_conditions(config.mode, config.conditions, config.seed)
+    conditions = make_conditions(config.mode, config.n_conditions, config.seed)
     shards = [clips[i : i + config.shard_size] for i in range(0, len(clips), config.shard_size)]
     return clips, conditions, shards
 
@@ -201,11 +226,14 @@ def _check_settings(out: Path, config: AugmentConfig, conditions: list[AugmentEn
 def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[AugmentEnv]],
                config: AugmentConfig, projector: Projector, tick: Callable[[int], None]) -> dict[str, Any]:
     """Project, filter and write one shard; returns its record (written by the caller)."""
-    motions, envs, pairs, load_errors = [], [], [], {}
+    from simdiff.data.augment.signal import measure
+
+    motions, envs, pairs, load_errors, content = [], [], [], {}, {}
     for clip in clips:
         conditions = assigned[clip]
         try:
             joints = load_source_joints(corpus, clip)
+            content[clip] = measure(joints)
         except SimdiffError as exc:
             load_errors[clip] = str(exc)
             continue
@@ -218,7 +246,7 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: 
         conditions = assigned[clip]
         for cond in conditions:
             records.append({"clip": clip, "condition": cond.index, "id": clip_id_for(clip, cond), "kept": False,
-                            "reason": "error", "info": message})
+                            "reason": "error", "info": message, "env": list(cond.env.as_tuple()), "factor": cond.factor})
         tick(len(conditions))
     results = iter(projector(motions, envs)) if motions else iter(())
     for clip, cond in pairs:
@@ -237,8 +265,15 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: 
                 write_npy(out / "new_joint_vecs" / f"{aid}.npy", feats)
                 write_npy(out / "new_joints" / f"{aid}.npy", joints)
                 write_bytes(out / "texts" / f"{aid}.txt", (corpus / "texts" / f"{clip}.txt").read_bytes())
+        signal = None
+        if rollout is not None and bool(getattr(info, "success", False) or (isinstance(info, dict) and info.get("success"))):
+            try:
+                signal = measure(rollout)
+            except SimdiffError:
+                signal = None
         records.append({"clip": clip, "condition": cond.index, "id": aid, "kept": kept, "reason": reason,
-                        "info": _info_dict(info)})
+                        "info": _info_dict(info), "env": list(cond.env.as_tuple()), "factor": cond.factor,
+                        "signal": signal, "content": content.get(clip)})
         tick(1)
     order = {(c, k.index): i for i, (c, k) in enumerate((c, k) for c in clips for k in assigned[c])}
     records.sort(key=lambda r: order[(r["clip"], r["condition"])])
@@ -262,7 +297,7 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
     clips, conditions, shards = plan(corpus, config)
     out.mkdir(parents=True, exist_ok=True)
     _check_settings(out, config, conditions)
-    assigned = assign_conditions(clips, conditions, config.per_clip if config.mode == "random" else None)
+    assigned = conditions_for(clips, conditions, config)
     todo = []
     for i, shard in enumerate(shards):
         path = _shard_path(out, i)
@@ -297,9 +332,15 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
             records.extend(shard["records"])
     kept = [r for r in records if r["kept"]]
     by_index = {c.index: c for c in conditions}
+
+    def cond_of(r: dict[str, Any]) -> AugmentEnv:
+        if "env" in r:  # the pair's own φ (paired mode draws per clip)
+            return AugmentEnv(int(r["condition"]), str(r.get("factor", "")), Environment(*map(float, r["env"])))
+        return by_index[r["condition"]]
+
     env = {
-        r["id"]: {"env": list(by_index[r["condition"]].env.as_tuple()), "env_index": env_index_for(config.mode, by_index[r["condition"]]),
-                  "condition": r["condition"], "factor": by_index[r["condition"]].factor, "source": r["clip"]}
+        r["id"]: {"env": list(cond_of(r).env.as_tuple()), "env_index": env_index_for(config.mode, cond_of(r)),
+                  "condition": r["condition"], "factor": cond_of(r).factor, "source": r["clip"]}
         for r in kept
     }
     ids = [r["id"] for r in kept]
@@ -324,40 +365,3 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
     write_json(out / "report.json", report)
     (out / "report.md").write_text(report_markdown(report), encoding="utf-8")
     return report
-
-
-def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[AugmentEnv], config: AugmentConfig) -> dict[str, Any]:
-    """Kept fraction and reasons per condition and overall, and the simulator CPU time."""
-    rows = []
-    for cond in conditions:
-        mine = [r for r in records if r["condition"] == cond.index]
-        reasons = {k: sum(1 for r in mine if r["reason"] == k) for k in REASONS}
-        rows.append({**cond.to_dict(), "pairs": len(mine), "kept": reasons["kept"],
-                     "kept_fraction": reasons["kept"] / len(mine) if mine else None, "reasons": reasons})
-    cpu = [float(r["info"].get("cpu_s", 0.0)) for r in records if isinstance(r["info"], dict)]
-    total_kept = sum(1 for r in records if r["kept"])
-    return {"settings": config.settings(), "pairs": len(records), "kept": total_kept,
-            "kept_fraction": total_kept / len(records) if records else None,
-            "clips": len({r["clip"] for r in records}), "sim_cpu_s_total": round(sum(cpu), 3),
-            "per_condition": rows}
-
-
-def report_markdown(report: dict[str, Any]) -> str:
-    """The report as a Markdown table."""
-    frac = report["kept_fraction"]
-    lines = [
-        "# Simulator-augmented corpus", "",
-        f"* pairs: {report['pairs']} from {report['clips']} clips; kept {report['kept']}"
-        + (f" ({100 * frac:.1f} %)" if frac is not None else ""),
-        f"* filter: {report['settings']['filter']}; tracker residual bound {report['settings']['residual_bound']}·m·g",
-        f"* simulator CPU time: {report['sim_cpu_s_total']} s", "",
-        "| cond | factor | g_z | w_x | w_y | pairs | kept | kept % | failed | d_L2 | residual | error |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    for r in report["per_condition"]:
-        g, wx, wy = r["env"]
-        pct = "—" if r["kept_fraction"] is None else f"{100 * r['kept_fraction']:.1f}"
-        rs = r["reasons"]
-        lines.append(f"| {r['index']} | {r['factor']} | {g:.2f} | {wx:.2f} | {wy:.2f} | {r['pairs']} | {r['kept']} | {pct} "
-                     f"| {rs['failed']} | {rs['d_l2']} | {rs['residual']} | {rs['error']} |")
-    return "\n".join(lines) + "\n"

@@ -1,0 +1,97 @@
+"""The augmentation report: keep rates and rejections per condition bin, confound check, physics signal."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from simdiff.data.augment.conditions import AugmentEnv
+from simdiff.data.augment.confound import confound_check
+from simdiff.data.augment.filter import CRITERIA, REASONS, FilterConfig, rejections
+from simdiff.data.augment.signal import condition_bin, signal_markdown, signal_table
+
+
+def _env(r: dict[str, Any], by_index: dict[int, AugmentEnv]) -> list[float]:
+    if "env" in r:
+        return [float(v) for v in r["env"]]
+    return list(by_index[r["condition"]].env.as_tuple())
+
+
+def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[AugmentEnv], config: Any) -> dict[str, Any]:
+    """Kept fraction and reasons per condition and per condition bin, confound check, signal table.
+
+    Args:
+        records: the shards' pair records (``clip``, ``condition``, ``kept``, ``reason``,
+            ``info``, and in paired mode ``env``, ``signal``, ``content``).
+        conditions: the run's shared condition list (paired mode: Earth only).
+        config: the :class:`simdiff.data.augment.run.AugmentConfig`.
+    """
+    by_index = {c.index: c for c in conditions}
+    filt: FilterConfig = getattr(config, "filter", FilterConfig())
+    rows = []
+    if config.mode != "paired":
+        for cond in conditions:
+            mine = [r for r in records if r["condition"] == cond.index]
+            reasons = {k: sum(1 for r in mine if r["reason"] == k) for k in REASONS}
+            rows.append({**cond.to_dict(), "pairs": len(mine), "kept": reasons["kept"],
+                         "kept_fraction": reasons["kept"] / len(mine) if mine else None, "reasons": reasons})
+    bins: dict[str, dict[str, Any]] = {}
+    for r in records:
+        b = condition_bin(_env(r, by_index))
+        row = bins.setdefault(b, {"pairs": 0, "kept": 0, "error": 0, **{f"rejected_{c}": 0 for c in CRITERIA}})
+        row["pairs"] += 1
+        row["kept"] += bool(r["kept"])
+        if r["reason"] == "error":
+            row["error"] += 1
+            continue
+        for c, v in rejections(r["info"], filt).items():
+            row[f"rejected_{c}"] += bool(v)
+    for row in bins.values():
+        row["kept_fraction"] = row["kept"] / row["pairs"] if row["pairs"] else None
+    cpu = [float(r["info"].get("cpu_s", 0.0)) for r in records if isinstance(r["info"], dict)]
+    sim_s = [float(r["info"].get("n_out", 0)) / 20.0 for r in records if isinstance(r["info"], dict)]
+    total_kept = sum(1 for r in records if r["kept"])
+    content = {r["clip"]: r["content"] for r in records if r.get("content")}
+    table_in = [{"clip": r["clip"], "env": _env(r, by_index), "kept": r["kept"], "signal": r.get("signal")}
+                for r in records]
+    return {"settings": config.settings(), "pairs": len(records), "kept": total_kept,
+            "kept_fraction": total_kept / len(records) if records else None,
+            "clips": len({r["clip"] for r in records}), "sim_cpu_s_total": round(sum(cpu), 3),
+            "cpu_s_per_sim_s": round(sum(cpu) / sum(sim_s), 4) if sum(sim_s) > 0 else None,
+            "per_condition": rows, "per_bin": dict(sorted(bins.items())),
+            "confound": confound_check([t for t in table_in if t["kept"]], content),
+            "signal": signal_table(table_in)}
+
+
+def report_markdown(report: dict[str, Any]) -> str:
+    """The report as Markdown tables."""
+    frac = report["kept_fraction"]
+    lines = [
+        "# Simulator-augmented corpus", "",
+        f"* pairs: {report['pairs']} from {report['clips']} clips; kept {report['kept']}"
+        + (f" ({100 * frac:.1f} %)" if frac is not None else ""),
+        f"* filter: {report['settings']['filter']}; tracker residual bound {report['settings']['residual_bound']}·m·g",
+        f"* simulator CPU time: {report['sim_cpu_s_total']} s ({report.get('cpu_s_per_sim_s')} CPU s per simulated s)", "",
+        "## Keep rate per condition bin (each criterion judged on its own)", "",
+        "| bin | pairs | kept | kept % | failed | faithfulness | residual | error |", "|---|---|---|---|---|---|---|---|",
+    ]
+    for b, r in report["per_bin"].items():
+        pct = "—" if r["kept_fraction"] is None else f"{100 * r['kept_fraction']:.1f}"
+        lines.append(f"| {b} | {r['pairs']} | {r['kept']} | {pct} | {r['rejected_failed']} | {r['rejected_faithfulness']} "
+                     f"| {r['rejected_residual']} | {r['error']} |")
+    c = report["confound"]
+    lines += ["", "## Confound check (φ vs clip content over kept pairs)", "",
+              f"* max |r| = {c['max_abs_r'] if c['max_abs_r'] is None else round(c['max_abs_r'], 3)} "
+              f"({c['worst']}) over {c['pairs']} pairs; passes (≤ {c['bound']}): {c['passes']}", "",
+              "## Physics signal (medians, against each clip's own Earth rollout)", "", signal_markdown(report["signal"])]
+    if report["per_condition"]:
+        lines += ["## Per condition", "",
+                  "| cond | factor | g_z | w_x | w_y | pairs | kept | kept % | failed | faithfulness | residual | error |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in report["per_condition"]:
+            g, wx, wy = r["env"]
+            pct = "—" if r["kept_fraction"] is None else f"{100 * r['kept_fraction']:.1f}"
+            rs = r["reasons"]
+            lines.append(f"| {r['index']} | {r['factor']} | {g:.2f} | {wx:.2f} | {wy:.2f} | {r['pairs']} | {r['kept']} "
+                         f"| {pct} | {rs['failed']} | {rs['faithfulness']} | {rs['residual']} | {rs['error']} |")
+    return "\n".join(lines) + "\n"

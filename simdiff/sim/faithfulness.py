@@ -1,0 +1,54 @@
+"""Faithfulness to the source that does not punish what φ changes (timing, height, speed).
+
+:func:`pose_d_l2` is paper eq. 13 restricted to the *pose* channels of the 263-d HumanML3D
+features and taken against the source re-timed onto the rollout's clock
+(:func:`simdiff.sim.flight.aligned_source`):
+
+* kept: joint positions relative to the root in the heading frame, horizontal components
+  (``ric`` x, z: 42 dims) and the local joint rotations (``rot6d``: 126 dims);
+* dropped: root height and the joints' heights (``root_y``, ``ric`` y: a higher or lower
+  flight), every velocity channel (``root_rot_vel``, ``root_lin_vel``, ``vel``: a slower fall,
+  a longer flight, and the re-timed source stands still while the clock waits) and the foot
+  contacts (a flight that lasts longer has more airborne frames).
+
+So it measures whether the rollout still performs the text's motion, pose by pose, not
+whether it moves with Earth's timing. Units: normalised feature units, like d_L2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simdiff.motion.features import SLICES
+
+
+def pose_feature_mask() -> np.ndarray:
+    """(263,) bool: the pose channels compared by :func:`pose_d_l2`."""
+    mask = np.zeros(263, dtype=bool)
+    ric = np.arange(SLICES["ric"].start, SLICES["ric"].stop)
+    mask[ric[(ric - SLICES["ric"].start) % 3 != 1]] = True  # x and z of each joint
+    mask[SLICES["rot6d"]] = True
+    return mask
+
+
+def pose_d_l2(source_aligned: np.ndarray, out_joints: np.ndarray, normalizer) -> float:
+    """Mean per-frame L2 distance of the normalised pose channels (see module docstring).
+
+    Args:
+        source_aligned: (T, 22, 3) source joints re-timed onto the rollout (metres, Y-up).
+        out_joints: (T', 22, 3) rollout joints; both are cut to the common length.
+        normalizer: a :class:`simdiff.motion.normalize.Normalizer`; None gives NaN.
+    Returns:
+        The distance, NaN with fewer than 2 common frames or without a normaliser.
+    """
+    if normalizer is None:
+        return float("nan")
+    n = min(len(source_aligned), len(out_joints))
+    if n < 2:
+        return float("nan")
+    from simdiff.sim.retarget import joints_to_features
+
+    mask = pose_feature_mask()
+    fr = np.asarray(normalizer.normalize(joints_to_features(source_aligned[:n])))[:, mask]
+    fo = np.asarray(normalizer.normalize(joints_to_features(out_joints[:n])))[:, mask]
+    return float(np.linalg.norm(fr - fo, axis=-1).mean())
