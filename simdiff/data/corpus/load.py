@@ -8,8 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from simdiff.data.corpus.item import Item
-from simdiff.errors import MotionFormatError, SimdiffError
-from simdiff.motion.skeleton import FPS
+from simdiff.errors import SimdiffError
 
 _CMU_RIG = {"cmu-amc": "amc", "cmu-bvh": "bvh", "cmu-deepmimic": "deepmimic"}
 _DEFAULT_FPS = {"bandai": 30.0, "deepmimic": 30.0, "cmu-deepmimic": 30.0, "cmu-bvh": 60.0}
@@ -51,14 +50,14 @@ def load_item(item: Item) -> tuple[np.ndarray, int]:
     """(T, 22, 3) float32 joints of ``item`` at 20 fps and the leading source frames dropped.
 
     CMU copies in ``shared/cmu`` go through :func:`simdiff.data.cmu.load.load_source` (same
-    output as ``build-cmu``); the rest through :func:`simdiff.motion.io.load_joints`, with
-    the Bandai joint map when the generic reader does not know that rig.
+    output as ``build-cmu``); the rest through :func:`simdiff.motion.io.load_joints` (which
+    knows the Bandai, Motionbuilder, Daz, HDM05 and DeepMimic rigs and their clean-ups).
 
     Raises:
         SimdiffError: (often MotionFormatError) naming the file.
     """
-    from simdiff.data.cmu.load import lift_penetrations, load_source
-    from simdiff.motion.io import load_joints, load_rig, retarget_rig
+    from simdiff.data.cmu.load import load_source
+    from simdiff.motion.io import load_joints
 
     if item.source in _CMU_RIG and "cmu_trial" in item.meta:
         joints, skipped = load_source(item.meta["cmu_trial"], _CMU_RIG[item.source])  # type: ignore[arg-type]
@@ -66,16 +65,5 @@ def load_item(item: Item) -> tuple[np.ndarray, int]:
     if item.source == "hdm05":
         return _check(item, load_joints(item.path, asf=item.asf, fps=item.fps)), 0
     if item.source == "bandai":
-        try:
-            return _check(item, load_joints(item.path, drop_first=False)), 0
-        except MotionFormatError as exc:
-            if "no HumanML3D joint map" not in str(exc):
-                raise
-            from simdiff.data.corpus.src_bandai import JOINT_MAP
-
-            rig = load_rig(item.path, drop_first=False)
-            return _check(item, retarget_rig(rig, fps=FPS, joint_map=JOINT_MAP)), 0  # type: ignore[arg-type]
-    joints = load_joints(item.path, asf=item.asf, fps=item.fps)
-    if item.source == "deepmimic":
-        joints = lift_penetrations(joints)
-    return _check(item, joints), 0
+        return _check(item, load_joints(item.path, drop_first=False)), 0
+    return _check(item, load_joints(item.path, asf=item.asf, fps=item.fps)), 0

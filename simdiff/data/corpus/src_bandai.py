@@ -11,22 +11,6 @@ from pathlib import Path
 from simdiff.data.corpus.archive import source_dir
 from simdiff.data.corpus.item import Item
 
-JOINT_MAP: dict[str, object] = {
-    "pelvis": (("UpperLeg_L", 0.425), ("UpperLeg_R", 0.425), ("Neck", 0.15)),
-    "left_hip": "UpperLeg_L", "right_hip": "UpperLeg_R",
-    "spine1": ("Hips", "Spine", 0.5), "spine2": "Spine", "spine3": "Chest",
-    "left_knee": "LowerLeg_L", "right_knee": "LowerLeg_R",
-    "left_ankle": "Foot_L", "right_ankle": "Foot_R",
-    "left_foot": "Toes_L", "right_foot": "Toes_R",
-    "neck": "Neck", "head": "Head",
-    "left_collar": "Shoulder_L", "right_collar": "Shoulder_R",
-    "left_shoulder": "UpperArm_L", "right_shoulder": "UpperArm_R",
-    "left_elbow": "LowerArm_L", "right_elbow": "LowerArm_R",
-    "left_wrist": "Hand_L", "right_wrist": "Hand_R",
-}
-"""Bandai rig -> HumanML3D joints, used when the generic reader has no map for the rig
-(``joint_Root`` is a static parent; the pelvis follows the CMU map's hip/neck placement)."""
-
 CONTENTS: dict[str, tuple[str, tuple[str, ...]]] = {
     "walk": ("walk", ("walks forward", "walks ahead", "takes a walk forward")),
     "run": ("run", ("runs forward", "jogs ahead", "runs")),
@@ -112,6 +96,5 @@ def discover(shared: Path, cache: Path) -> list[Item]:
                 id=f"bn{number}_{content}_{style}_{take}", trial=f"bandai:{number}/{path.stem}", source="bandai",
                 path=path, licence="CC-BY-NC-4.0", motion_type=kind, verbs=verbs, adverbs=adverbs,
                 subjects=subjects, caption_origin="bandai-labels", description=f"{content} / {style}",
-                meta={"joint_map": "bandai"},
             ))
     return items
