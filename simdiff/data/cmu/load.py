@@ -1,4 +1,8 @@
-"""Read one source file of a trial and retarget it to HumanML3D joints at 20 fps."""
+"""Read one source file of a trial and retarget it to HumanML3D joints at 20 fps.
+
+``lift_penetrations`` (DeepMimic ground clean-up) lives in :mod:`simdiff.motion.io.ground`;
+:func:`simdiff.motion.io.retarget_rig` applies it to DeepMimic rigs.
+"""
 
 from __future__ import annotations
 
@@ -8,8 +12,12 @@ import numpy as np
 
 from simdiff.data.cmu.sources import Trial
 from simdiff.errors import SimdiffError
+from simdiff.motion.io.ground import GROUND_PERCENTILE, MAX_LIFT, lift_penetrations
 from simdiff.motion.io.rig import RigMotion
 from simdiff.motion.skeleton import FPS
+
+__all__ = ["BVH_FPS", "GROUND_PERCENTILE", "MAX_LIFT", "lift_penetrations", "load_rig_joints",
+           "load_source", "read_source_rig", "source_fps", "source_frame"]
 
 BVH_FPS: float = 60.0
 """Frame rate of the Character-Creator CMU BVH set."""
@@ -57,43 +65,6 @@ def read_source_rig(trial: Trial, rig: str) -> tuple[RigMotion, int]:
     raise SimdiffError(f"unknown rig kind {rig!r}")
 
 
-GROUND_PERCENTILE: float = 5.0
-"""Percentile of the per-frame lowest joint taken as the ground in :func:`lift_penetrations`."""
-MAX_LIFT: float = 0.06
-"""Largest vertical correction (m) of :func:`lift_penetrations`; deeper dips are left alone."""
-
-
-def lift_penetrations(joints: np.ndarray, fps: float = FPS) -> np.ndarray:
-    """Raise the frames that sink below the ground, then put the trial on the floor.
-
-    The DeepMimic retargets were made without ground contact: in 1-5 % of the frames a toe
-    (push-off with a rigid box foot) or a limb (rolls, get-ups) dips 2-10 cm below the level
-    the body otherwise stands or lies on. The corpus floor is the lowest joint of a clip, so
-    those few frames lifted the floor under all the others (median floating 79 mm vs 21 mm
-    for AMC). Here the ground is the :data:`GROUND_PERCENTILE` th percentile of the per-frame
-    lowest joint; a frame below it is raised by the missing height (at most
-    :data:`MAX_LIFT`), the correction smoothed over 0.25 s so that no jerk is added.
-
-    Args:
-        joints: (T, 22, 3) metres, Y-up.
-    Returns:
-        (T, 22, 3) float32, floor (lowest joint) at y = 0.
-    """
-    from scipy.ndimage import maximum_filter1d, uniform_filter1d
-
-    out = np.array(joints, dtype=np.float64, copy=True)
-    lowest = out[..., 1].min(axis=-1)
-    if lowest.size < 3:
-        return out.astype(np.float32)
-    ground = float(np.percentile(lowest, GROUND_PERCENTILE))
-    lift = np.clip(ground - lowest, 0.0, MAX_LIFT)
-    size = max(1, int(round(0.25 * fps)))
-    lift = uniform_filter1d(maximum_filter1d(lift, size, mode="nearest"), size, mode="nearest")
-    out[..., 1] += lift[:, None]
-    out[..., 1] -= out[..., 1].min()
-    return out.astype(np.float32)
-
-
 def load_source(trial: Trial, rig: str) -> tuple[np.ndarray, int]:
     """(T, 22, 3) float32 joints of ``trial`` read from its ``rig`` file (metres, Y-up,
     20 fps, floor at y = 0, source bone proportions) and the number of leading source
@@ -105,9 +76,7 @@ def load_source(trial: Trial, rig: str) -> tuple[np.ndarray, int]:
     from simdiff.motion.io import retarget_rig
 
     motion, skipped = read_source_rig(trial, rig)
-    joints = retarget_rig(motion, fps=FPS)
-    if rig == "deepmimic":
-        joints = lift_penetrations(joints)
+    joints = retarget_rig(motion, fps=FPS)  # DeepMimic: includes lift_penetrations
     if joints.ndim != 3 or joints.shape[1:] != (22, 3) or not np.all(np.isfinite(joints)):
         raise SimdiffError(f"{Path(trial.files[rig])}: retarget gave unusable joints {joints.shape}")
     return joints.astype(np.float32), skipped

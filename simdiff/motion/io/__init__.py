@@ -4,6 +4,22 @@ HumanML3D 22-joint skeleton, and writers (BVH, .npy).
 :func:`load_joints` reads any supported file into (T, 22, 3) float32 joint positions in
 metres, Y-up, at 20 fps.
 
+Sources and what the readers do for them (rig families: :mod:`simdiff.motion.io.rigs`):
+
+- CMU ASF/AMC and HDM05 ASF/AMC (``HDM_<actor>.asf`` found beside ``HDM_<actor>_*.amc``;
+  rate from ``CMU_data.csv`` or a ``_120`` name suffix, else 120 fps);
+- BVH: CMU Character-Creator (an added first T-pose is detected and dropped), CMU
+  Motionbuilder (CMU ASF units, first frame a T-pose: dropped; its missing thorax bone is
+  put back), Daz-style CMU/acLSTM (cm), Bandai-Namco (cm, 30 fps), generic bipeds;
+- DeepMimic JSON (``.txt``): variable frame durations are resampled on their time stamps;
+  :func:`retarget_rig` applies the DeepMimic ground clean-up ``lift_penetrations``;
+- ``.npy`` HumanML3D joints or features.
+
+BVH units (file unit -> metres), in order: the ``units`` argument ("m", "cm", "mm",
+"inch", "cmu" or a factor); the rig family's known unit (Bandai, Daz: cm; Motionbuilder:
+inch / 0.45); else the unit among those that brings the body size (90th percentile over
+frames of the largest joint-cloud extent) nearest 1.7 m.
+
 ``simdiff.motion.io.retarget`` and ``simdiff.motion.io.resample`` are always the modules;
 the functions are :func:`retarget_rig` (also exported here) and
 ``simdiff.motion.io.resample.resample``.
@@ -17,19 +33,35 @@ import numpy as np
 
 from simdiff.errors import MotionFormatError, SimdiffError
 from simdiff.motion.io.asf_amc import DEFAULT_FPS as AMC_DEFAULT_FPS
-from simdiff.motion.io.asf_amc import AsfSkeleton, find_asf, lookup_cmu_fps, read_amc, read_asf
-from simdiff.motion.io.bvh import read_bvh, starts_with_tpose
+from simdiff.motion.io.asf_amc import (
+    AsfSkeleton,
+    amc_fps_from_name,
+    find_asf,
+    lookup_cmu_fps,
+    read_amc,
+    read_asf,
+)
+from simdiff.motion.io.bvh import (
+    KNOWN_SCALES,
+    leading_transient,
+    parse_bvh,
+    read_bvh,
+    rig_from_bvh,
+    starts_with_tpose,
+)
 from simdiff.motion.io.bvh_writer import write_bvh
 from simdiff.motion.io.deepmimic import read_deepmimic
 from simdiff.motion.io.npy import read_npy, save_npy
 from simdiff.motion.io.resample import resample as _resample
 from simdiff.motion.io.retarget import retarget_rig, to_canonical_lengths
+from simdiff.motion.io.rigs import RigSpec, detect_rig
 from simdiff.motion.io.rig import RigMotion
 from simdiff.motion.skeleton import FPS
 
 __all__ = [
     "AsfSkeleton",
     "RigMotion",
+    "detect_rig",
     "find_asf",
     "load_joints",
     "load_rig",
@@ -54,15 +86,25 @@ def load_rig(
     asf: str | Path | None = None,
     fps: float | None = None,
     drop_first: bool | None = None,
+    units: str | float | None = None,
 ) -> RigMotion:
     """Read a motion file on its own rig (no retargeting, no resampling).
 
     Args:
         path: ``.amc``, ``.bvh`` or DeepMimic ``.txt``/``.json``.
-        asf: skeleton of an ``.amc`` (default: ``SS.asf`` beside it or in a sibling ``asf/``).
-        fps: the file's frame rate when it cannot be read from it (AMC: default from a
-            ``CMU_data.csv`` beside the data, else 120); overrides the file's own rate.
-        drop_first: BVH only: skip frame 0; None drops it when it is an added T-pose.
+        asf: skeleton of an ``.amc`` (default: :func:`find_asf`: ``SS.asf`` or
+            ``HDM_<actor>.asf`` beside it or in an ``asf/`` folder).
+        fps: the file's frame rate, overriding the file's own (AMC default: from a
+            ``CMU_data.csv`` beside the data, a ``_120`` name suffix, else 120).
+        drop_first: BVH only: True skips frame 0, False keeps every frame; None drops it
+            when the rig family always starts with a T-pose (CMU Motionbuilder), then any
+            detected start-up transient (:func:`~simdiff.motion.io.bvh.leading_transient`:
+            an added T-pose and the blend out of it). ``meta["dropped_frames"]`` counts them.
+        units: BVH only: file unit ("m", "cm", "mm", "inch", "cmu" or metres per unit);
+            None: the rig family's unit, else detected from the body size.
+    Returns:
+        RigMotion; ``meta["rig"]`` is the detected :class:`~simdiff.motion.io.rigs.RigSpec`
+        for BVH files.
     Raises:
         MotionFormatError: unknown extension, missing ASF, or a malformed file.
     """
@@ -70,22 +112,59 @@ def load_rig(
     suffix = path.suffix.lower()
     if not path.is_file():
         raise MotionFormatError(path, "no such file")
+    if units is not None and suffix != ".bvh":
+        raise MotionFormatError(path, f"units={units!r} applies to BVH files only")
     if suffix == ".amc":
         skeleton = Path(asf) if asf is not None else find_asf(path)
         if skeleton is None:
             raise MotionFormatError(
-                path, "no ASF skeleton found (looked for SS.asf beside it and in ../asf/); pass asf="
+                path, "no ASF skeleton found (looked for SS.asf / HDM_<actor>.asf beside it and in asf/); pass asf="
             )
-        rate = fps if fps is not None else (lookup_cmu_fps(path) or AMC_DEFAULT_FPS)
+        rate = fps if fps is not None else (
+            lookup_cmu_fps(path) or amc_fps_from_name(path) or AMC_DEFAULT_FPS
+        )
         return read_amc(path, skeleton, fps=rate)
     if suffix == ".bvh":
-        rig = read_bvh(path, fps=fps, drop_first=bool(drop_first))
-        if drop_first is None and starts_with_tpose(rig.positions):
-            rig = RigMotion(rig.names, rig.parents, rig.positions[1:], rig.fps, rig.source, rig.meta)
-        return rig
+        return _load_bvh(path, fps=fps, drop_first=drop_first, units=units)
     if suffix in (".txt", ".json"):
         return read_deepmimic(path, fps=fps)
     raise MotionFormatError(path, f"unsupported motion file type {suffix!r} (known: {', '.join(SUFFIXES)})")
+
+
+def _units_to_scale(path: Path, units: str | float) -> float:
+    """Metres per file unit of a ``units`` argument."""
+    if isinstance(units, str):
+        if units.lower() not in KNOWN_SCALES:
+            raise MotionFormatError(path, f"unknown units {units!r} (known: {', '.join(KNOWN_SCALES)})")
+        return KNOWN_SCALES[units.lower()]
+    if not float(units) > 0:
+        raise MotionFormatError(path, f"units must be positive metres per unit, got {units!r}")
+    return float(units)
+
+
+def _load_bvh(path: Path, *, fps: float | None, drop_first: bool | None,
+              units: str | float | None) -> RigMotion:
+    """A BVH on its rig: family detected from the joint names, its units, sites and T-pose."""
+    bvh = parse_bvh(path)
+    try:
+        spec: RigSpec | None = detect_rig(tuple(j.name for j in bvh.joints), path)
+    except MotionFormatError:  # an unknown rig can still be read (not retargeted)
+        spec = None
+    scale = _units_to_scale(path, units) if units is not None else (spec.units if spec else None)
+    drop = (spec is not None and spec.first_frame_tpose) if drop_first is None else drop_first
+    rig = rig_from_bvh(bvh, scale=scale, fps=fps, drop_first=drop,
+                       sites=spec.bvh_sites if spec else (),
+                       rest_axes=spec.rest_axes if spec else ((1, 0, 0), (0, 1, 0), (0, 0, 1)))
+    dropped = int(drop)
+    if drop_first is None:
+        skip = max(leading_transient(rig.positions, rig.fps), int(starts_with_tpose(rig.positions)))
+        if skip:
+            rig = RigMotion(rig.names, rig.parents, rig.positions[skip:], rig.fps, rig.source, rig.meta)
+            dropped += skip
+    rig.meta["dropped_frames"] = dropped
+    if spec is not None:
+        rig.meta["rig"] = spec
+    return rig
 
 
 def load_joints(
@@ -94,7 +173,9 @@ def load_joints(
     asf: str | Path | None = None,
     fps: float | None = None,
     drop_first: bool | None = None,
+    units: str | float | None = None,
     canonical: bool = False,
+    clean: bool = True,
 ) -> np.ndarray:
     """Read any supported motion file as HumanML3D joints.
 
@@ -108,7 +189,10 @@ def load_joints(
         asf: ASF skeleton for an ``.amc`` file (default: found beside it).
         fps: the source frame rate, overriding the file's (for ``.npy``: default 20).
         drop_first: BVH only, see :func:`load_rig`.
+        units: BVH only, file unit, see :func:`load_rig`.
         canonical: rebuild with HumanML3D's canonical bone lengths.
+        clean: apply the rig family's clean-up (DeepMimic: ``lift_penetrations``; CMU
+            Motionbuilder: thorax restored), see :func:`retarget_rig`.
     Returns:
         (T, 22, 3) float32 joint positions in metres, Y-up, 20 fps.
     Raises:
@@ -118,6 +202,8 @@ def load_joints(
     if path.suffix.lower() == ".npy":
         if not path.is_file():
             raise MotionFormatError(path, "no such file")
+        if units is not None:
+            raise MotionFormatError(path, f"units={units!r} applies to BVH files only")
         array = read_npy(path)
         if array.ndim == 2:
             # lazy: the feature pipeline (simdiff.motion.features) is heavier and optional here
@@ -132,5 +218,5 @@ def load_joints(
         if canonical:
             array = to_canonical_lengths(array, floor=False)
         return np.ascontiguousarray(array, dtype=np.float32)
-    rig = load_rig(path, asf=asf, fps=fps, drop_first=drop_first)
-    return retarget_rig(rig, fps=FPS, canonical=canonical)
+    rig = load_rig(path, asf=asf, fps=fps, drop_first=drop_first, units=units)
+    return retarget_rig(rig, fps=FPS, canonical=canonical, clean=clean)

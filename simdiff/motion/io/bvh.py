@@ -9,6 +9,7 @@ kept as joints named ``<parent>_End``. File units are converted to metres by ``s
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,8 +21,11 @@ from simdiff.motion.io.rig import RigMotion, read_motion_text
 
 _CHANNELS = ("xposition", "yposition", "zposition", "xrotation", "yrotation", "zrotation")
 
-KNOWN_SCALES: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254}
-"""Unit -> metres factors considered by :func:`detect_scale`."""
+KNOWN_SCALES: dict[str, float] = {
+    "m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254, "cmu": 0.0254 / 0.45,
+}
+"""Unit -> metres factors considered by :func:`detect_scale` (``cmu``: the CMU ASF length
+unit, inch / 0.45, kept by the CMU Motionbuilder BVH conversion)."""
 
 HUMAN_HEIGHT: float = 1.7
 """Typical standing height in metres, the target of :func:`detect_scale`."""
@@ -239,6 +243,11 @@ def _header_value(path: Path, lines: list[str], row: int, key: str) -> tuple[flo
 
 def forward_kinematics(bvh: BvhFile, scale: float = 1.0) -> np.ndarray:
     """Global joint positions (T, J, 3) of a parsed BVH, in file axes times ``scale``."""
+    return forward_kinematics_rotations(bvh, scale)[0]
+
+
+def forward_kinematics_rotations(bvh: BvhFile, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Global positions (T, J, 3) (file axes x ``scale``) and rotations (T, J, 3, 3) of a BVH."""
     num_frames = bvh.values.shape[0]
     joints = bvh.joints
     rotations = np.empty((num_frames, len(joints), 3, 3))
@@ -261,17 +270,19 @@ def forward_kinematics(bvh: BvhFile, scale: float = 1.0) -> np.ndarray:
             parent_r = rotations[:, joint.parent]
             rotations[:, i] = parent_r @ local_r
             positions[:, i] = positions[:, joint.parent] + (parent_r @ local_t[..., None])[..., 0]
-    return positions
+    return positions, rotations
 
 
 def rig_height(positions: np.ndarray) -> float:
-    """Rough body size: median over frames of the largest joint-cloud extent (input units).
+    """Rough body size: 90th percentile over frames of the largest joint-cloud extent
+    (input units); a high percentile so that clips spent crouching or sitting still see
+    the standing (or lying) body.
 
     Args:
         positions: (T, J, 3) joint positions.
     """
     extent = positions.max(axis=1) - positions.min(axis=1)
-    return float(np.median(extent.max(axis=-1)))
+    return float(np.percentile(extent.max(axis=-1), 90))
 
 
 def detect_scale(height: float) -> float:
@@ -298,6 +309,37 @@ def starts_with_tpose(positions: np.ndarray) -> bool:
     return bool(steps[0] > 0.10 and steps[0] > 10.0 * np.median(steps[1:]))
 
 
+TRANSIENT_WINDOW: float = 0.1
+"""Seconds at the start of a clip searched by :func:`leading_transient`."""
+TRANSIENT_STEP: float = 0.02
+"""Metres: smallest per-frame step (median over joints) counted as a start-up jump."""
+TRANSIENT_FACTOR: float = 5.0
+"""A start-up jump is also this many times the clip's median step."""
+
+
+def leading_transient(positions: np.ndarray, fps: float) -> int:
+    """Number of leading frames to drop: an added rest pose and the blend out of it.
+
+    Several BVH conversions start with a T-pose, followed (Daz-style CMU files, the
+    acLSTM dances) by 3-5 frames interpolated from it into the motion, or (CMU
+    Motionbuilder 09_10) by frames left at the origin. Every frame before the last step
+    within the first :data:`TRANSIENT_WINDOW` s (at least 2 steps) whose median joint
+    displacement exceeds both :data:`TRANSIENT_STEP` and :data:`TRANSIENT_FACTOR` x the
+    clip's median step is dropped.
+
+    Args:
+        positions: (T, J, 3) joint positions in metres.
+        fps: frames per second.
+    """
+    if positions.shape[0] < 4:
+        return 0
+    steps = np.median(np.linalg.norm(np.diff(positions, axis=0), axis=-1), axis=-1)
+    limit = max(TRANSIENT_STEP, TRANSIENT_FACTOR * float(np.median(steps)))
+    window = min(len(steps) - 1, max(2, int(round(TRANSIENT_WINDOW * fps))))
+    jumps = np.flatnonzero(steps[:window] > limit)
+    return int(jumps[-1]) + 1 if jumps.size else 0
+
+
 def _to_y_up(positions: np.ndarray, up: str) -> np.ndarray:
     """Rotate positions whose up axis is ``up`` ("y", "z" or "-z"... ) so that up is +Y."""
     up = up.lower()
@@ -318,23 +360,42 @@ def read_bvh(
     up: str = "y",
     drop_first: bool = False,
     fps: float | None = None,
+    sites: Sequence[tuple[str, str, str, tuple[float, float, float]]] = (),
+    rest_axes: Sequence[Sequence[float]] = ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
 ) -> RigMotion:
     """Read a BVH file into global joint positions.
 
     Args:
         path: the ``.bvh`` file.
         scale: file units -> metres (0.01 for centimetres); None detects it from the size
-            of the posed rig (:func:`detect_scale`: m, cm, mm or inches).
+            of the posed rig (:func:`detect_scale`: m, cm, mm, inches or CMU units).
         up: the file's up axis ("y", "z" or "x"); positions are rotated to Y-up.
         drop_first: skip frame 0 (e.g. an added T-pose, as in the CMU Character-Creator set).
         fps: frame rate; default 1 / Frame Time.
+        sites: derived points ``(name, joint, child, (left, up, forward))`` appended as
+            joints (see :data:`simdiff.motion.io.rigs.base.BvhSite`).
+        rest_axes: (left, up, forward) of the rest pose in file axes, for ``sites``.
     Returns:
-        RigMotion with every joint and End Site, (T, J, 3) metres Y-up; ``meta`` holds
-        "scale" and "frame_time".
+        RigMotion with every joint, End Site and site, (T, J, 3) metres Y-up; ``meta``
+        holds "scale" and "frame_time".
     Raises:
         MotionFormatError: naming the file and line of a malformed or truncated input.
     """
-    bvh = parse_bvh(path)
+    return rig_from_bvh(parse_bvh(path), scale=scale, up=up, drop_first=drop_first, fps=fps,
+                        sites=sites, rest_axes=rest_axes)
+
+
+def rig_from_bvh(
+    bvh: BvhFile,
+    *,
+    scale: float | None = None,
+    up: str = "y",
+    drop_first: bool = False,
+    fps: float | None = None,
+    sites: Sequence[tuple[str, str, str, tuple[float, float, float]]] = (),
+    rest_axes: Sequence[Sequence[float]] = ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
+) -> RigMotion:
+    """A parsed BVH as a :class:`RigMotion`; arguments as :func:`read_bvh`."""
     if drop_first:
         if bvh.values.shape[0] < 2:
             raise MotionFormatError(bvh.path, "cannot drop the first frame of a one-frame motion")
@@ -348,12 +409,48 @@ def read_bvh(
         scale = detect_scale(rig_height(probe))
     elif not scale > 0:
         raise ValueError(f"scale must be positive, got {scale}")
-    positions = _to_y_up(forward_kinematics(bvh, scale), up)
+    positions, rotations = forward_kinematics_rotations(bvh, scale)
+    names = [j.name for j in bvh.joints]
+    parents = [j.parent for j in bvh.joints]
+    if sites:
+        extra = _site_positions(bvh, names, positions, rotations, scale, sites, rest_axes)
+        positions = np.concatenate([positions, extra], axis=1)
+        names += [s[0] for s in sites]
+        parents += [names.index(s[1]) for s in sites]
+    positions = _to_y_up(positions, up)
     return RigMotion(
-        names=tuple(j.name for j in bvh.joints),
-        parents=tuple(j.parent for j in bvh.joints),
+        names=tuple(names),
+        parents=tuple(parents),
         positions=positions.astype(np.float32),
         fps=fps if fps is not None else 1.0 / bvh.frame_time,
         source=bvh.path,
         meta={"scale": scale, "frame_time": bvh.frame_time},
     )
+
+
+def rest_positions(bvh: BvhFile) -> np.ndarray:
+    """(J, 3) joint positions of the rest pose (OFFSETs only, all rotations zero), file units."""
+    out = np.zeros((len(bvh.joints), 3))
+    for i, joint in enumerate(bvh.joints):
+        out[i] = joint.offset + (out[joint.parent] if joint.parent >= 0 else 0.0)
+    return out
+
+
+def _site_positions(
+    bvh: BvhFile, names: list[str], positions: np.ndarray, rotations: np.ndarray, scale: float,
+    sites: Sequence[tuple[str, str, str, tuple[float, float, float]]],
+    rest_axes: Sequence[Sequence[float]],
+) -> np.ndarray:
+    """(T, S, 3) positions of derived sites, rigid with their joint's global frame."""
+    rest = rest_positions(bvh) * scale
+    axes = np.asarray(rest_axes, dtype=np.float64)
+    out = []
+    for name, joint, child, offset in sites:
+        if joint not in names or child not in names:
+            raise MotionFormatError(bvh.path, f"site {name!r} needs joints {joint!r} and {child!r}")
+        j, c = names.index(joint), names.index(child)
+        bone = rest[c] - rest[j]
+        unit = float(np.linalg.norm(bone)) if c != j else 1.0
+        local = bone + unit * (np.asarray(offset, dtype=np.float64) @ axes)
+        out.append(positions[:, j] + rotations[:, j] @ local)
+    return np.stack(out, axis=1)
