@@ -8,7 +8,8 @@ Sources and what the readers do for them (rig families: :mod:`simdiff.motion.io.
 
 - CMU ASF/AMC and HDM05 ASF/AMC (``HDM_<actor>.asf`` found beside ``HDM_<actor>_*.amc``;
   rate from ``CMU_data.csv`` or a ``_120`` name suffix, else 120 fps);
-- BVH: CMU Character-Creator (an added first T-pose is detected and dropped), CMU
+- BVH (rate: a folder ``readme.txt`` rate, e.g. acLSTM salsa 60 fps, else the header):
+  CMU Character-Creator (an added first T-pose is detected and dropped), CMU
   Motionbuilder (CMU ASF units, first frame a T-pose: dropped; its missing thorax bone is
   put back), Daz-style CMU/acLSTM (cm), Bandai-Namco (cm, 30 fps), generic bipeds;
 - DeepMimic JSON (``.txt``): variable frame durations are resampled on their time stamps;
@@ -52,6 +53,7 @@ from simdiff.motion.io.bvh import (
 from simdiff.motion.io.bvh_writer import write_bvh
 from simdiff.motion.io.deepmimic import read_deepmimic
 from simdiff.motion.io.npy import read_npy, save_npy
+from simdiff.motion.io.rates import folder_fps_hint
 from simdiff.motion.io.resample import resample as _resample
 from simdiff.motion.io.retarget import retarget_rig, to_canonical_lengths
 from simdiff.motion.io.rigs import RigSpec, detect_rig
@@ -95,7 +97,9 @@ def load_rig(
         asf: skeleton of an ``.amc`` (default: :func:`find_asf`: ``SS.asf`` or
             ``HDM_<actor>.asf`` beside it or in an ``asf/`` folder).
         fps: the file's frame rate, overriding the file's own (AMC default: from a
-            ``CMU_data.csv`` beside the data, a ``_120`` name suffix, else 120).
+            ``CMU_data.csv`` beside the data, a ``_120`` name suffix, else 120; BVH default:
+            a folder rate in a ``readme.txt`` one level up
+            (:func:`~simdiff.motion.io.rates.folder_fps_hint`), else the header).
         drop_first: BVH only: True skips frame 0, False keeps every frame; None drops it
             when the rig family always starts with a T-pose (CMU Motionbuilder), then any
             detected start-up transient (:func:`~simdiff.motion.io.bvh.leading_transient`:
@@ -152,7 +156,8 @@ def _load_bvh(path: Path, *, fps: float | None, drop_first: bool | None,
         spec = None
     scale = _units_to_scale(path, units) if units is not None else (spec.units if spec else None)
     drop = (spec is not None and spec.first_frame_tpose) if drop_first is None else drop_first
-    rig = rig_from_bvh(bvh, scale=scale, fps=fps, drop_first=drop,
+    hint = folder_fps_hint(path) if fps is None else None
+    rig = rig_from_bvh(bvh, scale=scale, fps=fps if fps is not None else hint, drop_first=drop,
                        sites=spec.bvh_sites if spec else (),
                        rest_axes=spec.rest_axes if spec else ((1, 0, 0), (0, 1, 0), (0, 0, 1)))
     dropped = int(drop)
@@ -162,6 +167,7 @@ def _load_bvh(path: Path, *, fps: float | None, drop_first: bool | None,
             rig = RigMotion(rig.names, rig.parents, rig.positions[skip:], rig.fps, rig.source, rig.meta)
             dropped += skip
     rig.meta["dropped_frames"] = dropped
+    rig.meta["fps_source"] = "argument" if fps is not None else ("readme" if hint else "header")
     if spec is not None:
         rig.meta["rig"] = spec
     return rig

@@ -450,7 +450,9 @@ def _site_positions(
             raise MotionFormatError(bvh.path, f"site {name!r} needs joints {joint!r} and {child!r}")
         j, c = names.index(joint), names.index(child)
         bone = rest[c] - rest[j]
-        unit = float(np.linalg.norm(bone)) if c != j else 1.0
+        parent = bvh.joints[j].parent
+        own = rest[j] - rest[parent] if parent >= 0 else bone
+        unit = float(np.linalg.norm(bone if c != j else own))
         local = bone + unit * (np.asarray(offset, dtype=np.float64) @ axes)
         out.append(positions[:, j] + rotations[:, j] @ local)
     return np.stack(out, axis=1)
