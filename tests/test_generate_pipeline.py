@@ -11,7 +11,7 @@ import torch
 
 from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network
 from simdiff.motion.features import features_to_joints
-from simdiff.product.gif import write_gif
+from simdiff.viz.video import write_gif
 from simdiff.product.pipeline import Timer, run_generation, sample_motions
 from simdiff.product.request import build_request
 from simdiff.train.testing import HashTextEncoder

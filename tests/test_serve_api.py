@@ -173,7 +173,7 @@ def test_generation_requests_are_serialised(server):
     ({"text": "walk", "gravity": "low"}, "gravity must be a finite number, got 'low'"),
     ({"text": "walk", "seed": 1.5}, "seed must be an integer, got 1.5"),
     ({"text": "walk", "seed": -1}, "seed must be a non-negative integer"),
-    ({"text": "walk", "steps": 0}, "steps must be in [1, 1000], got 0"),
+    ({"text": "walk", "steps": 0}, "steps must be in [1, 200], got 0"),
     ({"text": "walk", "windx": 1}, "unknown field 'windx'"),
     (["walk"], "request body must be a JSON object"),
 ])
@@ -274,7 +274,7 @@ def test_cli_builds_a_server_with_listed_files(tmp_path, walk, model_dir):
 
     np.save(tmp_path / "walk.npy", walk)
     args = argparse.Namespace(files=[tmp_path / "walk.npy"], port=0, host="127.0.0.1", model=model_dir,
-                              device="cpu", steps=None, no_browser=True)
+                              device="cpu", steps=None, queue=4, no_browser=True)
     srv = build_server(args)
     srv.verbose = False
     srv.start_in_thread()

@@ -44,6 +44,33 @@ def test_track_bad_phi(motion_file, capsys, argv):
     assert err.startswith("simdiff: error:") and len(err.strip().splitlines()) == 1
 
 
+def test_track_workers_same_results(motion_file, tmp_path, capsys):
+    """--workers 2 (spawned processes) gives the same rollouts and numbers as --workers 1, in order."""
+    other = tmp_path / "standing.npy"
+    np.save(other, synthetic.standing(20))
+    files = [str(motion_file), str(other)]
+    runs = []
+    for workers in ("1", "2"):
+        out = tmp_path / f"w{workers}"
+        assert main(["track", *files, "--json", "--out", str(out), "--workers", workers]) == 0
+        captured = capsys.readouterr()
+        records = [json.loads(line) for line in captured.out.strip().splitlines()]
+        assert "tracking" in captured.err  # the progress bar
+        for r in records:  # timings and output paths differ between runs
+            for key in ("cpu_s", "sim_cpu_s", "out"):
+                r.pop(key)
+        runs.append((records, [np.load(out / n) for n in ("squat.npy", "standing.npy")]))
+    (rec1, arr1), (rec2, arr2) = runs
+    assert [r["file"] for r in rec1] == files and rec1 == rec2
+    for a, b in zip(arr1, arr2):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_track_bad_workers(motion_file, capsys):
+    assert main(["track", str(motion_file), "--workers", "-1"]) == 2
+    assert "--workers" in capsys.readouterr().err
+
+
 def test_track_missing_file(tmp_path, capsys):
     assert main(["track", str(tmp_path / "nope.npy")]) == 2
 

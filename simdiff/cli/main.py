@@ -65,6 +65,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         return 0
+    except OSError as exc:  # a read or write the command did not foresee: still one line, no traceback
+        from simdiff.fsio import reason
+
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"simdiff: error: {where}{reason(exc)}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

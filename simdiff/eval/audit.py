@@ -322,5 +322,8 @@ def plot_audit(a: Audit, path: str | Path, dpi: int = 110) -> Path:
     fig.suptitle(f"{a.name}   g={g:g} m/s², wind=({wx:g}, {wy:g}) N   residual p90 {r['force_p90_mg']:.2f} m·g, "
                  f"{status}", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
-    fig.savefig(path)
+    from simdiff.fsio import atomic_path
+
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp)
     return path

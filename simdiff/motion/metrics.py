@@ -20,9 +20,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import sys
+from typing import TYPE_CHECKING
+
 import numpy as np
-import torch
 from scipy.ndimage import uniform_filter1d
+
+if TYPE_CHECKING:
+    import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS, NUM_JOINTS
@@ -41,13 +46,19 @@ SKATE_WINDOW: int = 5
 METRIC_NAMES: tuple[str, ...] = ("penetration", "floating", "sliding", "skate_ratio")
 
 
+def _as_numpy(value: object) -> object:
+    """A torch tensor as a numpy array (torch is not imported here: a tensor implies it is loaded)."""
+    torch = sys.modules.get("torch")
+    if torch is not None and isinstance(value, torch.Tensor):
+        return value.detach().cpu().numpy()
+    return value
+
+
 def _prepare(
     joints: np.ndarray | torch.Tensor, lengths: Sequence[int] | np.ndarray | torch.Tensor | None
 ) -> tuple[np.ndarray, np.ndarray]:
     """(B, T, 22, 3) float array and (B,) int64 lengths, validated."""
-    if isinstance(joints, torch.Tensor):
-        joints = joints.detach().cpu().numpy()
-    arr = np.asarray(joints)
+    arr = np.asarray(_as_numpy(joints))
     if arr.ndim not in (3, 4) or arr.shape[-2:] != (NUM_JOINTS, 3):
         raise SimdiffError(f"joints must have shape (B, T, 22, 3) or (T, 22, 3), got {arr.shape}")
     if arr.ndim == 3:
@@ -60,9 +71,7 @@ def _prepare(
     if lengths is None:
         lens = np.full(batch, frames, dtype=np.int64)
     else:
-        if isinstance(lengths, torch.Tensor):
-            lengths = lengths.detach().cpu().numpy()
-        lens = np.asarray(lengths).reshape(-1)
+        lens = np.asarray(_as_numpy(lengths)).reshape(-1)
         if lens.shape != (batch,):
             raise SimdiffError(f"lengths must have {batch} entries, got {lens.shape[0]}")
         if not np.issubdtype(lens.dtype, np.integer):

@@ -76,8 +76,10 @@ class Normalizer:
         """Write ``Mean.npy`` and ``Std.npy`` into directory ``path`` (created if needed)."""
         path = Path(path)
         path.mkdir(parents=True, exist_ok=True)
-        np.save(path / "Mean.npy", self.mean)
-        np.save(path / "Std.npy", self.std)
+        from simdiff.fsio import save_npy
+
+        save_npy(path / "Mean.npy", self.mean)
+        save_npy(path / "Std.npy", self.std)
 
     def _stats_like(self, x: Array) -> tuple[Array, Array]:
         if x.shape[-1:] != (FEATURE_DIM,):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
@@ -10,6 +9,7 @@ from typing import Callable, Iterable, Sequence
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.fsio import ensure_dir, save_npy, write_json
 from simdiff.motion.skeleton import FPS
 
 Progress = Callable[[Iterable, int, str], Iterable]
@@ -47,11 +47,7 @@ def prepare_out_dir(path: Path) -> Path:
     """Create the output folder; a path that exists and is not a folder raises."""
     if path.exists() and not path.is_dir():
         raise SimdiffError(f"--out {str(path)!r} exists and is not a folder")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise SimdiffError(f"cannot create output folder {str(path)!r}: {exc.strerror or exc}") from None
-    return path
+    return ensure_dir(path)
 
 
 def write_motion(stem: Path, joints: np.ndarray, features: np.ndarray, formats: Sequence[str],
@@ -69,9 +65,9 @@ def write_motion(stem: Path, joints: np.ndarray, features: np.ndarray, formats: 
     written: dict[str, Path] = {}
     if "npy" in formats:
         written["joints"] = stem.with_name(stem.name + "_joints.npy")
-        np.save(written["joints"], np.asarray(joints, dtype=np.float32))
+        save_npy(written["joints"], np.asarray(joints, dtype=np.float32))
         written["features"] = stem.with_name(stem.name + "_features.npy")
-        np.save(written["features"], np.asarray(features, dtype=np.float32))
+        save_npy(written["features"], np.asarray(features, dtype=np.float32))
     if "bvh" in formats:
         from simdiff.motion.io.bvh_writer import write_bvh
 
@@ -84,7 +80,7 @@ def render_video(motions: Sequence[np.ndarray], captions: Sequence[str], path: P
     """Render (T, 22, 3) motions side by side to ``path`` (``.gif`` or ``.mp4``).
 
     Frames come from the stick renderer (:func:`simdiff.viz.stick.animation_frames`); GIFs go through the
-    shared-palette writer (:func:`simdiff.product.gif.write_gif`), MP4s through H.264.
+    shared-palette writer (:func:`simdiff.viz.video.write_gif`), MP4s through H.264; both atomically.
     """
     from simdiff.viz.stick import animation_frames
 
@@ -94,18 +90,12 @@ def render_video(motions: Sequence[np.ndarray], captions: Sequence[str], path: P
     frames: Iterable[np.ndarray] = animation_frames(list(motions), list(captions), fps)
     if progress is not None:
         frames = progress(frames, max(int(m.shape[0]) for m in motions), f"rendering {suffix[1:]}")
-    if suffix == ".gif":
-        from simdiff.product.gif import write_gif
+    from simdiff.viz.video import write_video
 
-        write_gif(frames, path, fps)
-    elif suffix == ".mp4":
-        from simdiff.viz.video import write_mp4
-
-        write_mp4(frames, path, fps)
+    write_video(frames, path, fps)
     return path
 
 
 def write_metadata(path: Path, data: dict) -> Path:
-    """Write ``data`` as indented JSON (non-finite floats are refused)."""
-    path.write_text(json.dumps(data, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    return path
+    """Write ``data`` as indented JSON atomically (non-finite floats are refused)."""
+    return write_json(path, data, indent=2, allow_nan=False)

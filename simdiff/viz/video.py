@@ -1,4 +1,11 @@
-"""Write RGB frames to GIF (imageio/Pillow) or MP4 (imageio-ffmpeg, H.264)."""
+"""Write RGB frames to GIF (Pillow, one shared palette) or MP4 (imageio-ffmpeg, H.264), atomically.
+
+GIF: a per-frame adaptive palette (imageio's GIF plugin) costs about 15 ms per 320×185
+frame; stick figures and body renders use few flat colours plus anti-aliasing shades, so one
+palette computed once from a mosaic of frames looks the same and maps every frame about 10×
+faster (no dithering: flat colours stay flat). Both writers encode to a temporary file beside
+the target and rename it on success (:mod:`simdiff.fsio`), so a failure leaves no partial file.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +15,12 @@ from typing import Iterable
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.fsio import atomic_path
+
+PALETTE_COLOURS: int = 96
+"""Colours in the shared GIF palette (GIF allows 256)."""
+PALETTE_SAMPLES: int = 12
+"""Frames (evenly spaced) the GIF palette is computed from."""
 
 
 def _even(frame: np.ndarray) -> np.ndarray:
@@ -18,46 +31,63 @@ def _even(frame: np.ndarray) -> np.ndarray:
     return np.pad(frame, ((0, h % 2), (0, w % 2), (0, 0)), constant_values=255)
 
 
-def write_gif(frames: Iterable[np.ndarray], path: Path, fps: float) -> int:
-    """Write (H, W, 3) uint8 frames as a looping GIF; returns the number of frames.
+def write_gif(frames: Iterable[np.ndarray], path: str | Path, fps: float, colours: int = PALETTE_COLOURS) -> int:
+    """Write (H, W, 3) uint8 RGB frames as a looping GIF with one shared palette.
 
-    GIF delays are whole centiseconds, so 20 fps (5 cs) is exact; other rates are rounded.
+    Args:
+        frames: equally sized (H, W, 3) uint8 images.
+        path: output ``.gif`` file (its folder is created).
+        fps: playback rate in frames per second; GIF delays are whole centiseconds (20 fps is exact).
+        colours: palette size, 2..256.
+    Returns:
+        The number of frames written.
     """
-    import imageio.v3 as iio
+    from PIL import Image
 
-    stack = np.stack(list(frames))
-    iio.imwrite(path, stack, extension=".gif", duration=1000.0 / fps, loop=0)
-    return len(stack)
+    if not 2 <= colours <= 256:
+        raise SimdiffError(f"GIF palette size must be 2..256, got {colours}")
+    stack = [np.ascontiguousarray(f, dtype=np.uint8) for f in frames]
+    if not stack:
+        raise SimdiffError(f"no frames to write to {str(path)!r}")
+    picks = np.unique(np.linspace(0, len(stack) - 1, min(PALETTE_SAMPLES, len(stack))).round().astype(int))
+    mosaic = Image.fromarray(np.concatenate([stack[i] for i in picks], axis=0))
+    palette = mosaic.quantize(colors=colours, method=Image.Quantize.MEDIANCUT)
+    images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE) for f in stack]
+    with atomic_path(path) as tmp:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=1000.0 / fps, loop=0)
+    return len(images)
 
 
-def write_mp4(frames: Iterable[np.ndarray], path: Path, fps: float) -> int:
+def write_mp4(frames: Iterable[np.ndarray], path: str | Path, fps: float) -> int:
     """Write (H, W, 3) uint8 frames as an H.264 MP4 at ``fps``; returns the number of frames."""
     import imageio_ffmpeg
 
-    writer = None
     count = 0
-    try:
-        for frame in frames:
-            frame = _even(np.ascontiguousarray(frame, dtype=np.uint8))
-            if writer is None:
-                h, w = frame.shape[:2]
-                writer = imageio_ffmpeg.write_frames(
-                    str(path), (w, h), fps=fps, codec="libx264", pix_fmt_out="yuv420p",
-                    macro_block_size=1, quality=7, ffmpeg_log_level="error",
-                )
-                writer.send(None)  # start ffmpeg
-            writer.send(frame)
-            count += 1
-    finally:
-        if writer is not None:
-            writer.close()
-    if count == 0:
-        raise SimdiffError(f"no frames to write to {str(path)!r}")
+    with atomic_path(path) as tmp:
+        writer = None
+        try:
+            for frame in frames:
+                frame = _even(np.ascontiguousarray(frame, dtype=np.uint8))
+                if writer is None:
+                    h, w = frame.shape[:2]
+                    writer = imageio_ffmpeg.write_frames(
+                        str(tmp), (w, h), fps=fps, codec="libx264", pix_fmt_out="yuv420p",
+                        macro_block_size=1, quality=7, ffmpeg_log_level="error",
+                    )
+                    writer.send(None)  # start ffmpeg
+                writer.send(frame)
+                count += 1
+        finally:
+            if writer is not None:
+                writer.close()
+        if count == 0:
+            raise SimdiffError(f"no frames to write to {str(path)!r}")
     return count
 
 
-def write_video(frames: Iterable[np.ndarray], path: Path, fps: float) -> int:
-    """Dispatch on the suffix of ``path`` (``.gif`` or ``.mp4``)."""
+def write_video(frames: Iterable[np.ndarray], path: str | Path, fps: float) -> int:
+    """Dispatch on the suffix of ``path`` (``.gif`` or ``.mp4``); returns the number of frames."""
+    path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".gif":
         return write_gif(frames, path, fps)

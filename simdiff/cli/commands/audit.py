@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 from pathlib import Path
 
 from simdiff.cli.options import add_environment_options
@@ -47,9 +46,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
-
     from simdiff.eval.audit import audit_motion, plot_audit
+    from simdiff.fsio import check_writable, ensure_dir, save_npy, write_json
     from simdiff.motion.io import load_joints
     from simdiff.sim.env import Environment
     from simdiff.sim.residual import ResidualConfig
@@ -68,7 +66,8 @@ def run(args: argparse.Namespace) -> int:
 
         normalizer = _normalizer(args.stats)
     if args.out is not None:
-        args.out.mkdir(parents=True, exist_ok=True)
+        ensure_dir(args.out)
+        check_writable(args.out / f"{args.files[0].stem}_audit.json")
     for path in args.files:
         joints = load_joints(path, asf=args.asf, fps=args.fps)
         audit = audit_motion(joints, env, name=path.name, residual=ResidualConfig(max_force=args.residual),
@@ -78,14 +77,11 @@ def run(args: argparse.Namespace) -> int:
             stem = path.stem
             record["plot"] = str(plot_audit(audit, args.out / f"{stem}_audit.png"))
             if audit.rollout is not None:
-                target = args.out / f"{stem}_rollout.npy"
-                tmp = target.with_suffix(".tmp.npy")
-                np.save(tmp, audit.rollout.astype(np.float32))
-                os.replace(tmp, target)
+                target = save_npy(args.out / f"{stem}_rollout.npy", audit.rollout.astype("float32"))
                 record["rollout"] = str(target)
             if args.render:
                 record["render"] = str(_render(joints, audit, args.out / f"{stem}_body.mp4", not args.json))
-            (args.out / f"{stem}_audit.json").write_text(json.dumps(record, indent=1) + "\n")
+            write_json(args.out / f"{stem}_audit.json", record, indent=1)
         if args.json:
             print(json.dumps(record))
         else:

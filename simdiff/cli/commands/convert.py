@@ -34,22 +34,28 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from simdiff.motion.features import joints_to_features
-    from simdiff.motion.io import load_joints, save_npy, write_bvh
+    from simdiff.cli.feedback import slow_notice
+    from simdiff.fsio import check_writable, save_npy
+    from simdiff.motion.io import load_joints, write_bvh
 
     suffix = args.output.suffix.lower()
     if suffix not in (".npy", ".bvh"):
         raise SimdiffError(f"unsupported output type {args.output.name!r}: use .npy or .bvh")
     if suffix == ".bvh" and args.to == "features":
         raise SimdiffError("--to features needs a .npy output, not .bvh")
-    joints = load_joints(args.input, asf=args.asf, fps=args.fps)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
+    check_writable(args.output)
+    with slow_notice(f"reading {args.input}"):
+        joints = load_joints(args.input, asf=args.asf, fps=args.fps)
     if suffix == ".bvh":
-        write_bvh(args.output, joints)
+        with slow_notice(f"writing {args.output}"):
+            write_bvh(args.output, joints)
         what = f"BVH, {joints.shape[0]} frames"
     elif args.to == "features":
-        feats = joints_to_features(joints)
-        np.save(args.output, feats.astype(np.float32))
+        from simdiff.motion.features import joints_to_features  # torch: only for features
+
+        with slow_notice("computing HumanML3D features"):
+            feats = joints_to_features(joints)
+        save_npy(args.output, feats.astype(np.float32))
         what = f"features {feats.shape}"
     else:
         save_npy(args.output, joints)

@@ -24,13 +24,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simdiff.cli.feedback import slow_notice
     from simdiff.motion.io import load_joints
     from simdiff.motion.metrics import physics_metrics
 
     rows = []
-    for path in args.files:
-        joints = load_joints(path, asf=args.asf)
-        values = physics_metrics(joints)
+    for i, path in enumerate(args.files):
+        with slow_notice(f"reading {path} ({i + 1}/{len(args.files)})"):
+            joints = load_joints(path, asf=args.asf)
+            values = physics_metrics(joints)
         rows.append({"file": str(path), "frames": int(joints.shape[0]), **{k: float(v) for k, v in values.items()}})
     if args.json:
         for row in rows:

@@ -42,10 +42,13 @@ def _run(args: argparse.Namespace) -> int:
     fps = args.fps if args.fps is not None else FPS
     if args.body:
         return _run_body(args, motions, captions, out, fps)
-    if args.filmstrip or out.suffix.lower() == ".png":
-        render_filmstrip(motions, out, captions=captions, n_frames=args.frames, fps=fps)
-    else:
-        render_animation(motions, out, captions=captions, fps=fps)
+    from simdiff.cli.feedback import slow_notice
+
+    with slow_notice(f"rendering {out}"):
+        if args.filmstrip or out.suffix.lower() == ".png":
+            render_filmstrip(motions, out, captions=captions, n_frames=args.frames, fps=fps)
+        else:
+            render_animation(motions, out, captions=captions, fps=fps)
     print(out)
     return 0
 

@@ -35,14 +35,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
-
     import numpy as np
     import torch
 
     from simdiff.errors import SimdiffError
+    from simdiff.fsio import check_writable, ensure_dir, save_npy, write_json
     from simdiff.model.generator import MAX_FRAMES, MotionGenerator
 
+    from simdiff.product.request import check_text
+
+    args.text = [check_text(t) for t in args.text]
     if not 1 <= args.length <= MAX_FRAMES:
         raise SimdiffError(f"--length must be 1..{MAX_FRAMES} frames (9.8 s at 20 fps), got {args.length}")
     if args.batch < 1:
@@ -53,6 +55,8 @@ def run(args: argparse.Namespace) -> int:
         device = torch.device(args.device)
     except RuntimeError:
         raise SimdiffError(f"unknown device {args.device!r}") from None
+    ensure_dir(args.out)
+    check_writable(args.out / "samples.json")
     gen = MotionGenerator.load(args.model, device, text_weights=args.clip_weights)
     texts = [t for t in args.text for _ in range(args.batch)]
     def progress(steps):
@@ -67,18 +71,17 @@ def run(args: argparse.Namespace) -> int:
         from simdiff.motion.features import features_to_joints
     except ImportError:  # pragma: no cover - the motion package ships with simdiff
         features_to_joints = None
-    args.out.mkdir(parents=True, exist_ok=True)
     index = []
     for i, clip in enumerate(out.clips()):
         features = clip.cpu().numpy().astype(np.float32)
-        np.save(args.out / f"sample_{i:03d}.npy", features)
+        save_npy(args.out / f"sample_{i:03d}.npy", features)
         entry = {"file": f"sample_{i:03d}.npy", "text": texts[i], "frames": int(features.shape[0]), "fps": 20}
         if features_to_joints is not None:
-            np.save(args.out / f"sample_{i:03d}_joints.npy", features_to_joints(features))
+            save_npy(args.out / f"sample_{i:03d}_joints.npy", features_to_joints(features))
             entry["joints"] = f"sample_{i:03d}_joints.npy"
         index.append(entry)
     meta = {"model": str(args.model), "sampler": args.sampler, "steps": args.steps, "guidance": args.guidance,
             "seed": args.seed, "alpha": args.alpha, "env": args.env, "env_index": args.env_index, "samples": index}
-    (args.out / "samples.json").write_text(json.dumps(meta, indent=2) + "\n")
+    write_json(args.out / "samples.json", meta, indent=2)
     print(f"wrote {len(index)} motion(s) to {args.out}")
     return 0

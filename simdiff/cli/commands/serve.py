@@ -23,6 +23,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 exposes it to the network)")
     p.add_argument("--model", type=Path, help="model folder (default: $SIMDIFF_MODEL, else the shipped model)")
     p.add_argument("--steps", type=int, help="DDIM sampling steps (default 50; fewer is faster, rougher)")
+    p.add_argument("--queue", type=int, default=4, metavar="N",
+                   help="generation requests that may wait behind the running one; more get 429 (default 4)")
     p.add_argument("--device", default="cpu", help="torch device for generation (default cpu)")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser tab")
     p.set_defaults(func=run)
@@ -39,10 +41,12 @@ def build_server(args: argparse.Namespace):  # -> simdiff.serve.ViewerServer (im
 
     from simdiff.errors import SimdiffError
     from simdiff.serve import MotionService, ViewerServer, read_listed
-    from simdiff.serve.params import MAX_STEPS
+    from simdiff.product.request import MAX_STEPS
 
     if not 0 <= args.port <= 65535:
         raise SimdiffError(f"--port must be 0..65535, got {args.port}")
+    if args.queue < 0:
+        raise SimdiffError(f"--queue must be ≥ 0, got {args.queue}")
     if args.steps is not None and not 1 <= args.steps <= MAX_STEPS:
         raise SimdiffError(f"--steps must be 1..{MAX_STEPS}, got {args.steps}")
     try:
@@ -58,7 +62,7 @@ def build_server(args: argparse.Namespace):  # -> simdiff.serve.ViewerServer (im
 
     listed = read_listed(args.files, files_progress)
     service = MotionService(args.model, device=args.device, files=listed, progress=sampling_progress,
-                            steps=args.steps)
+                            steps=args.steps, max_queue=args.queue)
     return ViewerServer(service, args.host, args.port, verbose=True)
 
 

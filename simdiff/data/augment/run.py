@@ -36,6 +36,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from simdiff.fsio import write_text
 from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
 from simdiff.data.augment.filter import FilterConfig, keep_pair
 from simdiff.data.augment.report import build_report, report_markdown
@@ -363,5 +364,5 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
     report = build_report(records, conditions, config)
     report["wall_s_this_run"] = round(wall_s, 3)
     write_json(out / "report.json", report)
-    (out / "report.md").write_text(report_markdown(report), encoding="utf-8")
+    write_text(out / "report.md", report_markdown(report))
     return report

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from simdiff.fsio import atomic_path
 from simdiff.data.cmu.writer import write_json, write_text
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS, JOINT_NAMES
@@ -181,7 +182,8 @@ def _summary_figure(path: Path, clips: list[dict[str, Any]], metrics: list[dict[
         ax.set_title(title)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, facecolor="white")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, facecolor="white")
 
 
 def _pick(clips: list[dict[str, Any]], rng: np.random.Generator, n: int) -> list[dict[str, Any]]:

@@ -25,6 +25,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from simdiff.fsio import write_text
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments import fig4, fig5, retrack, table1, table2
 from simdiff.eval.experiments.config import KINDS, ExperimentConfig, ModelSpec, load_config
@@ -66,7 +67,7 @@ def run(runner: Runner) -> dict[str, Any]:
               "budget": budget_info(c), "paths": c.resolved_paths(), "config": dataclasses.asdict(c), "rows": rows}
     body = module.finish(runner, report)
     atomic_write_json(report, runner.out / "report.json")
-    (runner.out / "report.md").write_text("\n".join(header(report, module.TITLE) + body) + "\n", encoding="utf-8")
+    write_text(runner.out / "report.md", "\n".join(header(report, module.TITLE) + body) + "\n")
     return report
 
 

@@ -14,6 +14,7 @@ import time
 from dataclasses import asdict
 from typing import Any
 
+from simdiff.fsio import atomic_path
 from simdiff.eval.experiments.config import ModelSpec
 from simdiff.eval.experiments.report import value
 from simdiff.eval.experiments.rows import method_key
@@ -101,7 +102,8 @@ def figure(rows: list[dict[str, Any]], ref: float, path: Any) -> Any:
     ax.legend(fontsize=8)
     ax.margins(y=0.2)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return path
 

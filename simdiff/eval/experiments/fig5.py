@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from simdiff.fsio import atomic_path, save_npy
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ModelSpec
 from simdiff.eval.experiments.report import fmt_env
@@ -67,7 +68,7 @@ def measure(runner: Runner, spec: ModelSpec, env: list[float] | None, key: str) 
     feats, seconds = runner.generate(fn, captions, [o.length] * len(captions), runner.config.seed)
     joints = np.asarray(features_to_joints(feats.double()), dtype=np.float32)
     samples = [{"prompt": c, "seed": i % o.seeds, **motion_stats(j)} for i, (c, j) in enumerate(zip(captions, joints))]
-    np.save(runner.rows_dir / f"{key}.motion.npy", joints[0])
+    save_npy(runner.rows_dir / f"{key}.motion.npy", joints[0])
     summary = {}
     for k in ("apex_m", "drift_x_m", "drift_z_m", "airborne"):
         v = np.array([s[k] for s in samples])
@@ -128,7 +129,8 @@ def sweep_figure(rows: list[dict[str, Any]], path: Path) -> Path:
         ax.set_ylabel(ylabel)
     axes[0].legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return path
 
@@ -172,7 +174,8 @@ def combination_figure(rows: list[dict[str, Any]], path: Path) -> Path:
         ax.set_xticks(range(len(keys)), [t for _, t in keys])
         ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return path
 

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from simdiff.fsio import atomic_path
 from simdiff.eval.experiments.config import ModelSpec
 from simdiff.eval.experiments.report import fmt_env, value
 from simdiff.eval.experiments.runner import EARTH, RowPlan, Runner, env_key, safe
@@ -118,7 +119,8 @@ def figure(rows: list[dict[str, Any]], path: Any) -> Any:
     axes[0].set_ylim(0, 1.05)
     axes[0].legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return path
 

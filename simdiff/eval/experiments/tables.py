@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from simdiff.fsio import atomic_path
 from simdiff.eval.experiments.report import PHYSICS_METRICS, T2M_METRICS, mean_ci, value
 from simdiff.eval.experiments.rows import phys_err
 
@@ -60,7 +61,8 @@ def alpha_figure(rows: list[dict[str, Any]], path: Path, best: float | None = No
         ax.set_title(title, fontsize=10)
     axes[0].legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return path
 
@@ -85,6 +87,7 @@ def method_figure(rows: list[dict[str, Any]], path: Path) -> Path:
     for ax in axes:
         ax.set_xticks(range(len(rows)), labels, fontsize=7, rotation=45, ha="right")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return path

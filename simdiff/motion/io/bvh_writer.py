@@ -12,6 +12,13 @@ so a rigid triangle is fitted exactly. Rotations are solved from positions: bran
 joints by a Kabsch (SVD) fit of their children, chain joints by the shortest rotation
 (no twist relative to the parent) that aims the bone from the already-placed parent at
 its target, so limb chains reproduce the input up to bone-length changes.
+
+Motions whose bone lengths change over time (generated ones, recovered from root-relative
+positions, vary by several millimetres) also get position channels on every joint: the
+motion's own per-frame offset of each joint in its parent's frame, so that reading the file
+back gives the input joints to the printed precision (joints → BVH → joints ≤ 1 µm here,
+instead of tens of millimetres with fixed bones). Constant-length rigs keep rotation-only
+joints.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.fsio import write_text
 from simdiff.motion.io.euler import matrix_to_euler
 from simdiff.motion.skeleton import FPS, JOINT_NAMES, NUM_JOINTS, PARENTS, RAW_OFFSETS
 
@@ -29,6 +37,9 @@ ROOT_ORDER: str = "ZXY"
 """Root rotation channels (yaw about Y innermost, so turning never meets gimbal lock)."""
 JOINT_ORDER: str = "ZYX"
 """Other joints (twist about the bone's Y axis in the middle, away from +-90 degrees)."""
+
+STRETCH_TOLERANCE: float = 1e-5
+"""Bone-length range (metres) above which joints get per-frame position channels."""
 
 _BRANCHES: dict[int, tuple[int, int, int]] = {0: (1, 2, 3), 9: (13, 14, 12)}
 """Branching joint -> (left child, right child, up child)."""
@@ -149,7 +160,36 @@ def solve_rotations(joints: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     return local_rot
 
 
-def _hierarchy_lines(offsets: np.ndarray) -> list[str]:
+def global_rotations(local: np.ndarray) -> np.ndarray:
+    """Global rotations (T, 22, 3, 3) from local ones (row 0 the root's global rotation)."""
+    out = np.empty_like(local)
+    for j in range(NUM_JOINTS):
+        parent = PARENTS[j]
+        out[:, j] = local[:, j] if parent < 0 else out[:, parent] @ local[:, j]
+    return out
+
+
+def local_translations(joints: np.ndarray, local: np.ndarray) -> np.ndarray:
+    """(T, 22, 3) offset of each joint from its parent in the parent's frame (row 0: root position)."""
+    joints = np.asarray(joints, dtype=np.float64)
+    glob = global_rotations(local)
+    parents = np.asarray(PARENTS)
+    out = np.empty_like(joints)
+    out[:, 0] = joints[:, 0]
+    delta = joints[:, 1:] - joints[:, parents[1:]]
+    out[:, 1:] = np.einsum("tjki,tjk->tji", glob[:, parents[1:]], delta)
+    return out
+
+
+def bones_stretch(joints: np.ndarray, tolerance: float = STRETCH_TOLERANCE) -> bool:
+    """Whether any bone of (T, 22, 3) ``joints`` changes length by more than ``tolerance`` metres."""
+    joints = np.asarray(joints, dtype=np.float64)
+    parents = np.asarray(PARENTS)
+    lengths = np.linalg.norm(joints[:, 1:] - joints[:, parents[1:]], axis=-1)
+    return bool(np.any(lengths.max(axis=0) - lengths.min(axis=0) > tolerance))
+
+
+def _hierarchy_lines(offsets: np.ndarray, positions: bool = False) -> list[str]:
     kids = _children()
     lines = ["HIERARCHY"]
 
@@ -165,7 +205,10 @@ def _hierarchy_lines(offsets: np.ndarray) -> list[str]:
             lines.append(f"{pad}  CHANNELS 6 Xposition Yposition Zposition {rot}")
         else:
             rot = " ".join(f"{a}rotation" for a in JOINT_ORDER)
-            lines.append(f"{pad}  CHANNELS 3 {rot}")
+            if positions:
+                lines.append(f"{pad}  CHANNELS 6 Xposition Yposition Zposition {rot}")
+            else:
+                lines.append(f"{pad}  CHANNELS 3 {rot}")
         if kids[j]:
             for child in kids[j]:
                 emit(child, depth + 1)
@@ -195,13 +238,15 @@ def _file_order() -> list[int]:
     return order
 
 
-def write_bvh(path: str | Path, joints: np.ndarray, fps: float = FPS) -> Path:
-    """Write (T, 22, 3) HumanML3D joint positions (metres, Y-up) as a BVH file.
+def write_bvh(path: str | Path, joints: np.ndarray, fps: float = FPS, stretch: bool | None = None) -> Path:
+    """Write (T, 22, 3) HumanML3D joint positions (metres, Y-up) as a BVH file, atomically.
 
     Args:
         path: output ``.bvh`` file (parent folders are created).
         joints: (T, 22, 3) positions in metres, Y-up (HumanML3D order).
         fps: frame rate (HumanML3D: 20).
+        stretch: per-frame position channels on every joint (the motion's own bone lengths);
+            None: only when a bone's length varies by more than :data:`STRETCH_TOLERANCE`.
     Returns:
         The path written.
     Raises:
@@ -221,13 +266,16 @@ def write_bvh(path: str | Path, joints: np.ndarray, fps: float = FPS) -> Path:
         warnings.simplefilter("ignore")  # scipy's gimbal-lock note: angles stay valid
         root_angles = matrix_to_euler(local[:, 0], ROOT_ORDER)
         joint_angles = matrix_to_euler(local[:, order[1:]], JOINT_ORDER)
-    values = np.concatenate(
-        [joints[:, 0], root_angles, joint_angles.reshape(joints.shape[0], -1)], axis=1
-    )
-    lines = _hierarchy_lines(offsets)
+    num_frames = joints.shape[0]
+    if stretch is None:
+        stretch = bones_stretch(joints)
+    if stretch:
+        trans = local_translations(joints, local)[:, order[1:]]
+        per_joint = np.concatenate([trans, joint_angles], axis=-1).reshape(num_frames, -1)
+    else:
+        per_joint = joint_angles.reshape(num_frames, -1)
+    values = np.concatenate([joints[:, 0], root_angles, per_joint], axis=1)
+    lines = _hierarchy_lines(offsets, positions=stretch)
     lines += ["MOTION", f"Frames: {joints.shape[0]}", f"Frame Time: {1.0 / fps:.8f}"]
     lines += [" ".join(f"{v:.6f}" for v in row) for row in values]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
+    return write_text(Path(path), "\n".join(lines) + "\n")

@@ -24,11 +24,9 @@ def save_npy(path: str | Path, joints: np.ndarray) -> Path:
         raise SimdiffError(f"save_npy needs joints of shape (T, 22, 3), got {array.shape}")
     if not np.all(np.isfinite(array)):
         raise SimdiffError("save_npy: joints contain NaN or infinite values")
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "wb") as handle:  # np.save on a name would append ".npy"
-        np.save(handle, array)
-    return path
+    from simdiff.fsio import save_npy as atomic_save_npy
+
+    return atomic_save_npy(Path(path), array)
 
 
 def read_npy(path: str | Path) -> np.ndarray:

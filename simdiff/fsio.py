@@ -1,0 +1,157 @@
+"""Atomic file output: every writer goes through a temporary file in the target's folder.
+
+A file either appears complete under its final name (``os.replace`` is atomic on one file
+system) or not at all: a full disk, a read-only folder or an exception in the writer leaves
+nothing half-written behind, and the failure becomes one :class:`SimdiffError` line naming
+the path and the reason. The temporary file keeps the target's suffix, so writers that pick
+a format from the name (Pillow, matplotlib, ffmpeg) still do.
+"""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+
+from simdiff.errors import SimdiffError
+
+_REASONS: dict[int, str] = {
+    errno.ENOSPC: "no space left on device",
+    errno.EROFS: "read-only file system",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.ENOTDIR: "a parent of it is not a folder",
+    errno.EISDIR: "it is a folder",
+    errno.EDQUOT: "disk quota exceeded",
+    errno.EPIPE: "the encoder stopped (broken pipe)",
+}
+
+
+def reason(exc: BaseException) -> str:
+    """A short human reason for an ``OSError`` (``"no space left on device"``) or any exception."""
+    if isinstance(exc, OSError):
+        if exc.errno in _REASONS:
+            return _REASONS[exc.errno]
+        if exc.strerror:
+            return exc.strerror.lower()
+    text = str(exc).strip().splitlines()
+    return text[0] if text else type(exc).__name__
+
+
+def write_error(path: str | Path, exc: BaseException) -> SimdiffError:
+    """The one-line error for a failed write of ``path``."""
+    return SimdiffError(f"cannot write {str(path)!r}: {reason(exc)}")
+
+
+def ensure_parent(path: str | Path) -> Path:
+    """Create ``path``'s folder (and its parents); one-line :class:`SimdiffError` when impossible."""
+    path = Path(path)
+    parent = path.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SimdiffError(f"cannot create folder {str(parent)!r} for {str(path)!r}: {reason(exc)}") from None
+    if not parent.is_dir():
+        raise SimdiffError(f"cannot write {str(path)!r}: {str(parent)!r} is not a folder")
+    return path
+
+
+def ensure_dir(path: str | Path) -> Path:
+    """Create the output folder ``path``; a file in its place or an unwritable parent is one error line."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise SimdiffError(f"output folder {str(path)!r} exists and is not a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SimdiffError(f"cannot create folder {str(path)!r}: {reason(exc)}") from None
+    return path
+
+
+def _temp_name(path: Path) -> Path:
+    return path.with_name(f".{path.stem}.tmp{os.getpid()}{path.suffix}")
+
+
+def check_writable(path: str | Path) -> Path:
+    """Fail early (before slow work) when ``path`` cannot be written: creates its folder, probes a temp file."""
+    path = ensure_parent(path)
+    if path.is_dir():
+        raise SimdiffError(f"cannot write {str(path)!r}: it is a folder")
+    probe = _temp_name(path)
+    try:
+        with open(probe, "wb"):
+            pass
+    except OSError as exc:
+        raise write_error(path, exc) from None
+    finally:
+        try:
+            probe.unlink()
+        except OSError:
+            pass
+    return path
+
+
+@contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path beside ``path`` (same suffix); on success it replaces ``path``.
+
+    On any exception the temporary file is removed and ``path`` is left untouched; an
+    ``OSError`` (and a writer's error while writing) becomes one :class:`SimdiffError` line.
+    A :class:`SimdiffError` raised by the writer passes through unchanged.
+    """
+    path = ensure_parent(path)
+    if path.is_dir():
+        raise SimdiffError(f"cannot write {str(path)!r}: it is a folder")
+    tmp = _temp_name(path)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException as exc:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        if isinstance(exc, (SimdiffError, KeyboardInterrupt, SystemExit, GeneratorExit)):
+            raise
+        if isinstance(exc, OSError):
+            raise write_error(path, exc) from None
+        raise
+
+
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+    return Path(path)
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically."""
+    return write_bytes(path, text.encode("utf-8"))
+
+
+def write_json(path: str | Path, data: Any, indent: int | None = 2, allow_nan: bool = True) -> Path:
+    """Write ``data`` as JSON (with a final newline) atomically; ``allow_nan=False`` refuses NaN/inf."""
+    try:
+        text = json.dumps(data, indent=indent, allow_nan=allow_nan)
+    except ValueError as exc:
+        raise SimdiffError(f"cannot write {str(path)!r}: {exc}") from None
+    return write_text(path, text + "\n")
+
+
+def save_npy(path: str | Path, array: np.ndarray) -> Path:
+    """Save ``array`` as ``.npy`` at exactly ``path`` (no suffix added) atomically."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as handle:
+            np.save(handle, np.asarray(array))
+            handle.flush()
+            os.fsync(handle.fileno())
+    return Path(path)
