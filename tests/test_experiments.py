@@ -63,7 +63,7 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
     cfg = {"name": name or kind, "kind": kind, "corpus": str(setup["corpus"]),
            "paths": {r: str(setup[r]) for r in ("backbone", "adapters", "adapters_binary")},
            "evaluator": {"kind": "ours", "path": str(setup["evaluator"])}, "protocol": PROTO, "models": models,
-           "out_dir": str(setup["root"] / "reports"), **extra}
+           "out_dir": str(setup["root"] / "reports"), "smoke": True, **extra}
     path = setup["root"] / f"eval_{name or kind}.json"
     path.write_text(json.dumps(cfg))
     return path
@@ -109,7 +109,8 @@ def test_budget_and_overrides_apply_in_order(tmp_path: Path) -> None:
 
 def test_select_alpha_rules() -> None:
     def row(alpha: float, fid: float, pen: float) -> dict:
-        s = {"fid": {"mean": fid}, "penetration": {"mean": pen}, "floating": {"mean": 0.0}, "sliding": {"mean": 0.0}}
+        s = {"fid": {"mean": fid}, "penetration": {"mean": pen}, "floating": {"mean": 0.0}, "sliding": {"mean": 0.0},
+             "phys_err": {"mean": pen, "ci95": 0.0}}
         return {"alpha": alpha, "method": "S", "sampler": "ddim", "summary": s}
 
     rows = [row(0.01, 1.0, 9.0), row(0.1, 2.0, 2.0), row(1.0, 5.0, 1.0)]
@@ -148,7 +149,8 @@ def test_table2_then_table1_best_alpha_reuse_and_resume(setup: dict[str, Path], 
     rows = {r["key"]: r for r in t1["rows"]}
     # DDPM rows: physics + time on 3 motions (fewer than a batch); DDIM rows: the full protocol with MultiModality
     assert rows["MDM_ddpm"]["measured"] == "subset" and rows["MDM_ddpm"]["samples"] == 3
-    assert set(rows["MDM_ddpm"]["physics"]) == {"penetration", "floating", "sliding", "skate_ratio"}
+    assert set(rows["MDM_ddpm"]["physics"]) == {"penetration", "floating", "sliding", "skate_ratio", "floating_to_gt",
+                                                "phys_err"}
     s = rows["PhysDiff_ddim"]["summary"]
     assert {"r_precision_top1", "r_precision_top3", "fid", "mm_dist", "diversity", "multimodality", "skate_ratio"} <= set(s)
     assert s["fid"]["n"] == 2 and rows["PhysDiff_ddim"]["samples_per_replication"] == 8

@@ -171,6 +171,12 @@ class ExperimentConfig:
             :class:`~simdiff.eval.experiments.runner.Runner`'s ``text_encoder``).
         threads: torch CPU threads while the experiment runs (0: torch's default). On a machine whose
             cores are busy with other jobs, 1 avoids spinning threads slowing everything down.
+        smoke: a test or smoke run on stand-ins: the claim rules of the ``full`` budget are not
+            enforced and every report says it carries no claim.
+
+    Claim rules (``full`` budget, not ``smoke``; :func:`check`): table1/table2 protocols with
+    n ≥ 256 motions per replication (or the whole split) and R ≥ 5; DDPM rows on ≥ 32 motions;
+    table2 (which chooses α) on a split other than ``test``.
     """
 
     name: str
@@ -202,6 +208,7 @@ class ExperimentConfig:
     out_dir: str = "reports"
     text_encoder: str = "auto"
     threads: int = 0
+    smoke: bool = False
     budget: str = "full"
     """Set by :func:`load_config` (not in the file): the budget applied."""
     source: str = ""
@@ -330,3 +337,22 @@ def check(config: ExperimentConfig, origin: str | os.PathLike[str] = "config") -
         raise SimdiffError(f"{origin}: text_encoder {config.text_encoder!r} must be \"auto\" (each model's own encoder)")
     if config.projector.backend not in ("process", "serial"):
         raise SimdiffError(f"{origin}: projector backend {config.projector.backend!r} must be process or serial")
+    if config.kind == "table2" and config.split == "test" and not config.smoke:
+        raise SimdiffError(f"{origin}: table2 chooses α, so it must run on the val split, not {config.split!r} "
+                           "(table1 reports the chosen α on test)")
+    problems = claim_problems(config)
+    if problems and config.budget == "full" and not config.smoke:
+        raise SimdiffError(f"{origin}: the full budget must carry a claim: " + "; ".join(problems)
+                           + " (use a named budget such as quick, or smoke: true, for smaller runs)")
+
+
+def claim_problems(config: ExperimentConfig) -> list[str]:
+    """Why ``config`` cannot carry a claim (empty: it can); see :class:`ExperimentConfig`."""
+    from simdiff.eval.protocol import claim_problems as protocol_problems
+
+    out: list[str] = []
+    if config.kind in ("table1", "table2"):
+        out += [f"protocol.{p}" for p in protocol_problems(config.protocol, None)]
+    if config.kind == "table1" and "ddpm" in config.samplers and 0 < config.ddpm_samples < 32:
+        out.append(f"ddpm_samples={config.ddpm_samples} < 32")
+    return out

@@ -285,13 +285,15 @@ class Runner:
         reps = result["replications"]
         return {"summary": result["summary"]["generated"], "replications": [r["generated"] for r in reps],
                 "s_per_motion": float(np.mean([r["gen_s_per_sample"] for r in reps])),
-                "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps)}
+                "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps),
+                "split_size": result["split_size"], "seeds": protocol_seeds(proto)}
 
     def gt_measure(self) -> dict[str, Any]:
         """The ground-truth row of the protocol."""
         result = evaluate_t2m(self.evaluator, self.dataset, None, self.config.protocol, self.progress)
         return {"summary": result["summary"]["ground_truth"], "samples_per_replication": result["samples_per_replication"],
-                "replications_run": len(result["replications"])}
+                "replications_run": len(result["replications"]), "split_size": result["split_size"],
+                "seeds": protocol_seeds(self.config.protocol)}
 
     def subset_measure(self, spec: ModelSpec, sampler: str, alpha: float | None, n: int, env: Any = None) -> dict[str, Any]:
         """Physics metrics and time of ``n`` generated test motions (too few for the T2M metrics)."""
@@ -303,7 +305,13 @@ class Runner:
                                        self.config.seed * 1_000_003)
         joints = np.asarray(features_to_joints(feats.double()))
         lengths = np.clip(np.asarray(items["lengths"]), 2, joints.shape[1])
-        return {"physics": physics_metrics(joints, lengths), "s_per_motion": seconds / n, "samples": n}
+        physics = physics_metrics(joints, lengths)
+        gt = [np.asarray(features_to_joints(torch.as_tensor(f).double())) for f in items["features"]]
+        gt_float = float(np.average([physics_metrics(j)["floating"] for j in gt], weights=[len(j) for j in gt]))
+        physics["floating_to_gt"] = abs(physics["floating"] - gt_float)
+        physics["phys_err"] = physics["penetration"] + physics["sliding"] + physics["floating_to_gt"]
+        return {"physics": physics, "gt_floating": gt_float, "s_per_motion": seconds / n, "samples": n,
+                "seeds": {"data": [self.config.seed, 99], "generation": self.config.seed * 1_000_003}}
 
     def ddpm_protocol(self) -> ProtocolConfig | None:
         """Protocol of DDPM rows under ``ddpm_samples`` (None: physics-only subset rows)."""
@@ -420,6 +428,13 @@ class Runner:
             bar.set_postfix_str(f"{plan.key} (~{plan.estimate_s / 60:.1f} min)")
             rows.append(self.fetch(plan))
         return rows
+
+
+def protocol_seeds(proto: ProtocolConfig) -> dict[str, Any]:
+    """The seeds a protocol row used (stated in every report): data draws and generation noise per replication."""
+    return {"base": proto.seed, "data_draw": [[proto.seed, r] for r in range(proto.replications)],
+            "generation": [proto.seed * 1_000_003 + r * 1009 for r in range(proto.replications)],
+            "note": "batch k of replication r adds k to its generation seed"}
 
 
 def _stamp(path: str) -> dict[str, Any]:

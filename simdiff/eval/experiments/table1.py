@@ -32,9 +32,13 @@ def _read_best_alpha(runner: Runner) -> tuple[float | None, str]:
         return float(c.best_alpha), "config"
     path = Path(c.out_dir) / c.best_alpha_from / "report.json"
     if path.is_file():
-        best = json.loads(path.read_text(encoding="utf-8")).get("best_alpha")
+        report = json.loads(path.read_text(encoding="utf-8"))
+        best, split = report.get("best_alpha"), report.get("config", {}).get("split")
+        if best and split == c.split and not c.smoke:
+            return None, (f"refused: {path} chose α on the {split!r} split, the split this table reports on; "
+                          "run table2 on val")
         if best:
-            return float(best["alpha"]), f"{path} (select_by {best.get('select_by')})"
+            return float(best["alpha"]), f"{path} (select_by {best.get('select_by')}, chosen on the {split} split)"
     return None, (f"not available when this run started: no {path} with a best α and no 'best_alpha' in the config; "
                   "run table2 first (simdiff evaluate all does) and run table1 again")
 
