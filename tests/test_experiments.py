@@ -57,6 +57,7 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
         "fig4": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                  {"name": "SimDiff", "model": "adapters", **FAST}],
         "fig5": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}],
+        "env_response": [{"name": "MDM", "model": "backbone", **FAST}],
         "retrack": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                     {"name": "SimDiff", "model": "adapters", **FAST}],
     }[kind]
@@ -71,7 +72,8 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
 
 def test_shipped_configs_are_the_five_experiments_with_relative_paths() -> None:
     paths = sorted(CONFIGS.glob("eval_*.json"))
-    assert [p.stem for p in paths] == ["eval_fig4", "eval_fig5", "eval_retrack", "eval_table1", "eval_table2"]
+    assert [p.stem for p in paths] == ["eval_env_response", "eval_fig4", "eval_fig5", "eval_retrack", "eval_table1",
+                                       "eval_table2"]
     for path in paths:
         raw = json.loads(path.read_text())
         assert raw["kind"] == raw["name"] == path.stem[5:]
@@ -288,3 +290,48 @@ def test_table1_uses_the_best_alpha_known_when_it_started(setup: dict[str, Path]
 def test_config_refuses_a_text_encoder_stand_in(setup: dict[str, Path]) -> None:
     with pytest.raises(SimdiffError, match="text_encoder 'hash' must be \"auto\""):
         load_config(write(setup, "fig4", name="hash_encoder", text_encoder="hash"))
+
+
+class PhysicsStandIn:
+    """A fake simulator with a known response: wind pushes the body 0.02 m/s per N, low gravity lifts it mid-motion."""
+
+    def __init__(self) -> None:
+        self.envs: list[tuple[float, float, float]] = []
+
+    def __call__(self, motions, envs):
+        for m, e in zip(motions, envs):
+            g, wx, wy = e.as_tuple()
+            self.envs.append((g, wx, wy))
+            out = np.array(m, dtype=np.float32)
+            t = np.arange(len(out))[:, None] / 20.0
+            out[..., 0] += 0.02 * wx * t
+            out[..., 2] += 0.02 * wy * t
+            bump = np.sin(np.linspace(0, np.pi, len(out))) * 0.1 * (9.81 / abs(g) - 1.0)
+            out[..., 1] += bump[:, None]
+            yield out, {"success": True, "status": "ok"}
+
+
+def test_env_response_scores_methods_against_the_simulator(setup: dict[str, Path]) -> None:
+    sim = PhysicsStandIn()
+    control = {"prompts": ["a person jumps", "a person walks"], "seeds": 2, "length": 24, "gravity": [-3.0],
+               "wind": [5.0], "combos": [[-3.0, 5.0, 0.0]], "resamples": 50}
+    models = [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}]
+    report = run_experiment(write(setup, "env_response", env_control=control, models=models), projector=sim,
+                            progress=False, text_encoder=hash_text)
+    rows = {r["method"]: r for r in report["rows"]}
+    grid = [(-9.81, 0.0, 0.0), (-3.0, 0.0, 0.0), (-9.81, 5.0, 0.0), (-9.81, 0.0, 5.0), (-3.0, 5.0, 0.0)]
+    assert [tuple(e) for e in rows["MDM"]["envs"]] == grid
+    assert set(sim.envs) == set(grid) and len(sim.envs) == 2 * 4 * len(grid)  # 2 methods × 4 units × every φ
+    mdm = {(s["factor"], s["quantity"]): s for s in rows["MDM"]["scores"]}
+    assert not rows["MDM"]["env_aware"] and rows["SimDiff"]["env_aware"]
+    # the simulator's answer is known: +0.2 m along the wind over 1.15 s at 5 N... and MDM does not respond at all
+    drift = mdm[("wind", "drift_along_wind_m")]
+    assert drift["mean_dsim"] == pytest.approx(0.02 * 5 * 23 / 20, abs=1e-3) and drift["n_units"] == 4
+    assert drift["slope_ratio"][0] == pytest.approx(0.0, abs=1e-9) and drift["sign_agreement"][0] == 0.0
+    assert mdm[("gravity", "apex_m")]["mean_dsim"] > 0.1 and mdm[("gravity", "apex_m")]["slope_ratio"][0] == pytest.approx(0.0, abs=1e-9)
+    # the simulated effects are additive by construction here
+    add = {a["quantity"]: a for a in rows["MDM"]["additivity"]}
+    assert add["drift_x_m"]["simulated"][0] == pytest.approx(0.0, abs=1e-4) and add["drift_x_m"]["generated"][0] == 0.0
+    md = (setup["root"] / "reports/env_response/report.md").read_text()
+    assert "slope ratio" in md and "Additivity" in md and "no (one generation for every φ)" in md
+    assert (setup["root"] / "reports/env_response/env_response.png").is_file()

@@ -21,7 +21,7 @@ from typing import Any
 from simdiff.errors import SimdiffError
 from simdiff.eval.protocol import ProtocolConfig
 
-KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack")
+KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response")
 """Experiment kinds, named as in the issue (and the paper)."""
 ROLES: tuple[str, ...] = ("backbone", "adapters", "adapters_binary")
 """Model roles ``paths`` may name: MDM backbone, continuous (φ) adapters, categorical (binary) adapters."""
@@ -125,7 +125,7 @@ class TimingOptions:
 
 @dataclass
 class EnvControlOptions:
-    """Figure 5: environment control of generated jumps.
+    """Figure 5 and the environment-response benchmark: prompts, seeds and the φ grid.
 
     Attributes:
         prompts: captions (jumps); seeds: noise seeds per prompt; length: frames per motion.
@@ -133,6 +133,7 @@ class EnvControlOptions:
         combos: unseen combinations φ, each compared with its single-factor parts.
         alpha: adapter strength of the SimDiff rows.
         filmstrip_frames: frames per filmstrip row (0: no filmstrips).
+        resamples: bootstrap resamples of the env_response intervals.
     """
 
     prompts: list[str] = field(default_factory=lambda: ["a person jumps", "a person jumps up in place",
@@ -144,6 +145,7 @@ class EnvControlOptions:
     combos: list[list[float]] = field(default_factory=lambda: [[-3.0, 7.0, 7.0]])
     alpha: float = 1.0
     filmstrip_frames: int = 8
+    resamples: int = 1000
 
 
 @dataclass

@@ -192,11 +192,11 @@ class Runner:
             getattr(self._projector, "close", lambda: None)()
             self._projector = None
 
-    def preflight(self, needs_evaluator: bool) -> None:
+    def preflight(self, needs_evaluator: bool, needs_corpus: bool = True) -> None:
         """Check that the corpus, the evaluator and every model folder exist before measuring anything."""
         c = self.config
         corpus = Path(c.corpus).expanduser()
-        if not (corpus / f"{c.split}.txt").is_file():
+        if needs_corpus and not (corpus / f"{c.split}.txt").is_file():
             raise SimdiffError(f"corpus {corpus} has no {c.split}.txt (set the corpus with --corpus DIR)")
         if needs_evaluator and c.evaluator.kind == "ours" and not (Path(c.evaluator.path).expanduser() / "model.safetensors").is_file():
             raise SimdiffError(f"evaluator folder {c.evaluator.path or '(none)'} has no model.safetensors "
