@@ -335,3 +335,23 @@ def test_env_response_scores_methods_against_the_simulator(setup: dict[str, Path
     md = (setup["root"] / "reports/env_response/report.md").read_text()
     assert "slope ratio" in md and "Additivity" in md and "no (one generation for every φ)" in md
     assert (setup["root"] / "reports/env_response/env_response.png").is_file()
+
+
+def test_simulated_finish_rows_in_table1_and_fig4(setup: dict[str, Path]) -> None:
+    sim = EchoProjector()
+    finish = {"name": "SimDiff + simulated finish", "model": "adapters_binary", "env_index": 1, "simulate": True, **FAST}
+    report = run_experiment(write(setup, "table1", name="t1_sim", samplers=["ddim"], alphas=[0.1], models=[finish]),
+                            projector=sim, progress=False, text_encoder=hash_text)
+    row = next(r for r in report["rows"] if r["method"] == "SimDiff + simulated finish")
+    assert row["measured"] == "protocol" and "phys_err" in row["summary"]
+    # one re-tracking per generated batch: 2 replications × 1 batch + 2 MultiModality prompts each, under Earth
+    assert len(sim.calls) == 2 * (1 + 2) and {e for _, envs in sim.calls for e in envs} == {(-9.81, 0.0, 0.0)}
+    md = (setup["root"] / "reports/t1_sim/report.md").read_text()
+    assert "SimDiff + simulated finish" in md and "Student-t" in md and "|floating − ground truth's floating|" in md
+    timing = {"text": "a person jumps", "length": 24, "repeats": 2, "ddpm_repeats": 1, "warmup": 0}
+    fig = run_experiment(write(setup, "fig4", name="f4_sim", samplers=["ddim"], timing=timing,
+                               models=[{"name": "MDM", "model": "backbone", **FAST}, finish]),
+                         projector=sim, progress=False, text_encoder=hash_text)
+    cell = next(r for r in fig["rows"] if r["method"] == "SimDiff + simulated finish")
+    assert cell["projection_median_s"] is not None and len(cell["times_s"]) == 2
+    assert sim.calls[-1][0] == [24]  # the final sample's joints, once per repeat

@@ -214,8 +214,13 @@ def _multimodality(evaluator: Evaluator, batches: list[dict[str, Any]], generate
 
 def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_index: int | None = None, alpha: float = 1.0,
                  sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5,
-                 physdiff: Any = None, projector: Any = None) -> GenerateFn:
-    """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection)."""
+                 physdiff: Any = None, projector: Any = None, simulate: bool = False) -> GenerateFn:
+    """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
+
+    ``simulate``: the simulated finish: every final sample is re-tracked by ``projector`` under φ
+    (``env``, Earth when None) and its features are replaced by the rollout's where it tracked
+    (frames after a fall keep the generated ones, as a PhysDiff projection does).
+    """
 
     def generate(captions: list[str], lengths: list[int], seed: int) -> Tensor:
         kwargs: dict[str, Any] = {}
@@ -227,6 +232,27 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
             out, _ = physdiff_generate(generator, captions, lengths, physdiff, projector=projector, seed=seed, **kwargs)
         else:
             out = generator.generate(captions, lengths, sampler=sampler, steps=steps, guidance=guidance, seed=seed, **kwargs)
-        return out.features.detach().cpu()
+        feats = out.features.detach().cpu()
+        if simulate:
+            feats = simulated_finish(generator, feats, lengths, env, projector)
+        return feats
 
     return generate
+
+
+def simulated_finish(generator: Any, features: Tensor, lengths: Sequence[int], env: Sequence[float] | None,
+                     projector: Any) -> Tensor:
+    """(B, T, 263) raw features → the same with each motion replaced by its re-tracked rollout under φ."""
+    from simdiff.baselines.physdiff import ProjectionHook
+    from simdiff.motion.normalize import Normalizer
+    from simdiff.sim.env import Environment
+
+    if projector is None:
+        raise SimdiffError("the simulated finish needs a projector (the simulator)")
+    norm = Normalizer(generator.mean.cpu().numpy(), generator.std.cpu().numpy())
+    phi = Environment(*env) if env is not None else Environment()
+    hook = ProjectionHook(norm, [int(n) for n in lengths], phi, projector)
+    x0 = norm.normalize(features.float())
+    out = norm.denormalize(hook(x0, 0, x0))
+    mask = (torch.arange(out.shape[1])[None, :] < torch.as_tensor([int(n) for n in lengths])[:, None]).to(out.dtype)
+    return out * mask[..., None]

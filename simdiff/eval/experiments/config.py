@@ -43,6 +43,9 @@ class ModelSpec:
         guidance: classifier-free guidance scale.
         physdiff: :class:`simdiff.baselines.physdiff.PhysDiffConfig` fields → PhysDiff sampling
             (the row's sampler, steps and φ are filled in by the experiment).
+        simulate: simulated finish: each final sample is re-tracked under its φ (Earth for
+            categorical models) and the simulator's motion replaces it where tracked
+            (``simdiff generate --simulate``); rows named e.g. ``SimDiff + simulated finish``.
     """
 
     name: str
@@ -55,6 +58,7 @@ class ModelSpec:
     ddpm_steps: int | None = None
     guidance: float = 2.5
     physdiff: dict[str, Any] | None = None
+    simulate: bool = False
 
     def sampler_steps(self, sampler: str) -> int | None:
         """Steps of ``sampler`` for this method."""

@@ -46,6 +46,24 @@ def fmt_env(env: Any) -> str:
     return "(" + ", ".join(f"{float(v):g}" for v in env) + ")"
 
 
+PAPER_SPEEDUP_NOTE: str = "the paper reports SimDiff DDIM about 10× faster than PhysDiff DDIM"
+
+
+def speed_comparison(rows: list[dict[str, Any]], key: str, a: str = "SimDiff", b: str = "PhysDiff") -> list[str]:
+    """One line per sampler comparing method ``a`` with ``b`` on the seconds in ``key`` (faster or slower, ×)."""
+    lines = []
+    for sampler in dict.fromkeys(r.get("sampler") for r in rows if r.get("sampler")):
+        ra = next((r for r in rows if r["method"] == a and r.get("sampler") == sampler and r.get(key)), None)
+        rb = next((r for r in rows if r["method"] == b and r.get("sampler") == sampler and r.get(key)), None)
+        if ra is None or rb is None:
+            continue
+        ratio = rb[key] / ra[key]
+        word = f"{ratio:.1f}× faster than" if ratio >= 1 else f"{1 / ratio:.1f}× slower than"
+        note = f" ({PAPER_SPEEDUP_NOTE}; here it is {ratio:.1f}×)" if sampler == "ddim" else ""
+        lines.append(f"* {sampler.upper()}: {a} ({ra[key]:.2f} s/motion) is {word} {b} ({rb[key]:.2f} s/motion){note}")
+    return lines
+
+
 def duration(seconds: float) -> str:
     """Seconds as ``42 s``, ``3.5 min`` or ``2.1 h``."""
     if seconds < 90:

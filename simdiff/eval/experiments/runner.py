@@ -224,6 +224,9 @@ class Runner:
         if spec.physdiff is not None:
             out["physdiff"] = dataclasses.asdict(self.physdiff_config(spec, sampler, env))
             out["projector"] = dataclasses.asdict(self.config.projector)
+        if spec.simulate:
+            out["simulate"] = True
+            out["projector"] = dataclasses.asdict(self.config.projector)
         return out
 
     # --- generation -------------------------------------------------------------------------
@@ -250,7 +253,7 @@ class Runner:
         return generator_fn(gen, env=use_env, env_index=spec.env_index if gen.is_simdiff else None,
                             alpha=spec.alpha if alpha is None else float(alpha), sampler=sampler,
                             steps=spec.sampler_steps(sampler), guidance=spec.guidance, physdiff=phys,
-                            projector=self.sim if phys is not None else None)
+                            projector=self.sim if phys is not None or spec.simulate else None, simulate=spec.simulate)
 
     def generate(self, fn: GenerateFn, captions: list[str], lengths: list[int], seed: int) -> tuple[torch.Tensor, float]:
         """Generate in batches of the protocol's size; returns ((N, T, 263) features, seconds)."""
@@ -362,6 +365,8 @@ class Runner:
         if spec.physdiff is not None:
             calls = len(self.physdiff_config(spec, sampler).project_at)
             s += n * calls * self.projection_seconds(motion_s, workers)
+        if spec.simulate:
+            s += n * self.projection_seconds(motion_s, workers)
         return s
 
     def projection_seconds(self, motion_s: float | None = None, workers: int | None = None) -> float:

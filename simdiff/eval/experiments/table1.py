@@ -14,6 +14,7 @@ from typing import Any
 
 from simdiff.eval.experiments.rows import ground_truth_plan, method_plan
 from simdiff.eval.experiments.runner import RowPlan, Runner
+from simdiff.eval.experiments.report import speed_comparison
 from simdiff.eval.experiments.tables import method_figure, metrics_table
 
 TITLE = "Table 1 — MDM, PhysDiff and SimDiff with DDPM and DDIM"
@@ -102,5 +103,6 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
                          f"({cfg.steps or ('1000' if sampler == 'ddpm' else '50')} steps), residual bound {cfg.residual_bound}")
     lines.append("* s/motion: generation time per motion in the protocol's batches of 32 (PhysDiff: with projection); "
                  "see fig4 for batch-1 latency")
+    lines += speed_comparison(report["rows"], "s_per_motion")
     lines += ["", f"![Table 1]({figure.name})"]
     return lines
