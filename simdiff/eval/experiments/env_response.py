@@ -70,10 +70,13 @@ def measure(runner: Runner, spec: ModelSpec) -> dict[str, Any]:
     sim_s = time.perf_counter() - start
     sims: dict[tuple[int, tuple[float, ...]], dict[str, float] | None] = {}
     statuses: dict[str, int] = {}
+    errors: list[str] = []
     for (i, env), (rollout, info) in zip(jobs, results):
         ok = not isinstance(info, str) and bool(_get(info, "success")) and rollout is not None and len(rollout) >= 2
         status = "error" if isinstance(info, str) else str(_get(info, "status", "?"))
         statuses[status] = statuses.get(status, 0) + 1
+        if isinstance(info, str) and len(errors) < 3:
+            errors.append(info)
         sims[(i, tuple(env))] = quantities(np.asarray(rollout), env) if ok else None
     records = []
     for env in envs:
@@ -84,7 +87,7 @@ def measure(runner: Runner, spec: ModelSpec) -> dict[str, Any]:
     effs = effects(records)
     return {"records": records, "scores": score(effs, resamples=o.resamples, seed=c.seed),
             "additivity": additivity(effs, resamples=o.resamples, seed=c.seed), "effects": effs,
-            "rollouts": statuses, "env_aware": env_aware(runner, spec), "gen_s": seconds, "sim_s": sim_s,
+            "rollouts": statuses, "rollout_errors": errors, "env_aware": env_aware(runner, spec), "gen_s": seconds, "sim_s": sim_s,
             "units": len(units), "envs": envs}
 
 
@@ -193,5 +196,8 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     for r in rows:
         lines.append(f"| {r['method']} | {'yes' if r['env_aware'] else 'no (one generation for every φ)'} | "
                      + ", ".join(f"{k}: {v}" for k, v in sorted(r["rollouts"].items())) + f" | {r['gen_s']:.1f} | {r['sim_s']:.1f} |")
+    for r in rows:
+        for e in r.get("rollout_errors") or []:
+            lines.append(f"* {r['method']} rollout error: {e}")
     lines += ["", f"![generated vs simulated effects]({path.name})"]
     return lines

@@ -174,7 +174,8 @@ class Runner:
             from simdiff.data.augment.projector import SimProjector
 
             p = self.config.projector
-            stats = str(Path(self.config.corpus).expanduser())
+            corpus = Path(self.config.corpus).expanduser()
+            stats = str(corpus) if (corpus / "Mean.npy").is_file() else None  # d_L2 needs them; tracking does not
             self._projector = SimProjector(stats, p.workers, p.backend, p.residual_bound)
         return self._projector
 
