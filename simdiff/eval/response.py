@@ -12,7 +12,8 @@ Scores per (factor, quantity), over the pairs (u, φ) whose two rollouts tracked
 
 * sign agreement: fraction of pairs with ``|Δs| > tolerance`` where ``sign Δg = sign Δs``;
 * slope ratio: the through-origin least-squares slope ``Σ Δg·Δs / Σ Δs²`` (1: the size physics
-  gives; 0: no response, as an env-blind model must score);
+  gives; 0: no response, as an env-blind model must score); undefined (NaN) when no pair has a
+  physical effect above the tolerance (a ratio to a null effect is noise);
 * additivity error (combinations φ = (g, w_x, w_y)): ``|Δ(φ) − Σ Δ(single-factor parts)|``, for
   the generated and for the simulated motions (the simulator's own non-additivity is the reference).
 
@@ -123,6 +124,11 @@ def slope_ratio(pairs: Sequence[tuple[float, float]]) -> float:
     return float(g @ s / den) if den > 0 else float("nan")
 
 
+def _effect_slope(pairs: Sequence[tuple[float, float]], tolerance: float) -> float:
+    """:func:`slope_ratio` when some |Δs| exceeds ``tolerance``, else NaN."""
+    return slope_ratio(pairs) if any(abs(s) > tolerance for _, s in pairs) else float("nan")
+
+
 def score(effs: Sequence[dict[str, Any]], *, resamples: int = 1000, seed: int = 0) -> list[dict[str, Any]]:
     """Sign agreement and slope ratio per (factor, quantity), bootstrap intervals over units.
 
@@ -144,7 +150,7 @@ def score(effs: Sequence[dict[str, Any]], *, resamples: int = 1000, seed: int = 
             flat = [p for u in units for p in u]
             sign = bootstrap_interval(units, lambda us: sign_agreement([p for u in us for p in u], tol),
                                       resamples=resamples, seed=seed)
-            slope = bootstrap_interval(units, lambda us: slope_ratio([p for u in us for p in u]),
+            slope = bootstrap_interval(units, lambda us: _effect_slope([p for u in us for p in u], tol),
                                        resamples=resamples, seed=seed)
             rows.append({"factor": f, "quantity": q, "n_pairs": len(flat), "n_units": len(units),
                          "n_effect": sum(abs(s) > tol for _, s in flat), "sign_agreement": list(sign),

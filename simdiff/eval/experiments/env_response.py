@@ -164,6 +164,9 @@ def figure(rows: list[dict[str, Any]], path: Any) -> Any:
 def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     c, o = runner.config, runner.config.env_control
     rows = report["rows"]
+    for r in rows:  # scored again from the stored effects: a scoring change needs no new rollouts
+        r["scores"] = score(r["effects"], resamples=o.resamples, seed=c.seed)
+        r["additivity"] = additivity(r["effects"], resamples=o.resamples, seed=c.seed)
     envs = grid(runner)
     path = figure(rows, runner.out / "env_response.png")
     lines = [f"Prompts: {', '.join('“' + p + '”' for p in o.prompts)}; {o.seeds} seeds each (units n = "
@@ -192,6 +195,10 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
                 lines.append(f"| {r['method']} | {fmt_env(a['env'])} | {LABELS[a['quantity']]} | "
                              f"{_interval(a['generated'], 3)} | {_interval(a['simulated'], 3)} | "
                              f"{a['n_generated']} / {a['n_simulated']} |")
+    silent = [r["method"] for r in rows if not r["scores"]]
+    if silent:
+        lines += ["", f"No scored pair for {', '.join(silent)}: every rollout of its Earth motions or of φ fell "
+                      "(see the rollouts below)."]
     lines += ["", "| Method | φ reaches it | rollouts (status: count) | generation s | simulation s |", "|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['method']} | {'yes' if r['env_aware'] else 'no (one generation for every φ)'} | "
