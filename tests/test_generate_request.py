@@ -127,3 +127,12 @@ def test_default_threads_follow_idle_cores(cpus: int, load: float, torch_default
     from simdiff.product.threads import default_threads
 
     assert default_threads(torch_default, cpus=cpus, load=load) == expected
+
+
+def test_augment_cli_defaults_match_the_filter() -> None:
+    """The augment command repeats FilterConfig's defaults (to keep torch out of CLI start-up); they must agree."""
+    from simdiff.cli.commands.augment import FILTER_DEFAULTS
+    from simdiff.data.augment.filter import FilterConfig
+
+    assert FILTER_DEFAULTS.max_pose_d_l2 == FilterConfig().max_pose_d_l2
+    assert FILTER_DEFAULTS.max_residual_n == FilterConfig().max_residual_n

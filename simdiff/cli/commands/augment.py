@@ -6,9 +6,9 @@ import argparse
 from pathlib import Path
 
 from simdiff.cli.main import command_group
-from simdiff.data.augment.filter import FilterConfig
-
-FILTER_DEFAULTS = FilterConfig()
+# FilterConfig's defaults, repeated so that building the CLI does not import simdiff.data.augment (whose
+# package imports torch; `simdiff generate` must reject bad input before torch loads). A test keeps them equal.
+FILTER_DEFAULTS = argparse.Namespace(max_pose_d_l2=3.3, max_residual_n=70.6)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
