@@ -127,6 +127,8 @@ def test_generate_simulate_writes_the_simulated_motion_and_tracking(tiny_model: 
                  "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
     captured = capsys.readouterr()
     assert code == 0, captured.err
+    assert ("warning: the simulated finish" in captured.err) == (json.loads(
+        (tmp_path / "o" / "sample0_tracking.json").read_text())["status"] != "ok")
     names = [Path(p).name for p in captured.out.split()]
     assert "sample0_simulated_joints.npy" in names and "sample0_tracking.json" in names
     sim = np.load(tmp_path / "o" / "sample0_simulated_joints.npy")

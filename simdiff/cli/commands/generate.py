@@ -154,6 +154,10 @@ def run(args: argparse.Namespace) -> int:
                                  simulate=args.simulate, force=args.force)
     for rec in meta["samples"] if args.simulate else []:
         sim = rec["simulated"]
+        if not sim["success"]:
+            print(f"simdiff: warning: the simulated finish of sample {rec['index']} {sim['status']} at frame "
+                  f"{sim['fall_frame']}; its simulated motion ends there ({sim['n_out']} of {sim['n_frames']} frames)",
+                  file=sys.stderr)
         _note(args, f"sample {rec['index']} simulated: {sim['status']} ({sim['n_out']} frames, joint error "
                     f"{sim['err_mm']:.0f} mm, {sim['wall_s']:.2f} s)")
     for path in paths:
