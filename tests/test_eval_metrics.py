@@ -104,11 +104,16 @@ def test_multimodality_of_known_set() -> None:
     assert M.multimodality(np.ones((3, 10, 4)), 10) == 0.0
 
 
-def test_mean_ci_formula() -> None:
+def test_mean_ci_is_student_t() -> None:
+    from scipy import stats
+
     values = [1.0, 2.0, 3.0, 4.0]
     mean, ci = M.mean_ci(values)
     assert mean == 2.5
-    assert ci == pytest.approx(1.96 * np.std(values) / 2.0)
+    # closed form: t_{0.975, 3} * s / sqrt(4), s with ddof = 1 (wider than MDM's 1.96 * population std / 2)
+    assert ci == pytest.approx(stats.t.ppf(0.975, 3) * np.std(values, ddof=1) / 2.0)
+    assert ci > 1.96 * np.std(values) / 2.0
     summary = M.summarize([{"fid": 1.0, "div": 2.0}, {"fid": 3.0, "div": 2.0}])
-    assert summary["fid"] == {"mean": 2.0, "ci95": pytest.approx(1.96 * 1.0 / np.sqrt(2)), "n": 2}
+    assert summary["fid"]["mean"] == 2.0 and summary["fid"]["n"] == 2
+    assert summary["fid"]["ci95"] == pytest.approx(stats.t.ppf(0.975, 1) * np.sqrt(2.0) / np.sqrt(2))
     assert summary["div"]["ci95"] == 0.0

@@ -57,13 +57,14 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
         "fig4": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                  {"name": "SimDiff", "model": "adapters", **FAST}],
         "fig5": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}],
+        "env_response": [{"name": "MDM", "model": "backbone", **FAST}],
         "retrack": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                     {"name": "SimDiff", "model": "adapters", **FAST}],
     }[kind]
     cfg = {"name": name or kind, "kind": kind, "corpus": str(setup["corpus"]),
            "paths": {r: str(setup[r]) for r in ("backbone", "adapters", "adapters_binary")},
            "evaluator": {"kind": "ours", "path": str(setup["evaluator"])}, "protocol": PROTO, "models": models,
-           "out_dir": str(setup["root"] / "reports"), **extra}
+           "out_dir": str(setup["root"] / "reports"), "smoke": True, **extra}
     path = setup["root"] / f"eval_{name or kind}.json"
     path.write_text(json.dumps(cfg))
     return path
@@ -71,7 +72,8 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
 
 def test_shipped_configs_are_the_five_experiments_with_relative_paths() -> None:
     paths = sorted(CONFIGS.glob("eval_*.json"))
-    assert [p.stem for p in paths] == ["eval_fig4", "eval_fig5", "eval_retrack", "eval_table1", "eval_table2"]
+    assert [p.stem for p in paths] == ["eval_env_response", "eval_fig4", "eval_fig5", "eval_retrack", "eval_table1",
+                                       "eval_table2"]
     for path in paths:
         raw = json.loads(path.read_text())
         assert raw["kind"] == raw["name"] == path.stem[5:]
@@ -109,7 +111,8 @@ def test_budget_and_overrides_apply_in_order(tmp_path: Path) -> None:
 
 def test_select_alpha_rules() -> None:
     def row(alpha: float, fid: float, pen: float) -> dict:
-        s = {"fid": {"mean": fid}, "penetration": {"mean": pen}, "floating": {"mean": 0.0}, "sliding": {"mean": 0.0}}
+        s = {"fid": {"mean": fid}, "penetration": {"mean": pen}, "floating": {"mean": 0.0}, "sliding": {"mean": 0.0},
+             "phys_err": {"mean": pen, "ci95": 0.0}}
         return {"alpha": alpha, "method": "S", "sampler": "ddim", "summary": s}
 
     rows = [row(0.01, 1.0, 9.0), row(0.1, 2.0, 2.0), row(1.0, 5.0, 1.0)]
@@ -148,7 +151,8 @@ def test_table2_then_table1_best_alpha_reuse_and_resume(setup: dict[str, Path], 
     rows = {r["key"]: r for r in t1["rows"]}
     # DDPM rows: physics + time on 3 motions (fewer than a batch); DDIM rows: the full protocol with MultiModality
     assert rows["MDM_ddpm"]["measured"] == "subset" and rows["MDM_ddpm"]["samples"] == 3
-    assert set(rows["MDM_ddpm"]["physics"]) == {"penetration", "floating", "sliding", "skate_ratio"}
+    assert set(rows["MDM_ddpm"]["physics"]) == {"penetration", "floating", "sliding", "skate_ratio", "floating_to_gt",
+                                                "phys_err"}
     s = rows["PhysDiff_ddim"]["summary"]
     assert {"r_precision_top1", "r_precision_top3", "fid", "mm_dist", "diversity", "multimodality", "skate_ratio"} <= set(s)
     assert s["fid"]["n"] == 2 and rows["PhysDiff_ddim"]["samples_per_replication"] == 8
@@ -286,3 +290,68 @@ def test_table1_uses_the_best_alpha_known_when_it_started(setup: dict[str, Path]
 def test_config_refuses_a_text_encoder_stand_in(setup: dict[str, Path]) -> None:
     with pytest.raises(SimdiffError, match="text_encoder 'hash' must be \"auto\""):
         load_config(write(setup, "fig4", name="hash_encoder", text_encoder="hash"))
+
+
+class PhysicsStandIn:
+    """A fake simulator with a known response: wind pushes the body 0.02 m/s per N, low gravity lifts it mid-motion."""
+
+    def __init__(self) -> None:
+        self.envs: list[tuple[float, float, float]] = []
+
+    def __call__(self, motions, envs):
+        for m, e in zip(motions, envs):
+            g, wx, wy = e.as_tuple()
+            self.envs.append((g, wx, wy))
+            out = np.array(m, dtype=np.float32)
+            t = np.arange(len(out))[:, None] / 20.0
+            out[..., 0] += 0.02 * wx * t
+            out[..., 2] += 0.02 * wy * t
+            bump = np.sin(np.linspace(0, np.pi, len(out))) * 0.1 * (9.81 / abs(g) - 1.0)
+            out[..., 1] += bump[:, None]
+            yield out, {"success": True, "status": "ok"}
+
+
+def test_env_response_scores_methods_against_the_simulator(setup: dict[str, Path]) -> None:
+    sim = PhysicsStandIn()
+    control = {"prompts": ["a person jumps", "a person walks"], "seeds": 2, "length": 24, "gravity": [-3.0],
+               "wind": [5.0], "combos": [[-3.0, 5.0, 0.0]], "resamples": 50}
+    models = [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}]
+    report = run_experiment(write(setup, "env_response", env_control=control, models=models), projector=sim,
+                            progress=False, text_encoder=hash_text)
+    rows = {r["method"]: r for r in report["rows"]}
+    grid = [(-9.81, 0.0, 0.0), (-3.0, 0.0, 0.0), (-9.81, 5.0, 0.0), (-9.81, 0.0, 5.0), (-3.0, 5.0, 0.0)]
+    assert [tuple(e) for e in rows["MDM"]["envs"]] == grid
+    assert set(sim.envs) == set(grid) and len(sim.envs) == 2 * 4 * len(grid)  # 2 methods × 4 units × every φ
+    mdm = {(s["factor"], s["quantity"]): s for s in rows["MDM"]["scores"]}
+    assert not rows["MDM"]["env_aware"] and rows["SimDiff"]["env_aware"]
+    # the simulator's answer is known: +0.2 m along the wind over 1.15 s at 5 N... and MDM does not respond at all
+    drift = mdm[("wind", "drift_along_wind_m")]
+    assert drift["mean_dsim"] == pytest.approx(0.02 * 5 * 23 / 20, abs=1e-3) and drift["n_units"] == 4
+    assert drift["slope_ratio"][0] == pytest.approx(0.0, abs=1e-9) and drift["sign_agreement"][0] == 0.0
+    assert mdm[("gravity", "apex_m")]["mean_dsim"] > 0.1 and mdm[("gravity", "apex_m")]["slope_ratio"][0] == pytest.approx(0.0, abs=1e-9)
+    # the simulated effects are additive by construction here
+    add = {a["quantity"]: a for a in rows["MDM"]["additivity"]}
+    assert add["drift_x_m"]["simulated"][0] == pytest.approx(0.0, abs=1e-4) and add["drift_x_m"]["generated"][0] == 0.0
+    md = (setup["root"] / "reports/env_response/report.md").read_text()
+    assert "slope ratio" in md and "Additivity" in md and "no (one generation for every φ)" in md
+    assert (setup["root"] / "reports/env_response/env_response.png").is_file()
+
+
+def test_simulated_finish_rows_in_table1_and_fig4(setup: dict[str, Path]) -> None:
+    sim = EchoProjector()
+    finish = {"name": "SimDiff + simulated finish", "model": "adapters_binary", "env_index": 1, "simulate": True, **FAST}
+    report = run_experiment(write(setup, "table1", name="t1_sim", samplers=["ddim"], alphas=[0.1], models=[finish]),
+                            projector=sim, progress=False, text_encoder=hash_text)
+    row = next(r for r in report["rows"] if r["method"] == "SimDiff + simulated finish")
+    assert row["measured"] == "protocol" and "phys_err" in row["summary"]
+    # one re-tracking per generated batch: 2 replications × 1 batch + 2 MultiModality prompts each, under Earth
+    assert len(sim.calls) == 2 * (1 + 2) and {e for _, envs in sim.calls for e in envs} == {(-9.81, 0.0, 0.0)}
+    md = (setup["root"] / "reports/t1_sim/report.md").read_text()
+    assert "SimDiff + simulated finish" in md and "Student-t" in md and "|floating − ground truth's floating|" in md
+    timing = {"text": "a person jumps", "length": 24, "repeats": 2, "ddpm_repeats": 1, "warmup": 0}
+    fig = run_experiment(write(setup, "fig4", name="f4_sim", samplers=["ddim"], timing=timing,
+                               models=[{"name": "MDM", "model": "backbone", **FAST}, finish]),
+                         projector=sim, progress=False, text_encoder=hash_text)
+    cell = next(r for r in fig["rows"] if r["method"] == "SimDiff + simulated finish")
+    assert cell["projection_median_s"] is not None and len(cell["times_s"]) == 2
+    assert sim.calls[-1][0] == [24]  # the final sample's joints, once per repeat

@@ -120,3 +120,22 @@ def test_help_lists_every_option() -> None:
                    "--guidance", "--alpha", "--out", "--model", "--force", "--format", "--compare", "--no-video",
                    "--quiet", "--threads", "generation.json"):
         assert option in proc.stdout, option
+
+
+def test_generate_simulate_writes_the_simulated_motion_and_tracking(tiny_model: Path, tmp_path: Path, capsys) -> None:
+    code = main(["generate", "a person jumps", "--gravity", "-3.7", "--frames", "8", "--steps", "1", "--simulate",
+                 "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert ("warning: the simulated finish" in captured.err) == (json.loads(
+        (tmp_path / "o" / "sample0_tracking.json").read_text())["status"] != "ok")
+    names = [Path(p).name for p in captured.out.split()]
+    assert "sample0_simulated_joints.npy" in names and "sample0_tracking.json" in names
+    sim = np.load(tmp_path / "o" / "sample0_simulated_joints.npy")
+    assert sim.ndim == 3 and sim.shape[1:] == (22, 3) and sim.dtype == np.float32 and np.isfinite(sim).all()
+    tracking = json.loads((tmp_path / "o" / "sample0_tracking.json").read_text())
+    assert tracking["env"] == [-3.7, 0.0, 0.0] and tracking["status"] in ("ok", "fell", "unstable")
+    assert tracking["n_frames"] == 8 and tracking["n_out"] == len(sim) and tracking["wall_s"] > 0
+    assert set(tracking["physics_generated"]) >= {"penetration", "floating", "sliding"}
+    meta = json.loads((tmp_path / "o" / "generation.json").read_text())
+    assert meta["samples"][0]["simulated"]["status"] == tracking["status"] and meta["timings_s"]["simulate"] > 0

@@ -135,6 +135,18 @@ def test_generate_matches_direct_sampling(server, model_dir):
     np.testing.assert_allclose(joints, expected, atol=1e-4)  # rounded to 0.1 mm on the wire
 
 
+def test_generate_with_simulated_finish(server):
+    body = {"text": "a person jumps", "gravity": -3.0, "seconds": 0.4, "seed": 1, "simulate": True}
+    status, out, _ = call(server, "/api/generate", body)
+    assert status == 200, out
+    meta = out["meta"]
+    generated = np.asarray(meta["generated_joints"])
+    assert generated.shape == (8, 22, 3) and meta["params"]["simulate"] is True
+    sim = meta["simulated"]
+    assert sim["env"] == [-3.0, 0.0, 0.0] and sim["n_frames"] == 8 and sim["status"] in ("ok", "fell", "unstable")
+    assert np.asarray(out["joints"]).shape == (sim["n_out"], 22, 3)  # the simulated motion is the one shown
+
+
 def test_same_seed_repeats_and_gravity_changes_the_motion(server):
     body = {"text": "a person walks", "seconds": 1.5, "seed": 3}
     first = np.asarray(call(server, "/api/generate", body)[1]["joints"])
@@ -175,6 +187,7 @@ def test_generation_requests_are_serialised(server):
     ({"text": "walk", "seed": -1}, "seed must be a non-negative integer"),
     ({"text": "walk", "steps": 0}, "steps must be in [1, 200], got 0"),
     ({"text": "walk", "windx": 1}, "unknown field 'windx'"),
+    ({"text": "walk", "simulate": "yes"}, "simulate must be true or false, got 'yes'"),
     (["walk"], "request body must be a JSON object"),
 ])
 def test_bad_generate_request_is_a_400_with_one_line(server, body, needle):

@@ -14,7 +14,8 @@ official T2M evaluator) and return plain floats. Conventions follow
 * Diversity: mean L2 distance between two independent draws of ``times`` (300) embeddings;
 * MultiModality: per prompt, mean L2 distance between ``times`` (10) random pairs of its
   repeats, averaged over prompts;
-* reporting: mean and ``1.96·std/√R`` over R replications (population std, as MDM does).
+* reporting: mean and the Student-t 95 % half-width ``t_{0.975,R−1}·s/√R`` over R replications
+  (sample std; MDM's normal-theory ``1.96·σ/√R`` understates it at small R), see :mod:`simdiff.eval.stats`.
 """
 
 from __future__ import annotations
@@ -153,20 +154,21 @@ def multimodality(emb: np.ndarray, times: int = MM_TIMES, rng: np.random.Generat
 
 
 def mean_ci(values: Sequence[float] | np.ndarray) -> tuple[float, float]:
-    """(mean, 95% half-interval ``1.96·std/√R``) over R replications (population std)."""
-    v = np.asarray(values, dtype=np.float64).reshape(-1)
-    if v.size == 0:
-        raise SimdiffError("no replications to summarise")
-    return float(v.mean()), float(1.96 * v.std() / np.sqrt(v.size))
+    """(mean, 95% Student-t half-interval) over R replications (:func:`simdiff.eval.stats.t_interval`)."""
+    from simdiff.eval.stats import t_interval
+
+    return t_interval(values)
 
 
 def summarize(replications: Sequence[dict[str, float]]) -> dict[str, dict[str, float]]:
-    """{metric: {"mean", "ci95", "n"}} over a list of per-replication metric dicts."""
+    """{metric: {"mean", "ci95" (Student-t half-width), "sd" (ddof 1), "n"}} over per-replication metric dicts."""
     if not replications:
         raise SimdiffError("no replications to summarise")
     keys = [k for k in replications[0] if all(k in r for r in replications)]
     out: dict[str, dict[str, float]] = {}
     for key in keys:
-        mean, ci = mean_ci([r[key] for r in replications])
-        out[key] = {"mean": mean, "ci95": ci, "n": len(replications)}
+        values = np.asarray([r[key] for r in replications], dtype=np.float64)
+        mean, ci = mean_ci(values)
+        out[key] = {"mean": mean, "ci95": ci, "sd": float(values.std(ddof=1)) if len(values) > 1 else float("nan"),
+                    "n": len(replications)}
     return out

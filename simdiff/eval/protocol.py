@@ -6,12 +6,20 @@ caption and crop (multiple of 4 frames, MDM's 2/3–1/3 rule), generate one moti
 with the GT length, embed GT and generated motions and the texts, and compute
 
 * generated: R-precision top-1/2/3, MM-Dist, FID against this replication's GT motion
-  embeddings, Diversity (300 pairs), physics metrics (CLoSD's per-batch mean);
+  embeddings, Diversity (300 pairs), physics metrics (CLoSD's per-batch mean), floating_to_gt
+  (|floating − the same captions' GT floating|, mm) and phys_err (penetration + sliding +
+  floating_to_gt, mm; see :func:`simdiff.motion.metrics.phys_err`);
 * ground truth: the same, with FID against a second independent GT draw (crops/captions);
 * MultiModality (``mm_prompts`` > 0): ``mm_repeats`` generations for each of ``mm_prompts``
   captions, ``mm_times`` pairs each.
 
-Results: per-replication values and mean ± 1.96·std/√R.
+Results: per-replication values and mean ± the Student-t 95 % half-width (:mod:`simdiff.eval.stats`).
+
+FID is biased upwards at small n (the sample covariance of n embeddings has rank ≤ n − 1):
+the ground-truth row's FID (GT against an independent GT draw at the *same* n) is the floor
+a generated row's FID must be read against. Claim-carrying runs use n ≥ 256 motions per
+replication (or the whole split in whole batches, when smaller) and R ≥ 5
+(:data:`MIN_CLAIM_SAMPLES`, :data:`MIN_CLAIM_REPLICATIONS`).
 
 ``generate(captions, lengths, seed) -> (B, T, 263)`` must return *raw* (un-normalised)
 features, zero beyond each length (``MotionGenerator.generate(...).features``).
@@ -32,6 +40,10 @@ from simdiff.errors import SimdiffError
 from simdiff.eval import metrics as M
 
 GenerateFn = Callable[[list[str], list[int], int], Tensor]
+MIN_CLAIM_SAMPLES: int = 256
+"""Motions per replication a claim-carrying protocol needs (or the whole split, when smaller)."""
+MIN_CLAIM_REPLICATIONS: int = 5
+"""Replications a claim-carrying protocol needs."""
 
 
 class Evaluator(Protocol):
@@ -149,13 +161,40 @@ def evaluate_t2m(evaluator: Evaluator, dataset: Any, generate: GenerateFn | None
             row["generated"] = _scores(text, gen, gt, config, np.random.default_rng([config.seed, r, 3]))
             if phys:
                 row["generated"].update(_mean_dicts(phys))
+                gt_float = row["ground_truth"]["floating"]
+                row["generated"]["floating_to_gt"] = abs(row["generated"]["floating"] - gt_float)
+                row["generated"]["phys_err"] = phys_err(row["generated"], gt_float)
             if config.mm_prompts > 0:
                 row["generated"]["multimodality"] = _multimodality(evaluator, batches, generate, config, r)
             row["gen_s_per_sample"] = seconds / len(gen)
         reps.append(row)
     summary = {key: M.summarize([rep[key] for rep in reps]) for key in ("ground_truth", "generated") if key in reps[0]}
     return {"replications": reps, "summary": summary, "samples_per_replication": len(text),
-            "protocol": {**config.__dict__}}
+            "split_size": len(dataset), "protocol": {**config.__dict__}}
+
+
+def phys_err(metrics: dict[str, float], gt_floating: float) -> float:
+    """Penetration + sliding + |floating − GT floating| (mm): :func:`simdiff.motion.metrics.phys_err`."""
+    from simdiff.motion.metrics import phys_err as _phys_err
+
+    return _phys_err(metrics, gt_floating)
+
+
+def claim_problems(config: ProtocolConfig, split_size: int | None) -> list[str]:
+    """Why ``config`` cannot carry a claim on a split of ``split_size`` items (empty: it can).
+
+    n per replication must be ≥ :data:`MIN_CLAIM_SAMPLES`, or every whole batch of the split when
+    the split is smaller; R ≥ :data:`MIN_CLAIM_REPLICATIONS`.
+    """
+    out = []
+    if config.replications < MIN_CLAIM_REPLICATIONS:
+        out.append(f"replications={config.replications} < {MIN_CLAIM_REPLICATIONS}")
+    whole = None if split_size is None else split_size // config.batch_size
+    n = config.max_batches * config.batch_size if whole is None else min(config.max_batches, whole) * config.batch_size
+    if n < MIN_CLAIM_SAMPLES and (whole is None or config.max_batches < whole):
+        out.append(f"samples_limit={config.samples_limit} gives {n} motions per replication, fewer than "
+                   f"{MIN_CLAIM_SAMPLES} and fewer than the whole split")
+    return out
 
 
 def _mean_dicts(rows: list[dict[str, float]]) -> dict[str, float]:
@@ -175,8 +214,13 @@ def _multimodality(evaluator: Evaluator, batches: list[dict[str, Any]], generate
 
 def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_index: int | None = None, alpha: float = 1.0,
                  sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5,
-                 physdiff: Any = None, projector: Any = None) -> GenerateFn:
-    """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection)."""
+                 physdiff: Any = None, projector: Any = None, simulate: bool = False) -> GenerateFn:
+    """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
+
+    ``simulate``: the simulated finish: every final sample is re-tracked by ``projector`` under φ
+    (``env``, Earth when None) and its features are replaced by the rollout's where it tracked
+    (frames after a fall keep the generated ones, as a PhysDiff projection does).
+    """
 
     def generate(captions: list[str], lengths: list[int], seed: int) -> Tensor:
         kwargs: dict[str, Any] = {}
@@ -188,6 +232,27 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
             out, _ = physdiff_generate(generator, captions, lengths, physdiff, projector=projector, seed=seed, **kwargs)
         else:
             out = generator.generate(captions, lengths, sampler=sampler, steps=steps, guidance=guidance, seed=seed, **kwargs)
-        return out.features.detach().cpu()
+        feats = out.features.detach().cpu()
+        if simulate:
+            feats = simulated_finish(generator, feats, lengths, env, projector)
+        return feats
 
     return generate
+
+
+def simulated_finish(generator: Any, features: Tensor, lengths: Sequence[int], env: Sequence[float] | None,
+                     projector: Any) -> Tensor:
+    """(B, T, 263) raw features → the same with each motion replaced by its re-tracked rollout under φ."""
+    from simdiff.baselines.physdiff import ProjectionHook
+    from simdiff.motion.normalize import Normalizer
+    from simdiff.sim.env import Environment
+
+    if projector is None:
+        raise SimdiffError("the simulated finish needs a projector (the simulator)")
+    norm = Normalizer(generator.mean.cpu().numpy(), generator.std.cpu().numpy())
+    phi = Environment(*env) if env is not None else Environment()
+    hook = ProjectionHook(norm, [int(n) for n in lengths], phi, projector)
+    x0 = norm.normalize(features.float())
+    out = norm.denormalize(hook(x0, 0, x0))
+    mask = (torch.arange(out.shape[1])[None, :] < torch.as_tensor([int(n) for n in lengths])[:, None]).to(out.dtype)
+    return out * mask[..., None]

@@ -173,3 +173,38 @@ def physics_metrics(
         "sliding": float((per["sliding"] * n_pairs).sum() / n_pairs.sum()),
         "skate_ratio": float(per["skate_ratio"].mean()),
     }
+
+
+def floating_to_gt(
+    joints: np.ndarray | torch.Tensor,
+    gt_joints: np.ndarray | torch.Tensor,
+    lengths: Sequence[int] | np.ndarray | torch.Tensor | None = None,
+    gt_lengths: Sequence[int] | np.ndarray | torch.Tensor | None = None,
+) -> float:
+    """Floating scored as PhysDiff's table marks it ('→', closer to ground truth is better).
+
+    ``|floating(joints) − floating(gt_joints)|`` in mm, each the CLoSD pooled mean. Real motion
+    floats too (a lowest joint above 5 mm in flight and on tiptoe), so a motion that sinks into
+    the floor must not score better than the ground truth: with this term it scores worse.
+
+    Args:
+        joints, gt_joints: (B, T, 22, 3) or (T, 22, 3) metres, Y-up; the generated motions and the
+            ground-truth motions of the same captions (batches may differ in size and length).
+        lengths, gt_lengths: valid frames per sample (None: all).
+    """
+    gen = physics_metrics(joints, lengths)["floating"]
+    ref = physics_metrics(gt_joints, gt_lengths)["floating"]
+    return float(abs(gen - ref))
+
+
+def phys_err(metrics: dict[str, float], gt_floating: float) -> float:
+    """Our Phys-Err (mm): penetration + sliding + |floating − floating of the ground truth|.
+
+    PhysDiff's sum adds raw floating, which rewards sinking; we replace it by the distance to the
+    ground truth's floating (see :func:`floating_to_gt`). ``metrics`` holds penetration, floating
+    and sliding (:func:`physics_metrics`); sliding is mm/frame, counted as mm as PhysDiff does.
+    """
+    missing = [k for k in ("penetration", "floating", "sliding") if k not in metrics]
+    if missing:
+        raise SimdiffError(f"phys_err needs {', '.join(missing)}")
+    return float(metrics["penetration"] + metrics["sliding"] + abs(metrics["floating"] - gt_floating))

@@ -20,6 +20,7 @@ from simdiff import __version__
 from simdiff.motion.skeleton import FPS
 from simdiff.product.outputs import env_label, render_video, write_metadata, write_motion
 from simdiff.product.request import GenerationRequest
+from simdiff.product.simulate import SimulatedMotion, simulate_finish, write_simulated
 from simdiff.sim.env import Environment
 
 FEATURES_NOTE = ("(T, 263) float32 un-normalised HumanML3D features, one row per joint frame as the model "
@@ -67,6 +68,7 @@ class Sample:
     env: Environment | None
     features: np.ndarray
     joints: np.ndarray
+    simulated: "SimulatedMotion | None" = None
 
 
 def _progress(quiet: bool):
@@ -155,6 +157,9 @@ def write_outputs(samples: list[Sample], request: GenerationRequest, out_dir: Pa
             written.update(write_motion(stem, s.joints, s.features, [f for f in request.formats if f == "npy"]))
         with timer.stage("write_bvh"):
             written.update(write_motion(stem, s.joints, s.features, [f for f in request.formats if f == "bvh"]))
+        if s.simulated is not None:
+            with timer.stage("write_simulated"):
+                written.update(write_simulated(stem, s.simulated, list(request.formats)))
         files.append(written)
     videos: list[Path] = []
     progress = _progress(quiet)
@@ -192,7 +197,8 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
     cfg = generator.config
     simdiff_model = bool(generator.is_simdiff)
     records = [{"index": s.index, "seed": s.seed, "environment": None if s.env is None else _env_dict(s.env),
-                "frames": int(s.joints.shape[0]), "files": {kind: p.name for kind, p in written.items()}}
+                "frames": int(s.joints.shape[0]), "files": {kind: p.name for kind, p in written.items()},
+                **({"simulated": _simulated_summary(s.simulated)} if s.simulated is not None else {})}
                for s, written in zip(samples, files)]
     return {
         "simdiff_version": __version__,
@@ -228,10 +234,41 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
     }
 
 
+def _simulated_summary(sim: SimulatedMotion) -> dict:
+    """The tracking result's headline numbers for ``generation.json``."""
+    t = sim.tracking
+    keys = ("success", "status", "fall_frame", "n_frames", "n_out", "err_mm", "err_local_mm", "d_l2", "time_warp",
+            "wall_s", "cpu_s", "env_assumed")
+    return {**{k: t.get(k) for k in keys}, "physics_simulated": t.get("physics_simulated")}
+
+
+def normalizer_of(generator) -> object | None:
+    """The generator's feature statistics as a :class:`~simdiff.motion.normalize.Normalizer` (None if unusable)."""
+    from simdiff.errors import SimdiffError
+    from simdiff.motion.normalize import Normalizer
+
+    try:
+        return Normalizer(generator.mean.detach().cpu().numpy(), generator.std.detach().cpu().numpy())
+    except (SimdiffError, AttributeError):
+        return None
+
+
+def simulate_samples(generator, samples: list[Sample], timer: Timer, force: bool = False) -> None:
+    """Re-track every sample under its φ (:func:`simdiff.product.simulate.simulate_finish`), in place."""
+    norm = normalizer_of(generator)
+    with timer.stage("simulate"):
+        for s in samples:
+            s.simulated = simulate_finish(s.joints, s.env, normalizer=norm, force=force)
+
+
 def run_generation(generator, request: GenerationRequest, out_dir: Path, model_dir: Path, timer: Timer,
-                   quiet: bool = False, alpha_source: str = "default") -> tuple[dict, list[Path]]:
-    """Sample, write every file and ``generation.json``; returns (metadata, written paths in print order)."""
+                   quiet: bool = False, alpha_source: str = "default", simulate: bool = False,
+                   force: bool = False) -> tuple[dict, list[Path]]:
+    """Sample (and with ``simulate`` re-track under φ), write every file and ``generation.json``;
+    returns (metadata, written paths in print order)."""
     samples = sample_motions(generator, request, timer, quiet)
+    if simulate:
+        simulate_samples(generator, samples, timer, force)
     files, videos = write_outputs(samples, request, out_dir, timer, quiet)
     meta = metadata(request, generator, model_dir, samples, files, videos, timer, alpha_source)
     meta_path = write_metadata(out_dir / "generation.json", meta)

@@ -41,6 +41,8 @@ class GenerateParams:
         seed: noise seed (≥ 0).
         steps: DDIM steps, or None for the sampler's default (50).
         guidance: classifier-free guidance scale.
+        simulate: simulated finish: re-track the motion in the simulator under φ; the answer shows the
+            simulated motion and carries the generated one and the tracking result in ``meta``.
     """
 
     text: str
@@ -52,6 +54,7 @@ class GenerateParams:
     seed: int = 0
     steps: int | None = None
     guidance: float = 2.5
+    simulate: bool = False
 
     @property
     def frames(self) -> int:
@@ -98,7 +101,8 @@ def parse_generate(body: Any) -> GenerateParams:
     """Validate a ``POST /api/generate`` JSON body.
 
     Args:
-        body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance}``;
+        body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
+            simulate}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -133,5 +137,8 @@ def parse_generate(body: Any) -> GenerateParams:
         raise SimdiffError(f"steps must be in [1, {MAX_STEPS}], got {steps}")
     guidance = _number(body, "guidance", defaults.guidance)
     _check_range("guidance", guidance, *GUIDANCE_RANGE)
+    simulate = body.get("simulate", False)
+    if not isinstance(simulate, bool):
+        raise SimdiffError(f"simulate must be true or false, got {simulate!r}")
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
-                          guidance=guidance, **wind)
+                          guidance=guidance, simulate=simulate, **wind)

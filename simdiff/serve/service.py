@@ -223,6 +223,18 @@ class MotionService:
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
                 "kind": self._kind(generator.config), "env_used": uses_env, "elapsed_s": round(elapsed, 3),
                 "queue_position": position, "waited_s": round(waited, 3)}
+        if params.simulate:
+            from simdiff.product.pipeline import normalizer_of
+            from simdiff.product.simulate import simulate_finish
+            from simdiff.serve.payload import DECIMALS
+            from simdiff.sim.env import Environment
+
+            env = Environment(params.gravity, params.wind_x, params.wind_y) if uses_env else None
+            sim = simulate_finish(np.asarray(joints), env, normalizer=normalizer_of(generator))
+            meta["simulated"] = sim.tracking
+            meta["generated_joints"] = np.round(np.asarray(joints, dtype=np.float64), DECIMALS).tolist()
+            meta["elapsed_s"] = round(time.perf_counter() - start, 3)
+            return motion_payload(sim.joints, meta)
         return motion_payload(joints, meta)
 
     def open_listed(self, index: int) -> dict[str, Any]:

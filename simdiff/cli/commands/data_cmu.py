@@ -41,10 +41,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="quality report of a built corpus (markdown + PNG)",
         description=(
             "Counts and hours per split, source and motion type; per-clip physics metrics; "
-            "AMC vs BVH agreement of the trials captured in both; filmstrips."
+            "AMC vs BVH agreement of the trials captured in both; filmstrips. For a corpus of "
+            "`simdiff data build`: hours by source/licence/motion type/split, flight time, physics "
+            "metrics per source with outliers, dedupe cross-checks and a filmstrip per source."
         ),
     )
-    report.add_argument("corpus", type=Path, help="corpus folder written by build-cmu")
+    report.add_argument("corpus", type=Path, help="corpus folder written by build-cmu or build")
     report.add_argument("--out", type=Path, default=None, help="report folder (default CORPUS/report)")
     report.add_argument("--src", type=Path, default=None, help="CMU source folder (default: the one in manifest.json)")
     report.add_argument("--seed", type=int, default=0, help="seed for the clips shown in filmstrips")
@@ -76,8 +78,13 @@ def run_build(args: argparse.Namespace) -> int:
 
 
 def run_report(args: argparse.Namespace) -> int:
-    from simdiff.data.cmu.report import write_report
+    from simdiff.data.cmu.report import load_manifest, write_report
+    from simdiff.data.corpus.build import FORMAT
+    from simdiff.data.corpus.report import write_corpus_report
 
-    path = write_report(args.corpus, args.out, src=args.src, seed=args.seed, crosscheck=not args.no_crosscheck)
+    if load_manifest(args.corpus).get("format") == FORMAT:  # built by `simdiff data build`
+        path = write_corpus_report(args.corpus, args.out, seed=args.seed, crosscheck=not args.no_crosscheck)
+    else:
+        path = write_report(args.corpus, args.out, src=args.src, seed=args.seed, crosscheck=not args.no_crosscheck)
     print(f"report written to {path}")
     return 0

@@ -31,12 +31,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     r.add_argument("config", type=Path, help="experiment config (configs/eval_<kind>.json)")
     _common(r)
     r.set_defaults(func=run_experiment)
-    a = group.add_parser("all", help="run table2, table1, fig4, fig5 and retrack in sequence",
-                         description="Run the five experiments in order (table2 first: table1 takes its best α and reuses "
+    a = group.add_parser("all", help="run table2, table1, fig4, fig5, retrack and env_response in sequence",
+                         description="Run the six experiments in order (table2 first: table1 takes its best α and reuses "
                                      "its rows) from <configs>/eval_<kind>.json. --budget quick is the ~30-minute CPU "
                                      "preset each config defines; full is the configs as written.")
     a.add_argument("--configs", type=Path, default=Path("configs"), help="folder with eval_<kind>.json (default configs)")
-    a.add_argument("--only", nargs="+", metavar="KIND", help="run only these experiments (table1 table2 fig4 fig5 retrack)")
+    a.add_argument("--only", nargs="+", metavar="KIND", help="run only these experiments (table1 table2 fig4 fig5 retrack env_response)")
     _common(a)
     a.set_defaults(func=run_all)
 

@@ -13,6 +13,11 @@ outputs (in --out, default ./out/<prompt>/), per sample K = 0, 1, ...:
   sampleK.bvh            BVH animation (metres, Y-up, 20 fps; Blender: scale 1)
   sampleK.gif            stick-figure animation (.mp4 with --format npy,bvh,mp4)
   generation.json        prompt, environment, seed, sampler, steps, guidance, alpha, model, timings
+with --simulate, also (the final sample re-tracked in the simulator under the same φ):
+  sampleK_simulated_joints.npy  (T', 22, 3) the simulator's motion (T' = T unless it fell or a flight
+                                lasted longer/shorter under φ); sampleK_simulated.bvh with bvh
+  sampleK_tracking.json  tracking result: success/status/fall frame, joint error, d_L2, residual
+                         forces, physics metrics of the generated and the simulated motion, seconds
 with --compare, files are named <component><value>_sampleK.* and one video
 compare_sampleK.gif shows the environments side by side (same prompt, same noise).
 
@@ -20,6 +25,7 @@ examples:
   simdiff generate "a person jumps forward" --gravity -3.7 --wind 2 0
   simdiff generate "a person walks in a circle" --length 8 --num-samples 3 --no-video
   simdiff generate "a person jumps forward" --compare gravity=-9.81,-3.7,-1.6
+  simdiff generate "a person jumps forward" --gravity -3.7 --simulate
 """
 
 
@@ -29,7 +35,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="generate a motion from text under gravity and wind (default model)",
         description="Generate a motion from a text prompt under explicit gravity and wind with the\n"
                     "shipped default model (or --model / $SIMDIFF_MODEL) and write it as .npy joints\n"
-                    "and features, a BVH and a stick-figure GIF. Runs on the CPU; no simulator is used.",
+                    "and features, a BVH and a stick-figure GIF. Runs on the CPU; --simulate also re-tracks\n"
+                    "the result in the MuJoCo simulator under the same φ and writes the simulated motion.",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -43,6 +50,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     env.add_argument("--compare", metavar="SPEC",
                      help="render the same prompt and seed under several environments side by side: "
                           "gravity=-9.81,-3.7,-1.6 or wind_x=... or wind_y=... (replaces that component)")
+    env.add_argument("--simulate", action="store_true",
+                     help="simulated finish: re-track each final sample in the simulator under φ and write the "
+                          "simulated motion and its tracking result beside it")
     env.add_argument("--force", action="store_true",
                      help="allow environments outside the trained range (gravity -20..-1 m/s², |wind| <= 10 N)")
     smp = p.add_argument_group("sampling")
@@ -143,7 +153,16 @@ def run(args: argparse.Namespace) -> int:
         request = request.with_envs(request.envs[:1])
     elif generator.config.sim.mode != "continuous":
         raise SimdiffError(f"{folder} has categorical environments; use `simdiff sample --env-index` with it")
-    meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet, alpha_source)
+    meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet, alpha_source,
+                                 simulate=args.simulate, force=args.force)
+    for rec in meta["samples"] if args.simulate else []:
+        sim = rec["simulated"]
+        if not sim["success"]:
+            print(f"simdiff: warning: the simulated finish of sample {rec['index']} {sim['status']} at frame "
+                  f"{sim['fall_frame']}; its simulated motion ends there ({sim['n_out']} of {sim['n_frames']} frames)",
+                  file=sys.stderr)
+        _note(args, f"sample {rec['index']} simulated: {sim['status']} ({sim['n_out']} frames, joint error "
+                    f"{sim['err_mm']:.0f} mm, {sim['wall_s']:.2f} s)")
     for path in paths:
         print(path)
     n = len(meta["samples"])

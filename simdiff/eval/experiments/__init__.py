@@ -11,6 +11,8 @@ Kinds (``configs/eval_<kind>.json``):
 * ``fig5``: environment control: jump apex vs gravity, drift vs wind, an unseen combination,
   filmstrips; MDM as the env-blind reference (:mod:`.fig5`).
 * ``retrack``: closed loop: generated motions re-tracked in the simulator under their φ (:mod:`.retrack`).
+* ``env_response``: each generated response to φ against the simulator's response of the same
+  Earth motion: sign agreement, slope ratio, additivity (:mod:`.env_response`).
 
 Each report folder holds ``report.json`` (config, resolved paths, provenance, budget, rows),
 ``report.md`` (tables, provenance), figures, and ``rows/`` (one file per finished row; a rerun
@@ -27,7 +29,7 @@ from typing import Any
 
 from simdiff.fsio import write_text
 from simdiff.errors import SimdiffError
-from simdiff.eval.experiments import fig4, fig5, retrack, table1, table2
+from simdiff.eval.experiments import env_response, fig4, fig5, retrack, table1, table2
 from simdiff.eval.experiments.config import KINDS, ExperimentConfig, ModelSpec, load_config
 from simdiff.eval.experiments.provenance import load_average, now
 from simdiff.eval.experiments.report import duration, header
@@ -36,8 +38,9 @@ from simdiff.eval.experiments.runner import RowPlan, Runner
 __all__ = ["KINDS", "ORDER", "ExperimentConfig", "ModelSpec", "Runner", "load_config", "plan_experiment", "run_all",
            "run_experiment"]
 
-MODULES: dict[str, ModuleType] = {"table1": table1, "table2": table2, "fig4": fig4, "fig5": fig5, "retrack": retrack}
-ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack")
+MODULES: dict[str, ModuleType] = {"table1": table1, "table2": table2, "fig4": fig4, "fig5": fig5, "retrack": retrack,
+                                  "env_response": env_response}
+ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack", "env_response")
 """Run order of :func:`run_all`: table2 first, so table1 finds the best α and reuses its rows."""
 
 
@@ -53,7 +56,7 @@ def run(runner: Runner) -> dict[str, Any]:
 
     plans = module.plan(runner)
     if any(runner.status(p)[0] == "measure" for p in plans):
-        runner.preflight(needs_evaluator=c.kind in ("table1", "table2"))
+        runner.preflight(needs_evaluator=c.kind in ("table1", "table2"), needs_corpus=c.kind != "env_response")
     threads = torch.get_num_threads()
     if c.threads:
         torch.set_num_threads(c.threads)

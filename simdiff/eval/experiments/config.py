@@ -21,7 +21,7 @@ from typing import Any
 from simdiff.errors import SimdiffError
 from simdiff.eval.protocol import ProtocolConfig
 
-KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack")
+KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response")
 """Experiment kinds, named as in the issue (and the paper)."""
 ROLES: tuple[str, ...] = ("backbone", "adapters", "adapters_binary")
 """Model roles ``paths`` may name: MDM backbone, continuous (φ) adapters, categorical (binary) adapters."""
@@ -43,6 +43,9 @@ class ModelSpec:
         guidance: classifier-free guidance scale.
         physdiff: :class:`simdiff.baselines.physdiff.PhysDiffConfig` fields → PhysDiff sampling
             (the row's sampler, steps and φ are filled in by the experiment).
+        simulate: simulated finish: each final sample is re-tracked under its φ (Earth for
+            categorical models) and the simulator's motion replaces it where tracked
+            (``simdiff generate --simulate``); rows named e.g. ``SimDiff + simulated finish``.
     """
 
     name: str
@@ -55,6 +58,7 @@ class ModelSpec:
     ddpm_steps: int | None = None
     guidance: float = 2.5
     physdiff: dict[str, Any] | None = None
+    simulate: bool = False
 
     def sampler_steps(self, sampler: str) -> int | None:
         """Steps of ``sampler`` for this method."""
@@ -125,7 +129,7 @@ class TimingOptions:
 
 @dataclass
 class EnvControlOptions:
-    """Figure 5: environment control of generated jumps.
+    """Figure 5 and the environment-response benchmark: prompts, seeds and the φ grid.
 
     Attributes:
         prompts: captions (jumps); seeds: noise seeds per prompt; length: frames per motion.
@@ -133,6 +137,7 @@ class EnvControlOptions:
         combos: unseen combinations φ, each compared with its single-factor parts.
         alpha: adapter strength of the SimDiff rows.
         filmstrip_frames: frames per filmstrip row (0: no filmstrips).
+        resamples: bootstrap resamples of the env_response intervals.
     """
 
     prompts: list[str] = field(default_factory=lambda: ["a person jumps", "a person jumps up in place",
@@ -144,6 +149,7 @@ class EnvControlOptions:
     combos: list[list[float]] = field(default_factory=lambda: [[-3.0, 7.0, 7.0]])
     alpha: float = 1.0
     filmstrip_frames: int = 8
+    resamples: int = 1000
 
 
 @dataclass
@@ -171,6 +177,12 @@ class ExperimentConfig:
             :class:`~simdiff.eval.experiments.runner.Runner`'s ``text_encoder``).
         threads: torch CPU threads while the experiment runs (0: torch's default). On a machine whose
             cores are busy with other jobs, 1 avoids spinning threads slowing everything down.
+        smoke: a test or smoke run on stand-ins: the claim rules of the ``full`` budget are not
+            enforced and every report says it carries no claim.
+
+    Claim rules (``full`` budget, not ``smoke``; :func:`check`): table1/table2 protocols with
+    n ≥ 256 motions per replication (or the whole split) and R ≥ 5; DDPM rows on ≥ 32 motions;
+    table2 (which chooses α) on a split other than ``test``.
     """
 
     name: str
@@ -202,6 +214,7 @@ class ExperimentConfig:
     out_dir: str = "reports"
     text_encoder: str = "auto"
     threads: int = 0
+    smoke: bool = False
     budget: str = "full"
     """Set by :func:`load_config` (not in the file): the budget applied."""
     source: str = ""
@@ -330,3 +343,22 @@ def check(config: ExperimentConfig, origin: str | os.PathLike[str] = "config") -
         raise SimdiffError(f"{origin}: text_encoder {config.text_encoder!r} must be \"auto\" (each model's own encoder)")
     if config.projector.backend not in ("process", "serial"):
         raise SimdiffError(f"{origin}: projector backend {config.projector.backend!r} must be process or serial")
+    if config.kind == "table2" and config.split == "test" and not config.smoke:
+        raise SimdiffError(f"{origin}: table2 chooses α, so it must run on the val split, not {config.split!r} "
+                           "(table1 reports the chosen α on test)")
+    problems = claim_problems(config)
+    if problems and config.budget == "full" and not config.smoke:
+        raise SimdiffError(f"{origin}: the full budget must carry a claim: " + "; ".join(problems)
+                           + " (use a named budget such as quick, or smoke: true, for smaller runs)")
+
+
+def claim_problems(config: ExperimentConfig) -> list[str]:
+    """Why ``config`` cannot carry a claim (empty: it can); see :class:`ExperimentConfig`."""
+    from simdiff.eval.protocol import claim_problems as protocol_problems
+
+    out: list[str] = []
+    if config.kind in ("table1", "table2"):
+        out += [f"protocol.{p}" for p in protocol_problems(config.protocol, None)]
+    if config.kind == "table1" and "ddpm" in config.samplers and 0 < config.ddpm_samples < 32:
+        out.append(f"ddpm_samples={config.ddpm_samples} < 32")
+    return out

@@ -3,7 +3,8 @@
 Each cell generates one motion of ``timing.length`` frames from ``timing.text``, ``repeats``
 times (DDPM: ``ddpm_repeats``) after ``warmup`` untimed DDIM runs, and reports the median
 wall time, text encoding included. PhysDiff's time includes its four simulator projections
-(an in-process simulator at batch 1); the projection share is reported separately.
+(an in-process simulator at batch 1), a ``simulate`` method's its one re-tracking of the final
+sample (``simdiff generate --simulate``); the simulator share is reported separately.
 """
 
 from __future__ import annotations
@@ -14,9 +15,11 @@ import time
 from dataclasses import asdict
 from typing import Any
 
+import numpy as np
+
 from simdiff.fsio import atomic_path
 from simdiff.eval.experiments.config import ModelSpec
-from simdiff.eval.experiments.report import value
+from simdiff.eval.experiments.report import speed_comparison, value
 from simdiff.eval.experiments.rows import method_key
 from simdiff.eval.experiments.runner import EARTH, FPS, RowPlan, Runner
 
@@ -45,8 +48,17 @@ def measure(runner: Runner, spec: ModelSpec, sampler: str) -> dict[str, Any]:
                                         projector=runner.serial_projector(), seed=r, **kwargs)
             proj.append(sum(e["wall_s"] for e in hook.log))
         else:
-            gen.generate([t.text], t.length, sampler=sampler, steps=spec.sampler_steps(sampler), guidance=spec.guidance,
-                         seed=r, **kwargs)
+            out = gen.generate([t.text], t.length, sampler=sampler, steps=spec.sampler_steps(sampler),
+                               guidance=spec.guidance, seed=r, **kwargs)
+            if spec.simulate:  # the simulated finish of `simdiff generate --simulate`: one in-process re-tracking
+                from simdiff.motion.features import features_to_joints
+                from simdiff.sim.env import Environment
+
+                begin = time.perf_counter()
+                joints = np.asarray(features_to_joints(out.clips()[0].detach().cpu().double()))
+                env = Environment(*kwargs["env"]) if kwargs.get("env") else Environment()
+                list(runner.serial_projector()([joints], [env]))
+                proj.append(time.perf_counter() - begin)
         times.append(time.perf_counter() - start)
     return {"times_s": times, "median_s": statistics.median(times),
             "projection_median_s": statistics.median(proj) if proj else None, "repeats": repeats}
@@ -125,6 +137,8 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
         lines.append(f"| {r['method']} | {r['sampler'].upper()} | {r['median_s']:.2f} | ×{r['median_s'] / ref:.2f} | "
                      f"{value(r.get('projection_median_s'), 2)} | {r['repeats']} | "
                      + ", ".join(f"{x:.2f}" for x in r["times_s"]) + " |")
+    lines += ["", "SimDiff against PhysDiff, per sampler (median s/motion):"] + (speed_comparison(rows, "median_s") or
+                                                                                  ["* (no pair of rows to compare)"])
     m = runner.provenance["machine"]
     loads = [x[0] for x in (m.get("load_avg_start"), m.get("load_avg_end")) if x]
     if loads and max(loads) > (m.get("cpus") or 1):

@@ -25,6 +25,7 @@ from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ModelSpec
 from simdiff.eval.experiments.report import fmt_env
 from simdiff.eval.experiments.runner import EARTH, RowPlan, Runner, env_key, safe
+from simdiff.eval.stats import t_interval
 
 TITLE = "Figure 5 — environment control"
 STANDING_FRAMES: int = 5
@@ -72,7 +73,8 @@ def measure(runner: Runner, spec: ModelSpec, env: list[float] | None, key: str) 
     summary = {}
     for k in ("apex_m", "drift_x_m", "drift_z_m", "airborne"):
         v = np.array([s[k] for s in samples])
-        summary[k] = {"mean": float(v.mean()), "ci95": float(1.96 * v.std() / np.sqrt(len(v))), "std": float(v.std())}
+        mean, half = t_interval(v)
+        summary[k] = {"mean": mean, "ci95": half if half == half else 0.0, "std": float(v.std(ddof=1)) if len(v) > 1 else 0.0}
     return {"summary": summary, "samples": samples, "s_per_motion": seconds / len(captions)}
 
 

@@ -8,8 +8,17 @@ T2M_METRICS: tuple[tuple[str, str], ...] = (
     ("r_precision_top1", "R@1↑"), ("r_precision_top2", "R@2↑"), ("r_precision_top3", "R@3↑"), ("fid", "FID↓"),
     ("mm_dist", "MM-Dist↓"), ("diversity", "Diversity→"), ("multimodality", "MModality↑"))
 PHYSICS_METRICS: tuple[tuple[str, str], ...] = (
-    ("penetration", "Penetrate (mm)↓"), ("floating", "Float (mm)↓"), ("sliding", "Slide (mm/frame)↓"),
-    ("skate_ratio", "Skate ratio↓"))
+    ("penetration", "Penetrate (mm)↓"), ("floating", "Float (mm)→GT"), ("floating_to_gt", "|Float−GT| (mm)↓"),
+    ("sliding", "Slide (mm/frame)↓"), ("skate_ratio", "Skate ratio↓"))
+PHYS_ERR_NOTE: str = ("Phys-Err = penetration + sliding + |floating − ground truth's floating| (mm). PhysDiff adds raw "
+                      "floating, so a motion that sinks into the floor scores better than the ground truth; floating is "
+                      "'→' (closer to ground truth is better), so it enters as its distance to the ground truth's "
+                      "floating on the same captions.")
+INTERVAL_NOTE: str = ("± is the Student-t 95 % half-width over the R replications (t_{0.975,R−1}·s/√R, sample std); "
+                      "n × R: motions per replication × replications.")
+FID_NOTE: str = ("FID is biased upwards at small n (covariance rank ≤ n − 1 in a D-dimensional embedding): read a "
+                 "generated row's FID against the ground-truth row's, which compares two independent draws of the "
+                 "test motions at the same n (its FID floor).")
 METRIC_LABELS: dict[str, str] = dict(T2M_METRICS + PHYSICS_METRICS)
 
 
@@ -35,6 +44,24 @@ def fmt_env(env: Any) -> str:
     if env is None:
         return "—"
     return "(" + ", ".join(f"{float(v):g}" for v in env) + ")"
+
+
+PAPER_SPEEDUP_NOTE: str = "the paper reports SimDiff DDIM about 10× faster than PhysDiff DDIM"
+
+
+def speed_comparison(rows: list[dict[str, Any]], key: str, a: str = "SimDiff", b: str = "PhysDiff") -> list[str]:
+    """One line per sampler comparing method ``a`` with ``b`` on the seconds in ``key`` (faster or slower, ×)."""
+    lines = []
+    for sampler in dict.fromkeys(r.get("sampler") for r in rows if r.get("sampler")):
+        ra = next((r for r in rows if r["method"] == a and r.get("sampler") == sampler and r.get(key)), None)
+        rb = next((r for r in rows if r["method"] == b and r.get("sampler") == sampler and r.get(key)), None)
+        if ra is None or rb is None:
+            continue
+        ratio = rb[key] / ra[key]
+        word = f"{ratio:.1f}× faster than" if ratio >= 1 else f"{1 / ratio:.1f}× slower than"
+        note = f" ({PAPER_SPEEDUP_NOTE}; here it is {ratio:.1f}×)" if sampler == "ddim" else ""
+        lines.append(f"* {sampler.upper()}: {a} ({ra[key]:.2f} s/motion) is {word} {b} ({rb[key]:.2f} s/motion){note}")
+    return lines
 
 
 def duration(seconds: float) -> str:
@@ -66,6 +93,11 @@ def header(report: dict[str, Any], title: str) -> list[str]:
              f"* config: `{report['config'].get('source', '')}`"]
     if b.get("set"):
         lines.append("* budget overrides: " + ", ".join(f"`{k}={v}`" for k, v in b["set"].items()))
+    cfg = report["config"]
+    if cfg.get("smoke") or b["name"] != "full":
+        lines.append(f"* **no claim**: {'a smoke run' if cfg.get('smoke') else 'budget ' + repr(b['name'])} — below the "
+                     "claim protocol (n ≥ 256 motions or the whole split per replication, ≥ 5 replications, DDPM rows "
+                     "on ≥ 32 motions, α chosen on val); read these numbers as a check that the code runs")
     lines.append("* paths: " + ", ".join(f"{k} `{v}`" for k, v in report["paths"].items()))
     lines.append(f"* rows: {len(rows)} ({sum(1 for r in rows if r.get('reused_from'))} reused from other reports); "
                  f"measurement time {duration(measured)} (estimated {duration(estimate)})")

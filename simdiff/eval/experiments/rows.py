@@ -46,12 +46,25 @@ def ground_truth_plan(runner: Runner) -> RowPlan:
 
 
 def phys_err(row: dict[str, Any]) -> float | None:
-    """PhysDiff's Phys-Err = penetration + floating + sliding (mm), from a protocol or subset row."""
+    """Our Phys-Err (mm) = penetration + sliding + |floating − GT floating| of a protocol or subset row.
+
+    PhysDiff's sum adds raw floating, which rewards sinking into the floor; floating is scored as
+    the distance to the ground truth's floating instead (:func:`simdiff.motion.metrics.phys_err`).
+    The ground-truth row scores penetration + sliding. Rows measured before this rule (no
+    ``phys_err``) give None: they are re-measured, not re-scored.
+    """
+    if row.get("method") == "Ground truth" and "summary" in row:
+        s = row["summary"]
+        return s["penetration"]["mean"] + s["sliding"]["mean"] if "penetration" in s and "sliding" in s else None
     if "summary" in row:
         s = row["summary"]
-        keys = ("penetration", "floating", "sliding")
-        return sum(s[k]["mean"] for k in keys) if all(k in s for k in keys) else None
+        return s["phys_err"]["mean"] if "phys_err" in s else None
     if "physics" in row:
-        p = row["physics"]
-        return p["penetration"] + p["floating"] + p["sliding"]
+        return row["physics"].get("phys_err")
     return None
+
+
+def phys_err_ci(row: dict[str, Any]) -> float:
+    """The Student-t half-width of a protocol row's Phys-Err (0 for subset rows)."""
+    s = row.get("summary", {})
+    return float(s["phys_err"]["ci95"]) if "phys_err" in s and s["phys_err"]["ci95"] == s["phys_err"]["ci95"] else 0.0

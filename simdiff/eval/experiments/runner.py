@@ -174,7 +174,8 @@ class Runner:
             from simdiff.data.augment.projector import SimProjector
 
             p = self.config.projector
-            stats = str(Path(self.config.corpus).expanduser())
+            corpus = Path(self.config.corpus).expanduser()
+            stats = str(corpus) if (corpus / "Mean.npy").is_file() else None  # d_L2 needs them; tracking does not
             self._projector = SimProjector(stats, p.workers, p.backend, p.residual_bound)
         return self._projector
 
@@ -192,11 +193,11 @@ class Runner:
             getattr(self._projector, "close", lambda: None)()
             self._projector = None
 
-    def preflight(self, needs_evaluator: bool) -> None:
+    def preflight(self, needs_evaluator: bool, needs_corpus: bool = True) -> None:
         """Check that the corpus, the evaluator and every model folder exist before measuring anything."""
         c = self.config
         corpus = Path(c.corpus).expanduser()
-        if not (corpus / f"{c.split}.txt").is_file():
+        if needs_corpus and not (corpus / f"{c.split}.txt").is_file():
             raise SimdiffError(f"corpus {corpus} has no {c.split}.txt (set the corpus with --corpus DIR)")
         if needs_evaluator and c.evaluator.kind == "ours" and not (Path(c.evaluator.path).expanduser() / "model.safetensors").is_file():
             raise SimdiffError(f"evaluator folder {c.evaluator.path or '(none)'} has no model.safetensors "
@@ -224,6 +225,9 @@ class Runner:
         if spec.physdiff is not None:
             out["physdiff"] = dataclasses.asdict(self.physdiff_config(spec, sampler, env))
             out["projector"] = dataclasses.asdict(self.config.projector)
+        if spec.simulate:
+            out["simulate"] = True
+            out["projector"] = dataclasses.asdict(self.config.projector)
         return out
 
     # --- generation -------------------------------------------------------------------------
@@ -250,7 +254,7 @@ class Runner:
         return generator_fn(gen, env=use_env, env_index=spec.env_index if gen.is_simdiff else None,
                             alpha=spec.alpha if alpha is None else float(alpha), sampler=sampler,
                             steps=spec.sampler_steps(sampler), guidance=spec.guidance, physdiff=phys,
-                            projector=self.sim if phys is not None else None)
+                            projector=self.sim if phys is not None or spec.simulate else None, simulate=spec.simulate)
 
     def generate(self, fn: GenerateFn, captions: list[str], lengths: list[int], seed: int) -> tuple[torch.Tensor, float]:
         """Generate in batches of the protocol's size; returns ((N, T, 263) features, seconds)."""
@@ -285,13 +289,15 @@ class Runner:
         reps = result["replications"]
         return {"summary": result["summary"]["generated"], "replications": [r["generated"] for r in reps],
                 "s_per_motion": float(np.mean([r["gen_s_per_sample"] for r in reps])),
-                "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps)}
+                "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps),
+                "split_size": result["split_size"], "seeds": protocol_seeds(proto)}
 
     def gt_measure(self) -> dict[str, Any]:
         """The ground-truth row of the protocol."""
         result = evaluate_t2m(self.evaluator, self.dataset, None, self.config.protocol, self.progress)
         return {"summary": result["summary"]["ground_truth"], "samples_per_replication": result["samples_per_replication"],
-                "replications_run": len(result["replications"])}
+                "replications_run": len(result["replications"]), "split_size": result["split_size"],
+                "seeds": protocol_seeds(self.config.protocol)}
 
     def subset_measure(self, spec: ModelSpec, sampler: str, alpha: float | None, n: int, env: Any = None) -> dict[str, Any]:
         """Physics metrics and time of ``n`` generated test motions (too few for the T2M metrics)."""
@@ -303,7 +309,13 @@ class Runner:
                                        self.config.seed * 1_000_003)
         joints = np.asarray(features_to_joints(feats.double()))
         lengths = np.clip(np.asarray(items["lengths"]), 2, joints.shape[1])
-        return {"physics": physics_metrics(joints, lengths), "s_per_motion": seconds / n, "samples": n}
+        physics = physics_metrics(joints, lengths)
+        gt = [np.asarray(features_to_joints(torch.as_tensor(f).double())) for f in items["features"]]
+        gt_float = float(np.average([physics_metrics(j)["floating"] for j in gt], weights=[len(j) for j in gt]))
+        physics["floating_to_gt"] = abs(physics["floating"] - gt_float)
+        physics["phys_err"] = physics["penetration"] + physics["sliding"] + physics["floating_to_gt"]
+        return {"physics": physics, "gt_floating": gt_float, "s_per_motion": seconds / n, "samples": n,
+                "seeds": {"data": [self.config.seed, 99], "generation": self.config.seed * 1_000_003}}
 
     def ddpm_protocol(self) -> ProtocolConfig | None:
         """Protocol of DDPM rows under ``ddpm_samples`` (None: physics-only subset rows)."""
@@ -354,6 +366,8 @@ class Runner:
         if spec.physdiff is not None:
             calls = len(self.physdiff_config(spec, sampler).project_at)
             s += n * calls * self.projection_seconds(motion_s, workers)
+        if spec.simulate:
+            s += n * self.projection_seconds(motion_s, workers)
         return s
 
     def projection_seconds(self, motion_s: float | None = None, workers: int | None = None) -> float:
@@ -420,6 +434,13 @@ class Runner:
             bar.set_postfix_str(f"{plan.key} (~{plan.estimate_s / 60:.1f} min)")
             rows.append(self.fetch(plan))
         return rows
+
+
+def protocol_seeds(proto: ProtocolConfig) -> dict[str, Any]:
+    """The seeds a protocol row used (stated in every report): data draws and generation noise per replication."""
+    return {"base": proto.seed, "data_draw": [[proto.seed, r] for r in range(proto.replications)],
+            "generation": [proto.seed * 1_000_003 + r * 1009 for r in range(proto.replications)],
+            "note": "batch k of replication r adds k to its generation seed"}
 
 
 def _stamp(path: str) -> dict[str, Any]:

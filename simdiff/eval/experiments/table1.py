@@ -14,6 +14,7 @@ from typing import Any
 
 from simdiff.eval.experiments.rows import ground_truth_plan, method_plan
 from simdiff.eval.experiments.runner import RowPlan, Runner
+from simdiff.eval.experiments.report import speed_comparison
 from simdiff.eval.experiments.tables import method_figure, metrics_table
 
 TITLE = "Table 1 — MDM, PhysDiff and SimDiff with DDPM and DDIM"
@@ -32,9 +33,13 @@ def _read_best_alpha(runner: Runner) -> tuple[float | None, str]:
         return float(c.best_alpha), "config"
     path = Path(c.out_dir) / c.best_alpha_from / "report.json"
     if path.is_file():
-        best = json.loads(path.read_text(encoding="utf-8")).get("best_alpha")
+        report = json.loads(path.read_text(encoding="utf-8"))
+        best, split = report.get("best_alpha"), report.get("config", {}).get("split")
+        if best and split == c.split and not c.smoke:
+            return None, (f"refused: {path} chose α on the {split!r} split, the split this table reports on; "
+                          "run table2 on val")
         if best:
-            return float(best["alpha"]), f"{path} (select_by {best.get('select_by')})"
+            return float(best["alpha"]), f"{path} (select_by {best.get('select_by')}, chosen on the {split} split)"
     return None, (f"not available when this run started: no {path} with a best α and no 'best_alpha' in the config; "
                   "run table2 first (simdiff evaluate all does) and run table1 again")
 
@@ -98,5 +103,6 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
                          f"({cfg.steps or ('1000' if sampler == 'ddpm' else '50')} steps), residual bound {cfg.residual_bound}")
     lines.append("* s/motion: generation time per motion in the protocol's batches of 32 (PhysDiff: with projection); "
                  "see fig4 for batch-1 latency")
+    lines += speed_comparison(report["rows"], "s_per_motion")
     lines += ["", f"![Table 1]({figure.name})"]
     return lines

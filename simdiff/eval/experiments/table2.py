@@ -3,7 +3,8 @@
 Writes the best α (``report.json["best_alpha"]``) for table1, chosen by ``select_by``:
 ``balanced`` (default) the lowest mean of FID and Phys-Err, each min–max scaled to [0, 1]
 over the sweep (the α nearest the ideal corner of the trade-off; ties: lower FID), ``fid``
-the lowest FID, ``phys_err`` the lowest penetration + floating + sliding.
+the lowest FID, ``phys_err`` the lowest Phys-Err (penetration + sliding + |floating − GT floating|).
+Run it on the val split: α is chosen here and reported on test by table1.
 """
 
 from __future__ import annotations

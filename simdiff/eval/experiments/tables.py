@@ -6,8 +6,8 @@ from pathlib import Path
 from typing import Any
 
 from simdiff.fsio import atomic_path
-from simdiff.eval.experiments.report import PHYSICS_METRICS, T2M_METRICS, mean_ci, value
-from simdiff.eval.experiments.rows import phys_err
+from simdiff.eval.experiments.report import FID_NOTE, INTERVAL_NOTE, PHYS_ERR_NOTE, PHYSICS_METRICS, T2M_METRICS, mean_ci, value
+from simdiff.eval.experiments.rows import phys_err, phys_err_ci
 
 
 def metrics_table(rows: list[dict[str, Any]], first: str = "Method") -> list[str]:
@@ -21,6 +21,9 @@ def metrics_table(rows: list[dict[str, Any]], first: str = "Method") -> list[str
         if "summary" in r:
             s = r["summary"]
             n = f"{r['samples_per_replication']} × {r['replications_run']}"
+            if r.get("split_size") is not None and r["samples_per_replication"] >= (r["split_size"] // 32) * 32 \
+                    and r["samples_per_replication"] < 256:
+                n += " (whole split)"
             cells = [mean_ci(s, k) for k, _ in T2M_METRICS] + [mean_ci(s, k) for k, _ in PHYSICS_METRICS]
         else:
             p = r.get("physics", {})
@@ -31,6 +34,11 @@ def metrics_table(rows: list[dict[str, Any]], first: str = "Method") -> list[str
                      f" | {value(phys_err(r), 2)} | {sps} |")
     if any("summary" not in r for r in rows):
         lines += ["", "† physics metrics and time only: too few motions for R-precision (batches of 32), FID or Diversity."]
+    lines += ["", f"* {INTERVAL_NOTE}", f"* {PHYS_ERR_NOTE}", f"* {FID_NOTE}"]
+    seeds = next((r["seeds"] for r in rows if r.get("seeds")), None)
+    if seeds:
+        lines.append(f"* seeds: protocol base seed {seeds.get('base', seeds)}; replication r draws its data with "
+                     "[seed, r] and generates batch k with seed·1000003 + r·1009 + k (listed per row in report.json).")
     return lines
 
 
@@ -49,8 +57,8 @@ def alpha_figure(rows: list[dict[str, Any]], path: Path, best: float | None = No
             mine = sorted((r for r in rows if r["method"] == method and "summary" in r), key=lambda r: r["alpha"])
             xs = [r["alpha"] for r in mine]
             if key == "phys_err":
-                parts = ("penetration", "floating", "sliding")
-                ys, es = [phys_err(r) for r in mine], [sum(r["summary"][k]["ci95"] for k in parts) for r in mine]
+                pe = [phys_err(r) for r in mine]
+                ys, es = [float("nan") if v is None else v for v in pe], [phys_err_ci(r) for r in mine]
             else:
                 ys, es = [r["summary"][key]["mean"] for r in mine], [r["summary"][key]["ci95"] for r in mine]
             ax.errorbar(xs, ys, yerr=es, fmt="o-", capsize=3, label=method)
@@ -83,7 +91,7 @@ def method_figure(rows: list[dict[str, Any]], path: Path) -> Path:
     axes[0].bar(range(len(rows)), fid, yerr=fid_err, color="#4c72b0", capsize=3)
     axes[0].set_title("FID ↓ (DDPM subset rows: not measured)", fontsize=9)
     axes[1].bar(range(len(rows)), pe, color="#dd8452")
-    axes[1].set_title("Phys-Err = penetrate + float + slide (mm) ↓", fontsize=9)
+    axes[1].set_title("Phys-Err = penetrate + slide + |float − GT float| (mm) ↓", fontsize=9)
     for ax in axes:
         ax.set_xticks(range(len(rows)), labels, fontsize=7, rotation=45, ha="right")
     fig.tight_layout()

@@ -63,6 +63,7 @@ function show(motion) {
     state.params = p;
     state.generation_id += 1;
     caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${p.alpha.toFixed(2)}` : "");
+    if (meta.simulated) caption += ` · simulated finish (${meta.simulated.status}, joint error ${Math.round(meta.simulated.err_mm)} mm)`;
     const waited = meta.queue_position ? ` after waiting ${meta.waited_s.toFixed(1)} s behind ${meta.queue_position} request(s)` : "";
     setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s${waited}.`);
   } else {
@@ -84,6 +85,7 @@ function readParams() {
     text: $("prompt").value.trim() || $("prompt").placeholder,
     gravity: value("gravity"), wind_x: value("wind_x"), wind_y: value("wind_y"), alpha: value("alpha"),
     seconds: value("seconds"), seed: Math.round(value("seed")),
+    simulate: Boolean($("simulate") && $("simulate").checked),
   };
 }
 

@@ -1,0 +1,69 @@
+"""``simdiff data build``: one corpus from every motion source under ``../shared/data``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from simdiff.cli.main import command_group
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    from simdiff.data.corpus.item import LICENCE_SETS
+    from simdiff.data.corpus.registry import SOURCES
+
+    group = command_group(subparsers, "data", "corpus tools")
+    build = group.add_parser(
+        "build",
+        help="build one HumanML3D-layout corpus from every motion source (CMU, Bandai, HDM05, DeepMimic)",
+        description=(
+            "Discover every source under --shared (CMU AMC/BVH/DeepMimic, extra CMU BVH, Bandai-Namco, "
+            "HDM05, DeepMimic clips), keep one copy of each capture (AMC first; the others are "
+            "cross-checks), retarget to 22 joints at 20 fps, cut 2-9.8 s clips, add M<id> mirrors, "
+            "captions (>= 2 per clip), licence per clip, splits by trial stratified by source and motion "
+            "type, Mean/Std and manifest.json. Resumable; output independent of --workers. "
+            "`simdiff data build --sources cmu` is the superset of `build-cmu` (which stays as it was)."
+        ),
+    )
+    build.add_argument("--shared", type=Path, required=True, help="shared data root (e.g. ../shared/data)")
+    build.add_argument("--out", type=Path, required=True, help="output corpus folder (keep it outside the repository)")
+    build.add_argument("--licence", choices=sorted(LICENCE_SETS), default="all",
+                       help="all (default, research use) or permissive (no CC BY-NC, no CC BY-SA)")
+    build.add_argument("--sources", nargs="+", choices=list(SOURCES), default=list(SOURCES), metavar="SOURCE",
+                       help=f"source families (default all: {' '.join(SOURCES)})")
+    build.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    build.add_argument("--seed", type=int, default=0, help="seed for captions and split order (default 0)")
+    build.add_argument("--captions", type=int, default=3, metavar="N", help="generated captions per clip (default 3, min 2)")
+    build.add_argument("--no-mirror", action="store_true", help="do not write mirrored M<id> clips")
+    build.add_argument("--quiet", action="store_true", help="no progress bar")
+    build.set_defaults(func=run_build)
+
+
+def run_build(args: argparse.Namespace) -> int:
+    from simdiff.data.corpus.build import CorpusConfig, build
+    from simdiff.errors import SimdiffError
+
+    if args.captions < 2:
+        raise SimdiffError(f"--captions must be >= 2, got {args.captions}")
+    cfg = CorpusConfig(shared=args.shared, out=args.out, licence=args.licence, sources=tuple(args.sources),
+                       workers=args.workers, seed=args.seed, captions=args.captions, mirror=not args.no_mirror,
+                       progress=not args.quiet)
+    result = build(cfg)
+    originals = [c for c in result.clips if c["mirror_of"] is None]
+    hours = sum(c["seconds"] for c in result.clips) / 3600
+    hours0 = sum(c["seconds"] for c in originals) / 3600
+    splits = ", ".join(f"{k} {v}" for k, v in result.split_counts.items())
+    print(f"{len(result.clips)} clips ({hours0:.2f} h original, {hours:.2f} h with mirrors; {splits}) in {args.out}; "
+          f"{result.processed} item(s) processed, {result.reused} reused, {len(result.skipped)} skipped; "
+          f"{result.elapsed:.1f} s")
+    by_licence: dict[str, float] = {}
+    for clip in originals:
+        by_licence[clip["licence"]] = by_licence.get(clip["licence"], 0.0) + clip["seconds"] / 3600
+    print("hours (original) by licence: " + ", ".join(f"{k} {v:.2f}" for k, v in sorted(by_licence.items())))
+    reasons: dict[str, int] = {}
+    for item in result.skipped:
+        reason = "shorter than 2 s" if "shorter than" in item["error"] else item["error"].split(": ", 1)[-1][:80]
+        reasons[reason] = reasons.get(reason, 0) + 1
+    for reason, count in sorted(reasons.items(), key=lambda kv: -kv[1])[:10]:
+        print(f"  skipped {count}: {reason}")
+    return 0

@@ -1,0 +1,231 @@
+"""``simdiff data build``: one HumanML3D-layout corpus from every source under a shared root.
+
+Steps: discover items (:mod:`.registry`: licence filter, dedupe), process each item in a
+process pool (:func:`.clips.process_item`; output independent of the worker count), split by
+trial (:mod:`.splits`), write ``Mean.npy``/``Std.npy`` over train, split lists and
+``manifest.json``. Resumable: each finished item leaves ``.build/items/<id>.json`` keyed by
+its source bytes and every setting that changes its clips; a re-run reuses it. Files are
+written atomically; a rerun gives byte-identical outputs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from simdiff.data.cmu.build import BUILD_DIR, _files_exist, _load_record, _remove_stale, _write_stats
+from simdiff.data.cmu.splits import SPLIT_NAMES
+from simdiff.data.cmu.windows import MAX_WINDOW, MIN_WINDOW
+from simdiff.data.cmu.writer import write_json, write_lines
+from simdiff.data.corpus.clips import ClipSettings, process_item
+from simdiff.data.corpus.item import LICENCE_SETS, Item, file_digest
+from simdiff.data.corpus.registry import SOURCES, discover_all
+from simdiff.data.corpus.splits import assign_stratified
+from simdiff.errors import SimdiffError
+from simdiff.motion.skeleton import FPS
+
+PIPELINE_VERSION: int = 1
+"""Bump when an item's clips change for the same inputs (invalidates the item cache)."""
+
+FORMAT: str = "simdiff-corpus"
+
+
+@dataclass
+class CorpusConfig:
+    """Settings of one build.
+
+    Attributes:
+        shared: shared data root (``../shared/data``).
+        out: output corpus folder (outside the repository).
+        licence: ``all`` or ``permissive`` (see :data:`.item.LICENCE_SETS`).
+        sources: source families (default all of :data:`.registry.SOURCES`).
+        workers: processes (1: in this process); the output does not depend on it.
+        seed: captions and split order.
+        captions: generated sentences per clip.
+        mirror: write mirrored ``M<id>`` clips.
+        progress: show a tqdm bar.
+    """
+
+    shared: Path
+    out: Path
+    licence: str = "all"
+    sources: tuple[str, ...] = tuple(SOURCES)
+    workers: int = 2
+    seed: int = 0
+    captions: int = 3
+    mirror: bool = True
+    progress: bool = True
+
+
+@dataclass
+class CorpusResult:
+    """Summary of a build."""
+
+    clips: list[dict[str, Any]]
+    skipped: list[dict[str, str]]
+    reused: int = 0
+    processed: int = 0
+    elapsed: float = 0.0
+    split_counts: dict[str, int] = field(default_factory=dict)
+
+
+def item_key(item: Item, settings: ClipSettings) -> str:
+    """Cache key of an item: its source bytes and every setting that changes its clips."""
+    trial = item.meta.get("cmu_trial")
+    payload = {
+        "version": PIPELINE_VERSION, "id": item.id, "trial": item.trial, "source": item.source,
+        "licence": item.licence, "type": item.motion_type, "verbs": item.verbs, "adverbs": item.adverbs,
+        "subjects": item.subjects, "origin": item.caption_origin, "description": item.description,
+        "fps": item.fps, "seed": settings.seed, "captions": settings.captions, "mirror": settings.mirror,
+        "window": [MIN_WINDOW, MAX_WINDOW],
+    }
+    if trial is not None:
+        payload["cmu"] = {
+            "description": trial.description, "kitml": trial.kitml, "fps": trial.capture_fps,  # type: ignore[attr-defined]
+            "segments": [[s.hml_id, s.start20, s.end20] for s in trial.segments],  # type: ignore[attr-defined]
+        }
+    blob = json.dumps(payload, sort_keys=True, default=str) + file_digest(item.files())
+    return hashlib.sha1(blob.encode()).hexdigest()
+
+
+def _run_item(item: Item, settings: ClipSettings) -> tuple[list[dict[str, Any]], str | None, bool]:
+    """(records, error, cacheable) of one item; never raises."""
+    try:
+        return process_item(item, settings), None, True
+    except SimdiffError as exc:
+        return [], str(exc).splitlines()[0], True
+    except Exception as exc:  # anything else: reported, not cached, retried next run
+        return [], f"{item.path}: {type(exc).__name__}: {exc}".splitlines()[0], False
+
+
+def _alternates(item: Item, shared: Path) -> list[dict[str, Any]]:
+    from simdiff.data.corpus.clips import _relative
+
+    return [{"source": a.source, "file": _relative(a.path, shared)} for a in item.alternates]
+
+
+def build(cfg: CorpusConfig) -> CorpusResult:
+    """Build (or update) the corpus in ``cfg.out``; see the module docstring."""
+    from tqdm import tqdm
+
+    started = time.perf_counter()
+    shared, out = Path(cfg.shared), Path(cfg.out)
+    if cfg.workers < 1:
+        raise SimdiffError(f"--workers must be >= 1, got {cfg.workers}")
+    if cfg.licence not in LICENCE_SETS:
+        raise SimdiffError(f"unknown licence set {cfg.licence!r}; choose from {', '.join(LICENCE_SETS)}")
+    cache = out / BUILD_DIR
+    (cache / "items").mkdir(parents=True, exist_ok=True)
+    items = discover_all(shared, cache, cfg.sources, cfg.licence)
+    if not items:
+        raise SimdiffError(f"no motion files for sources {', '.join(cfg.sources)} under {shared}")
+    settings = ClipSettings(out=out, shared=shared, seed=cfg.seed, captions=cfg.captions, mirror=cfg.mirror)
+
+    records: dict[str, dict[str, Any]] = {}
+    todo: list[tuple[Item, str]] = []
+    stale: set[str] = set()
+    reused = 0
+    for item in items:
+        key = item_key(item, settings)
+        record = _load_record(cache / "items" / f"{item.id}.json")
+        if record:
+            stale.update(str(c["id"]) for c in record.get("clips", []))
+        if record and record.get("key") == key and (record.get("error") or _files_exist(out, record["clips"])):
+            records[item.id] = record
+            reused += 1
+        else:
+            todo.append((item, key))
+
+    bar = tqdm(total=len(todo), desc="build", unit="item", disable=not cfg.progress, dynamic_ncols=True)
+
+    def finish(item: Item, key: str, result: tuple[list[dict[str, Any]], str | None, bool]) -> None:
+        clips, error, cacheable = result
+        record = {"key": key, "id": item.id, "error": error, "clips": clips}
+        if cacheable:
+            write_json(cache / "items" / f"{item.id}.json", record)
+        records[item.id] = record
+        bar.update(1)
+
+    if cfg.workers == 1 or len(todo) <= 1:
+        for item, key in todo:
+            finish(item, key, _run_item(item, settings))
+    else:
+        with ProcessPoolExecutor(max_workers=cfg.workers) as pool:
+            futures = [(item, key, pool.submit(_run_item, item, settings)) for item, key in todo]
+            for item, key, future in futures:
+                finish(item, key, future.result())
+    bar.close()
+    return _finish(cfg, items, records, stale, reused, len(todo), started)
+
+
+def _finish(cfg: CorpusConfig, items: list[Item], records: dict[str, dict[str, Any]], stale: set[str],
+            reused: int, processed: int, started: float) -> CorpusResult:
+    """Splits, split lists, Mean/Std and the manifest from the item records."""
+    out, shared = Path(cfg.out), Path(cfg.shared)
+    clips: list[dict[str, Any]] = []
+    skipped: list[dict[str, str]] = []
+    durations: dict[str, float] = {}
+    strata: dict[str, str] = {}
+    fixed: dict[str, str] = {}
+    for item in items:
+        record = records[item.id]
+        if record.get("error"):
+            skipped.append({"id": item.id, "trial": item.trial, "error": str(record["error"])})
+            continue
+        for clip in record["clips"]:
+            clip["alternates"] = _alternates(item, shared)
+            clips.append(clip)
+            if clip["mirror_of"] is None:
+                durations[item.trial] = durations.get(item.trial, 0.0) + float(clip["seconds"])
+        strata[item.trial] = f"{item.source.split('-')[0]}/{item.motion_type}"
+        trial = item.meta.get("cmu_trial")
+        labels = trial.hml3d_splits if trial is not None and item.source in ("cmu-amc", "cmu-bvh", "cmu-deepmimic") else set()  # type: ignore[attr-defined]
+        hml = next((s for s in ("test", "val", "train") if s in labels), None)
+        if hml:
+            fixed[item.trial] = hml
+    if not clips:
+        raise SimdiffError(f"no clip could be built from {shared} ({len(skipped)} item(s) skipped)")
+    split_of = assign_stratified(durations, strata, fixed, seed=cfg.seed)
+    ids: dict[str, list[str]] = {name: [] for name in SPLIT_NAMES}
+    for clip in clips:
+        clip["split"] = split_of[clip["trial"]]
+        ids[clip["split"]].append(clip["id"])
+    for name in SPLIT_NAMES:
+        ids[name].sort()
+        write_lines(out / f"{name}.txt", ids[name])
+    write_lines(out / "train_val.txt", sorted(ids["train"] + ids["val"]))
+    write_lines(out / "all.txt", sorted(c["id"] for c in clips))
+    _remove_stale(out, {c["id"] for c in clips}, stale)
+    _write_stats(out, ids["train"])
+    result = CorpusResult(clips=clips, skipped=skipped, reused=reused, processed=processed,
+                          split_counts={k: len(v) for k, v in ids.items()})
+    by_licence: dict[str, float] = {}
+    for clip in clips:
+        if clip["mirror_of"] is None:
+            by_licence[clip["licence"]] = by_licence.get(clip["licence"], 0.0) + float(clip["seconds"]) / 3600
+    write_json(out / "manifest.json", {
+        "format": FORMAT,
+        "pipeline_version": PIPELINE_VERSION,
+        "src": str((shared / "cmu").resolve()),
+        "shared": str(shared.resolve()),
+        "licence": cfg.licence,
+        "sources": list(cfg.sources),
+        "seed": cfg.seed,
+        "fps": FPS,
+        "counts": {
+            "clips": len(clips), "trials": len(durations), "skipped_items": len(skipped),
+            "splits": result.split_counts,
+            "hours": round(sum(float(c["seconds"]) for c in clips) / 3600, 4),
+            "hours_originals": round(sum(float(c["seconds"]) for c in clips if c["mirror_of"] is None) / 3600, 4),
+            "hours_originals_by_licence": {k: round(v, 4) for k, v in sorted(by_licence.items())},
+        },
+        "clips": sorted(clips, key=lambda c: c["id"]),
+        "skipped": sorted(skipped, key=lambda s: s["id"]),
+    })
+    result.elapsed = time.perf_counter() - started
+    return result
