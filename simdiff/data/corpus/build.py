@@ -29,7 +29,7 @@ from simdiff.data.corpus.splits import assign_stratified
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 
-PIPELINE_VERSION: int = 1
+PIPELINE_VERSION: int = 2
 """Bump when an item's clips change for the same inputs (invalidates the item cache)."""
 
 FORMAT: str = "simdiff-corpus"
