@@ -165,6 +165,7 @@ def test_every_clip_has_captions_and_a_licence(corpus: tuple[Path, object]) -> N
     assert any("right" in s for s in mirror["captions"]) and not any("left" in s for s in mirror["captions"])
     hop = next(c for c in clips if c["id"] == "hdm_bd_hopBothLegs1hops_001_00")
     assert hop["padded_frames"] > 0 and hop["frames"] == 40
+    assert hop["source_frames"] == [0, 180]  # 1.5 s at 120 fps: the held frames map to the take's ends
     assert np.load(out / "new_joint_vecs" / "hdm_bd_hopBothLegs1hops_001_00.npy").shape == (40, 263)
     assert manifest["counts"]["hours_originals_by_licence"].keys() == {"CMU", "CC-BY-NC-4.0", "CC-BY-SA-3.0", "MIT"}
     assert next(c for c in clips if c["id"] == "01_01_00")["alternates"]
