@@ -40,6 +40,13 @@ SOURCES: dict[str, str] = {
 }
 """Source name -> glob under the extracted archives folder."""
 
+DIP: float = 0.05
+"""Metres below the clip's ground (5th percentile of the per-frame lowest joint) that
+counts a frame as sinking through the floor (``dip_frames``)."""
+PROPS: float = 0.5
+"""A clip whose lowest joint is within 15 cm of its floor in fewer than this fraction of
+frames is flagged ``props`` (climbing, uneven terrain: the corpus ``support`` rule)."""
+
 
 def measure(path: Path, **kwargs: object) -> dict[str, object]:
     """Metrics and body measures of one file (an "error" entry when it cannot be read)."""
@@ -56,6 +63,7 @@ def measure(path: Path, **kwargs: object) -> dict[str, object]:
         for a, b in ((1, 4), (4, 7), (2, 5), (5, 8))
     ]) * 2
     lowest = joints[..., 1].min(axis=-1)
+    ground = float(np.percentile(lowest, 5))
     return {
         "file": str(path),
         "frames20": int(joints.shape[0]),
@@ -64,6 +72,8 @@ def measure(path: Path, **kwargs: object) -> dict[str, object]:
         "head_p90": float(np.percentile(joints[:, 15, 1], 90)),
         "leg": float(leg),
         "trunk": float(np.linalg.norm(joints[:, 12] - hip_c, axis=-1).mean()),
+        "contact15": float(np.mean(lowest <= 0.15)),
+        "dip_frames": int(np.sum(lowest < ground - DIP)),
         "foot_ankle": float(np.mean([np.linalg.norm(joints[:, a] - joints[:, b], axis=-1).mean()
                                      for a, b in ((7, 10), (8, 11))])),
     }
@@ -104,14 +114,14 @@ def run(files: dict[str, list[Path]], cache: Path, kwargs: dict[str, dict[str, o
 def summary(rows: list[dict]) -> str:
     """Markdown table of per-source medians over files."""
     head = ("| source | files | unusable | hours@20fps | floating mm | sliding mm/frame | skate | "
-            "head p90 m | leg m | trunk m | ankle-toe m |\n|---|---|---|---|---|---|---|---|---|---|---|")
+            "head p90 m | leg m | trunk m | ankle-toe m | props | dips |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     out = [head]
     sources = list(dict.fromkeys(r["source"] for r in rows))
     for source in sources:
         ok = [r for r in rows if r["source"] == source and "error" not in r]
         bad = [r for r in rows if r["source"] == source and "error" in r]
         if not ok:
-            out.append(f"| {source} | {len(bad)} | {len(bad)} | | | | | | | | |")
+            out.append(f"| {source} | {len(bad)} | {len(bad)} | | | | | | | | | | |")
             continue
 
         def med(key: str) -> float:
@@ -121,7 +131,9 @@ def summary(rows: list[dict]) -> str:
         out.append(
             f"| {source} | {len(ok) + len(bad)} | {len(bad)} | {hours:.2f} | {med('floating'):.1f} | "
             f"{med('sliding'):.2f} | {med('skate_ratio'):.3f} | {med('head_p90'):.2f} | "
-            f"{med('leg'):.2f} | {med('trunk'):.2f} | {med('foot_ankle'):.3f} |"
+            f"{med('leg'):.2f} | {med('trunk'):.2f} | {med('foot_ankle'):.3f} | "
+            f"{sum(r['contact15'] < PROPS for r in ok)} | "
+            f"{sum(r['contact15'] >= PROPS and r['dip_frames'] > 0 for r in ok)} |"
         )
     return "\n".join(out)
 
@@ -145,9 +157,18 @@ def main(argv: list[str] | None = None) -> int:
     table = summary(rows)
     (args.out / "summary.md").write_text(table + "\n")
     print(table)
+    flags = []
     for r in rows:
         if "error" in r:
-            print(f"UNUSABLE {r['source']}: {r['error']}")
+            flags.append(f"UNUSABLE {r['source']}: {r['error']}")
+        elif r["contact15"] < PROPS:
+            flags.append(f"PROPS {r['source']} {Path(r['file']).name}: lowest joint within 15 cm "
+                         f"of the floor in {r['contact15']:.0%} of frames (floating {r['floating']:.0f} mm)")
+        elif r["dip_frames"] > 0:
+            flags.append(f"DIPS {r['source']} {Path(r['file']).name}: {r['dip_frames']} frames sink "
+                         f"> {DIP * 100:.0f} cm below the ground (floating {r['floating']:.0f} mm)")
+    (args.out / "flags.txt").write_text("\n".join(flags) + "\n")
+    print("\n".join(flags))
     return 0
 
 

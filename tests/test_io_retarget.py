@@ -56,9 +56,21 @@ def test_map_weights_sum_to_one() -> None:
     """Every map entry is an affine combination: it moves rigidly with the body."""
     from simdiff.motion.io.retarget import _terms
 
-    for joint_map in (CMU_ASF_MAP, CC_BVH_MAP, DEEPMIMIC_MAP):
+    from simdiff.motion.io.rigs import RIGS
+
+    for joint_map in (CMU_ASF_MAP, CC_BVH_MAP, DEEPMIMIC_MAP, *(spec.joint_map for spec in RIGS)):
         for name, src in joint_map.items():
             assert sum(w for _, w in _terms(src)) == pytest.approx(1.0, abs=1e-9), name
+        assert set(joint_map) >= set(JOINT_NAMES) - {"left_foot", "right_foot"}
+
+
+def test_rig_families_are_told_apart() -> None:
+    """Each family's joint names select that family (no earlier family claims them)."""
+    from simdiff.motion.io.rigs import RIGS, detect_rig
+
+    for spec in RIGS:
+        names = tuple(sorted(spec.needs()))
+        assert detect_rig(names) is spec, spec.name
 
 
 def test_cc_map_is_translation_and_rotation_equivariant() -> None:

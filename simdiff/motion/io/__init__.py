@@ -8,12 +8,18 @@ Sources and what the readers do for them (rig families: :mod:`simdiff.motion.io.
 
 - CMU ASF/AMC and HDM05 ASF/AMC (``HDM_<actor>.asf`` found beside ``HDM_<actor>_*.amc``;
   rate from ``CMU_data.csv`` or a ``_120`` name suffix, else 120 fps);
-- BVH: CMU Character-Creator (an added first T-pose is detected and dropped), CMU
-  Motionbuilder (CMU ASF units, first frame a T-pose: dropped; its missing thorax bone is
-  put back), Daz-style CMU/acLSTM (cm), Bandai-Namco (cm, 30 fps), generic bipeds;
+- BVH (rate: a folder ``readme.txt`` rate, e.g. acLSTM salsa 60 fps, else the header;
+  start-up frames dropped: the family's T-pose, then any T-pose / blend-out transient,
+  counted in ``meta["dropped_frames"]``): CMU Character-Creator, CMU Motionbuilder and the
+  ASF-named CMU BVH (CMU ASF units; the dropped thorax bone is put back; floor tilt
+  levelled), Daz-style CMU/acLSTM (cm; floor tilt levelled), Bandai-Namco (cm, 30 fps),
+  generic bipeds;
 - DeepMimic JSON (``.txt``): variable frame durations are resampled on their time stamps;
   :func:`retarget_rig` applies the DeepMimic ground clean-up ``lift_penetrations``;
 - ``.npy`` HumanML3D joints or features.
+
+Per-family clean-ups (``prepare`` before mapping, ``finish`` after retargeting) run inside
+:func:`retarget_rig` / :func:`load_joints` and are switched off with ``clean=False``.
 
 BVH units (file unit -> metres), in order: the ``units`` argument ("m", "cm", "mm",
 "inch", "cmu" or a factor); the rig family's known unit (Bandai, Daz: cm; Motionbuilder:
@@ -52,6 +58,7 @@ from simdiff.motion.io.bvh import (
 from simdiff.motion.io.bvh_writer import write_bvh
 from simdiff.motion.io.deepmimic import read_deepmimic
 from simdiff.motion.io.npy import read_npy, save_npy
+from simdiff.motion.io.rates import folder_fps_hint
 from simdiff.motion.io.resample import resample as _resample
 from simdiff.motion.io.retarget import retarget_rig, to_canonical_lengths
 from simdiff.motion.io.rigs import RigSpec, detect_rig
@@ -95,7 +102,9 @@ def load_rig(
         asf: skeleton of an ``.amc`` (default: :func:`find_asf`: ``SS.asf`` or
             ``HDM_<actor>.asf`` beside it or in an ``asf/`` folder).
         fps: the file's frame rate, overriding the file's own (AMC default: from a
-            ``CMU_data.csv`` beside the data, a ``_120`` name suffix, else 120).
+            ``CMU_data.csv`` beside the data, a ``_120`` name suffix, else 120; BVH default:
+            a folder rate in a ``readme.txt`` one level up
+            (:func:`~simdiff.motion.io.rates.folder_fps_hint`), else the header).
         drop_first: BVH only: True skips frame 0, False keeps every frame; None drops it
             when the rig family always starts with a T-pose (CMU Motionbuilder), then any
             detected start-up transient (:func:`~simdiff.motion.io.bvh.leading_transient`:
@@ -152,7 +161,8 @@ def _load_bvh(path: Path, *, fps: float | None, drop_first: bool | None,
         spec = None
     scale = _units_to_scale(path, units) if units is not None else (spec.units if spec else None)
     drop = (spec is not None and spec.first_frame_tpose) if drop_first is None else drop_first
-    rig = rig_from_bvh(bvh, scale=scale, fps=fps, drop_first=drop,
+    hint = folder_fps_hint(path) if fps is None else None
+    rig = rig_from_bvh(bvh, scale=scale, fps=fps if fps is not None else hint, drop_first=drop,
                        sites=spec.bvh_sites if spec else (),
                        rest_axes=spec.rest_axes if spec else ((1, 0, 0), (0, 1, 0), (0, 0, 1)))
     dropped = int(drop)
@@ -162,6 +172,7 @@ def _load_bvh(path: Path, *, fps: float | None, drop_first: bool | None,
             rig = RigMotion(rig.names, rig.parents, rig.positions[skip:], rig.fps, rig.source, rig.meta)
             dropped += skip
     rig.meta["dropped_frames"] = dropped
+    rig.meta["fps_source"] = "argument" if fps is not None else ("readme" if hint else "header")
     if spec is not None:
         rig.meta["rig"] = spec
     return rig

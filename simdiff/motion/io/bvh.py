@@ -311,8 +311,9 @@ def starts_with_tpose(positions: np.ndarray) -> bool:
 
 TRANSIENT_WINDOW: float = 0.1
 """Seconds at the start of a clip searched by :func:`leading_transient`."""
-TRANSIENT_STEP: float = 0.02
-"""Metres: smallest per-frame step (median over joints) counted as a start-up jump."""
+TRANSIENT_SPEED: float = 2.0
+"""Metres per second: smallest median-joint speed of a frame step counted as a start-up jump
+(a T-pose blend moves 20-40 m/s; real motion at a clip start well under 1 m/s)."""
 TRANSIENT_FACTOR: float = 5.0
 """A start-up jump is also this many times the clip's median step."""
 
@@ -324,8 +325,9 @@ def leading_transient(positions: np.ndarray, fps: float) -> int:
     acLSTM dances) by 3-5 frames interpolated from it into the motion, or (CMU
     Motionbuilder 09_10) by frames left at the origin. Every frame before the last step
     within the first :data:`TRANSIENT_WINDOW` s (at least 2 steps) whose median joint
-    displacement exceeds both :data:`TRANSIENT_STEP` and :data:`TRANSIENT_FACTOR` x the
-    clip's median step is dropped.
+    displacement exceeds both :data:`TRANSIENT_SPEED` / ``fps`` and :data:`TRANSIENT_FACTOR` x the
+    clip's median step is dropped, and so are the following frames while the step keeps
+    shrinking and stays above twice the median step (the end of the blend).
 
     Args:
         positions: (T, J, 3) joint positions in metres.
@@ -334,10 +336,17 @@ def leading_transient(positions: np.ndarray, fps: float) -> int:
     if positions.shape[0] < 4:
         return 0
     steps = np.median(np.linalg.norm(np.diff(positions, axis=0), axis=-1), axis=-1)
-    limit = max(TRANSIENT_STEP, TRANSIENT_FACTOR * float(np.median(steps)))
+    limit = max(TRANSIENT_SPEED / fps, TRANSIENT_FACTOR * float(np.median(steps)))
     window = min(len(steps) - 1, max(2, int(round(TRANSIENT_WINDOW * fps))))
     jumps = np.flatnonzero(steps[:window] > limit)
-    return int(jumps[-1]) + 1 if jumps.size else 0
+    if not jumps.size:
+        return 0
+    # the blend out of the rest pose: steps still shrinking and above 2x the median step
+    end = int(jumps[-1])
+    typical = 2.0 * float(np.median(steps))
+    while end + 1 < len(steps) - 1 and typical < steps[end + 1] < steps[end]:
+        end += 1
+    return end + 1
 
 
 def _to_y_up(positions: np.ndarray, up: str) -> np.ndarray:
@@ -450,7 +459,9 @@ def _site_positions(
             raise MotionFormatError(bvh.path, f"site {name!r} needs joints {joint!r} and {child!r}")
         j, c = names.index(joint), names.index(child)
         bone = rest[c] - rest[j]
-        unit = float(np.linalg.norm(bone)) if c != j else 1.0
+        parent = bvh.joints[j].parent
+        own = rest[j] - rest[parent] if parent >= 0 else bone
+        unit = float(np.linalg.norm(bone if c != j else own))
         local = bone + unit * (np.asarray(offset, dtype=np.float64) @ axes)
         out.append(positions[:, j] + rotations[:, j] @ local)
     return np.stack(out, axis=1)

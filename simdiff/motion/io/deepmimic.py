@@ -98,7 +98,8 @@ def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
 
     Args:
         path: the JSON motion (``.txt`` or ``.json``).
-        fps: frame rate; default 1 / median frame duration (30 for the CMU set).
+        fps: frame rate; default 1 / median frame duration (30 for the CMU set). Frames
+            with other durations are put on this rate's grid by their time stamps.
     Returns:
         RigMotion with the 15 humanoid3d links plus :data:`SITES` (right_toe, left_toe,
         neck_top, head): (T, 19, 3) metres, Y-up (the character faces +X at identity root rotation).
@@ -161,14 +162,37 @@ def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
         i = names.index(link)
         extra.append(positions[:, i] + rotations[:, i] @ np.asarray(offset))
     all_positions = np.concatenate([positions, np.stack(extra, axis=1)], axis=1)
+    all_positions, retimed = _uniform_time(all_positions, dts, fps)
     return RigMotion(
         names=tuple(names),
         parents=tuple(parents),
         positions=all_positions.astype(np.float32),
         fps=fps,
         source=path,
-        meta={"loop": doc.get("Loop")},
+        meta={"loop": doc.get("Loop"), "retimed": retimed},
     )
+
+
+def _uniform_time(positions: np.ndarray, dts: np.ndarray, fps: float) -> tuple[np.ndarray, bool]:
+    """Positions on a uniform ``fps`` grid when the frame durations vary.
+
+    A frame's ``dt`` is the time to the next frame (the last one is usually 0). When every
+    duration but the last is within 5 % of 1 / ``fps`` the frames are kept as they are;
+    otherwise (e.g. ``humanoid3d_roll``: one 0.033 s gap among 0.0167 s frames) the
+    positions are linearly interpolated at ``k / fps`` on the cumulative time stamps.
+
+    Returns:
+        (T', J, 3) positions and whether they were resampled.
+    """
+    steps = dts[:-1]
+    if len(steps) == 0 or np.all(np.abs(steps * fps - 1.0) <= 0.05):
+        return positions, False
+    times = np.concatenate([[0.0], np.cumsum(steps)])
+    grid = np.arange(0.0, times[-1] + 0.5 / fps, 1.0 / fps)
+    grid = grid[grid <= times[-1] + 1e-9]
+    flat = positions.reshape(len(positions), -1)
+    out = np.stack([np.interp(grid, times, flat[:, c]) for c in range(flat.shape[1])], axis=1)
+    return out.reshape(len(grid), *positions.shape[1:]), True
 
 
 def _forward_kinematics(

@@ -50,7 +50,8 @@ BANDAI: RigSpec = RigSpec(
     units=0.01,
     # rest pose: left +Z, up +X (spine), forward = left x up = +Y
     rest_axes=((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
-    # SMPL head: 3.7 cm in front of and 1.3 cm below the Head joint (top of the neck)
-    bvh_sites=(("head_centre", "Head", "Head", (0.0, -0.013, 0.037)),),
+    # SMPL head: 3.7 cm in front of and 1.3 cm below the Head joint (top of the neck), in
+    # units of the 6.46 cm neck bone
+    bvh_sites=(("head_centre", "Head", "Head", (0.0, -0.201, 0.573)),),
 )
 """Bandai-Namco BVH: centimetres (stated by the dataset; standing heights 1.5-1.8 m)."""

@@ -16,8 +16,8 @@ a weighted mean of joints (weights summing to 1)."""
 BvhSite = tuple[str, str, str, tuple[float, float, float]]
 """``(name, joint, child, (left, up, forward))``: a point rigid with BVH ``joint``'s frame
 (the frame that places ``child``), at ``child``'s rest position plus the offset in units of
-the rest bone length ``|child - joint|`` (metres when ``child == joint``) along the rig's
-rest-pose axes (:attr:`RigSpec.rest_axes`)."""
+the rest bone length ``|child - joint|`` (when ``child == joint``: of the joint's own bone,
+from its parent) along the rig's rest-pose axes (:attr:`RigSpec.rest_axes`)."""
 
 
 def terms(src: Source) -> tuple[tuple[str, float], ...]:

@@ -41,8 +41,9 @@ DAZ: RigSpec = RigSpec(
     "daz",
     DAZ_MAP,
     units=0.01,
-    # SMPL head: 2.8 cm in front of and 0.5 cm below the head joint (top of the neck)
-    bvh_sites=(("head_centre", "head", "head", (0.0, -0.005, 0.028)),),
+    # SMPL head: 2.8 cm in front of and 0.5 cm below the head joint (top of the neck), in
+    # units of the 7.18 cm neck bone
+    bvh_sites=(("head_centre", "head", "head", (0.0, -0.070, 0.390)),),
     finish=level_ground,
 )
 """CMU Daz-style BVH (also the acLSTM dance folders), centimetres."""
