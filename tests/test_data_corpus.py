@@ -274,3 +274,21 @@ def test_real_shared_deepmimic_duplicates(shared_data: Path, tmp_path: Path) -> 
     assert len({i.meta["sha1"] for i in items}) == len(items)
     assert len({i.id for i in items}) == len(items) and len(items) >= 20
     assert "dm_backflip" in {i.id for i in items} and "dm_bridge" in {i.id for i in items}
+
+
+def test_item_cache_key_follows_bytes_code_and_settings(shared: Path, tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from simdiff.data.corpus.build import code_digest, item_key
+    from simdiff.data.corpus.clips import ClipSettings
+
+    item = next(i for i in discover_all(shared, tmp_path) if i.id == "dm_jump")
+    settings = ClipSettings(out=tmp_path, shared=shared)
+    code = code_digest()
+    key = item_key(item, settings, code)
+    assert key == item_key(item, settings, code)
+    assert key != item_key(item, settings, code + "x")
+    assert key != item_key(item, replace(settings, seed=1), code)
+    copy = tmp_path / "jump.txt"
+    copy.write_text(item.path.read_text().replace("]]", ", ]]", 0) + " ")
+    assert key != item_key(replace(item, path=copy), settings, code)
