@@ -165,6 +165,7 @@ def test_every_clip_has_captions_and_a_licence(corpus: tuple[Path, object]) -> N
     assert any("right" in s for s in mirror["captions"]) and not any("left" in s for s in mirror["captions"])
     hop = next(c for c in clips if c["id"] == "hdm_bd_hopBothLegs1hops_001_00")
     assert hop["padded_frames"] > 0 and hop["frames"] == 40
+    assert hop["source_frames"] == [0, 180]  # 1.5 s at 120 fps: the held frames map to the take's ends
     assert np.load(out / "new_joint_vecs" / "hdm_bd_hopBothLegs1hops_001_00.npy").shape == (40, 263)
     assert manifest["counts"]["hours_originals_by_licence"].keys() == {"CMU", "CC-BY-NC-4.0", "CC-BY-SA-3.0", "MIT"}
     assert next(c for c in clips if c["id"] == "01_01_00")["alternates"]
@@ -273,3 +274,21 @@ def test_real_shared_deepmimic_duplicates(shared_data: Path, tmp_path: Path) -> 
     assert len({i.meta["sha1"] for i in items}) == len(items)
     assert len({i.id for i in items}) == len(items) and len(items) >= 20
     assert "dm_backflip" in {i.id for i in items} and "dm_bridge" in {i.id for i in items}
+
+
+def test_item_cache_key_follows_bytes_code_and_settings(shared: Path, tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from simdiff.data.corpus.build import code_digest, item_key
+    from simdiff.data.corpus.clips import ClipSettings
+
+    item = next(i for i in discover_all(shared, tmp_path) if i.id == "dm_jump")
+    settings = ClipSettings(out=tmp_path, shared=shared)
+    code = code_digest()
+    key = item_key(item, settings, code)
+    assert key == item_key(item, settings, code)
+    assert key != item_key(item, settings, code + "x")
+    assert key != item_key(item, replace(settings, seed=1), code)
+    copy = tmp_path / "jump.txt"
+    copy.write_text(item.path.read_text().replace("]]", ", ]]", 0) + " ")
+    assert key != item_key(replace(item, path=copy), settings, code)

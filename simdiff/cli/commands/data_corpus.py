@@ -22,7 +22,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "cross-checks), retarget to 22 joints at 20 fps, cut 2-9.8 s clips, add M<id> mirrors, "
             "captions (>= 2 per clip), licence per clip, splits by trial stratified by source and motion "
             "type, Mean/Std and manifest.json. Resumable; output independent of --workers. "
-            "`simdiff data build --sources cmu` is the superset of `build-cmu` (which stays as it was)."
+            "`build-cmu` stays as it was; `build --sources cmu` makes the same CMU windows plus the extra "
+            "CMU BVH and padded short takes, with stratified splits."
         ),
     )
     build.add_argument("--shared", type=Path, required=True, help="shared data root (e.g. ../shared/data)")

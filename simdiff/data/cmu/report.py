@@ -170,7 +170,7 @@ def _summary_figure(path: Path, clips: list[dict[str, Any]], metrics: list[dict[
         groups = _group(clips, key)
         ax.bar(list(groups), [_hours(v) for v in groups.values()], color="#4477aa")
         ax.set_title(f"{title} (with mirrors)")
-        ax.tick_params(axis="x", rotation=45 if key == "motion_type" else 0, labelsize=8)
+        ax.tick_params(axis="x", rotation=0 if key == "split" else 45, labelsize=8)
     ax = axes[1, 0]
     ax.hist([c["frames"] / FPS for c in originals], bins=30, color="#66aa55")
     ax.set_title("clip length (s, originals)")

@@ -29,7 +29,7 @@ from simdiff.data.corpus.splits import assign_stratified
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 
-PIPELINE_VERSION: int = 1
+PIPELINE_VERSION: int = 2
 """Bump when an item's clips change for the same inputs (invalidates the item cache)."""
 
 FORMAT: str = "simdiff-corpus"
@@ -74,15 +74,24 @@ class CorpusResult:
     split_counts: dict[str, int] = field(default_factory=dict)
 
 
-def item_key(item: Item, settings: ClipSettings) -> str:
-    """Cache key of an item: its source bytes and every setting that changes its clips."""
+def code_digest() -> str:
+    """SHA-1 of the readers and retargeting code (``simdiff/motion/io``): a reader change
+    invalidates the item cache without a :data:`PIPELINE_VERSION` bump."""
+    import simdiff.motion.io as io_package
+
+    root = Path(io_package.__file__).parent
+    return file_digest(sorted(root.rglob("*.py")))
+
+
+def item_key(item: Item, settings: ClipSettings, code: str = "") -> str:
+    """Cache key of an item: its source bytes, the reader code and every setting that changes its clips."""
     trial = item.meta.get("cmu_trial")
     payload = {
         "version": PIPELINE_VERSION, "id": item.id, "trial": item.trial, "source": item.source,
         "licence": item.licence, "type": item.motion_type, "verbs": item.verbs, "adverbs": item.adverbs,
         "subjects": item.subjects, "origin": item.caption_origin, "description": item.description,
         "fps": item.fps, "seed": settings.seed, "captions": settings.captions, "mirror": settings.mirror,
-        "window": [MIN_WINDOW, MAX_WINDOW],
+        "window": [MIN_WINDOW, MAX_WINDOW], "code": code,
     }
     if trial is not None:
         payload["cmu"] = {
@@ -130,8 +139,9 @@ def build(cfg: CorpusConfig) -> CorpusResult:
     todo: list[tuple[Item, str]] = []
     stale: set[str] = set()
     reused = 0
+    code = code_digest()
     for item in items:
-        key = item_key(item, settings)
+        key = item_key(item, settings, code)
         record = _load_record(cache / "items" / f"{item.id}.json")
         if record:
             stale.update(str(c["id"]) for c in record.get("clips", []))

@@ -96,8 +96,9 @@ def process_item(item: Item, cfg: ClipSettings) -> list[dict[str, Any]]:
 
     joints, skipped = load_item(item)
     taken = joints.shape[0]
+    before = 0
     if MIN_TAKE <= taken < MIN_WINDOW:
-        joints, _ = pad_short(joints)
+        joints, before = pad_short(joints)
     padded = joints.shape[0] - taken
     trial = item.meta.get("cmu_trial")
     segments = list(getattr(trial, "segments", [])) if item.source in ("cmu-amc", "cmu-bvh", "cmu-deepmimic") else []
@@ -118,8 +119,8 @@ def process_item(item: Item, cfg: ClipSettings) -> list[dict[str, Any]]:
             "trial": item.trial, "source": item.source, "rig": item.source, "licence": item.licence,
             "motion_type": item.motion_type, "caption_origin": origin, "description": item.description,
             "file": _relative(item.path, cfg.shared), "fps": fps, "start20": window.start, "stop20": window.stop,
-            "source_frames": None if fps is None else [
-                int(round(window.start * fps / FPS)) + skipped, int(round(window.stop * fps / FPS)) + skipped],
+            "source_frames": None if fps is None else [  # held (padded) frames map to the take's ends
+                int(round(min(max(t - before, 0), taken) * fps / FPS)) + skipped for t in (window.start, window.stop)],
             "window": window.origin, "padded_frames": padded,
             "ground_contact": round(contact, 3), "support": support_of(contact),
         }

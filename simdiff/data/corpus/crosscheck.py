@@ -1,8 +1,10 @@
 """Agreement between the kept copy of a trial and its other copies (dedupe cross-check).
 
-Both copies are read as corpus items (:func:`.load.load_item`, 20 fps, floor at 0) and
-compared by :func:`simdiff.data.cmu.crosscheck.compare_joints` (best lag within ±0.2 s, then
-yaw + 3D translation). Results are cached in ``CORPUS/.build/crosscheck_all.json`` by the
+As in ``build-cmu``'s AMC/BVH check, both copies are retargeted at 120 fps (so they can be
+synced to 1/120 s), run through the corpus joint stage (canonical skeleton, floor, facing
++Z: :func:`simdiff.motion.features.process_joints`) and compared by
+:func:`simdiff.data.cmu.crosscheck.compare_joints` (best lag within ±0.2 s, then yaw + 3D
+translation). Results are cached in ``CORPUS/.build/crosscheck_all.json`` by the
 bytes of both files.
 """
 
@@ -12,13 +14,31 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from simdiff.data.cmu.crosscheck import CHECK_FPS
 from simdiff.data.cmu.writer import write_json
 from simdiff.data.corpus.item import Item, file_digest
 from simdiff.errors import SimdiffError
-from simdiff.motion.skeleton import FPS
 
+VERSION: int = 2
+"""Bump when the comparison changes (invalidates the cache)."""
 TARGET_M: float = 0.03
 """Wanted mean per-joint distance between two copies after alignment (metres)."""
+
+
+def _joints_120(item: Item) -> np.ndarray:
+    """(T, 22, 3) canonical joints of ``item`` at :data:`CHECK_FPS`."""
+    from simdiff.data.cmu.load import read_source_rig
+    from simdiff.motion.features import process_joints
+    from simdiff.motion.io import load_rig, retarget_rig
+
+    rigs = {"cmu-amc": "amc", "cmu-bvh": "bvh", "cmu-deepmimic": "deepmimic"}
+    if item.source in rigs and "cmu_trial" in item.meta:
+        rig = read_source_rig(item.meta["cmu_trial"], rigs[item.source])[0]  # type: ignore[arg-type]
+    else:
+        rig = load_rig(item.path, asf=item.asf, fps=item.fps)
+    return process_joints(retarget_rig(rig, fps=CHECK_FPS)).joints.astype(np.float64)
 
 
 def crosscheck_items(items: list[Item], cache_path: Path, progress: bool = True) -> list[dict[str, Any]]:
@@ -26,7 +46,6 @@ def crosscheck_items(items: list[Item], cache_path: Path, progress: bool = True)
     from tqdm import tqdm
 
     from simdiff.data.cmu.crosscheck import compare_joints
-    from simdiff.data.corpus.load import load_item
 
     try:
         cache = json.loads(cache_path.read_text())
@@ -36,12 +55,11 @@ def crosscheck_items(items: list[Item], cache_path: Path, progress: bool = True)
     rows: list[dict[str, Any]] = []
     for item, alt in tqdm(pairs, desc="cross-check", unit="pair", disable=not progress, leave=False):
         name = f"{item.id}:{item.source}:{alt.source}"
-        key = file_digest(item.files() + alt.files())
+        key = file_digest(item.files() + alt.files()) + f":v{VERSION}"
         entry = cache.get(name)
         if not (entry and entry.get("key") == key):
             try:
-                a, b = load_item(item)[0], load_item(alt)[0]
-                agreement = compare_joints(a, b, FPS, trial=item.id)
+                agreement = compare_joints(_joints_120(item), _joints_120(alt), CHECK_FPS, trial=item.id)
                 entry = {"key": key, "row": {
                     "trial": item.id, "kept": item.source, "copy": alt.source, "frames": agreement.frames,
                     "lag_s": agreement.lag_s, "mpjpe": agreement.mpjpe, "pose_only": agreement.root_relative,

@@ -22,7 +22,7 @@ from simdiff.data.cmu.report import (
 )
 from simdiff.data.cmu.writer import write_text
 from simdiff.data.corpus.crosscheck import TARGET_M, crosscheck_items
-from simdiff.data.corpus.flight import ANKLE_HEIGHT, MIN_FLIGHT_S, TOE_HEIGHT, flight_stats
+from simdiff.data.corpus.flight import ANKLE_HEIGHT, GROUND_PERCENTILE, MIN_FLIGHT_S, TOE_HEIGHT, flight_stats
 from simdiff.data.corpus.item import LICENCES
 from simdiff.errors import SimdiffError
 
@@ -51,8 +51,11 @@ def _stratification(originals: list[dict[str, Any]]) -> str:
 def _flight_section(originals: list[dict[str, Any]], flights: dict[str, dict[str, float]]) -> list[str]:
     md = ["## Flight (both feet off the floor)", "",
           f"A frame is airborne when both ankles are above {ANKLE_HEIGHT * 100:.0f} cm and both toes and every "
-          f"other joint above {TOE_HEIGHT * 100:.0f} cm over the clip's floor (lowest joint of the clip), heights "
-          f"only (`simdiff.data.corpus.flight`). Original clips only (a mirror flies as its original).", ""]
+          f"other joint above {TOE_HEIGHT * 100:.0f} cm over the clip's ground (the {GROUND_PERCENTILE:g}th "
+          "percentile of the per-frame lowest joint), heights only (`simdiff.data.corpus.flight`). Original "
+          "clips with `support: floor` only (a mirror flies as its original; `props` clips, hanging or "
+          "climbing, are left out).", ""]
+    originals = [c for c in originals if c.get("support", "floor") == "floor"]
     rows = []
     for source, group in [("all", originals)] + list(_group(originals, "source").items()):
         f = [flights[c["id"]] for c in group]
@@ -80,6 +83,9 @@ def _physics_section(originals: list[dict[str, Any]], by_id: dict[str, dict[str,
     md.append(_table(["source", "clips", "penetration mm", "floating mm", "sliding mm/frame", "skate ratio"], rows))
     md += ["", "Worst clips per metric:", ""]
     for key in METRICS:
+        if max(by_id[c["id"]][key] for c in originals) <= 0:
+            md.append(f"- {key}: 0 in every clip (the floor is the clip's lowest joint)")
+            continue
         worst = sorted(originals, key=lambda c: (-by_id[c["id"]][key], c["id"]))[:4]
         md.append(f"- {key}: " + "; ".join(
             f"`{c['id']}` ({c['source']}, {c['description']}) {by_id[c['id']][key]:.2f}" for c in worst))
@@ -103,8 +109,9 @@ def _crosscheck_section(manifest: dict[str, Any], corpus: Path, progress: bool) 
     ok = [r for r in rows if not r.get("error")]
     if not ok:
         return md + ["No trial arrives in more than one copy."]
-    md += [f"{len(rows)} pairs; each copy retargeted by its own joint map at 20 fps, then aligned in time "
-           f"(±0.2 s) and space (yaw + translation); MPJPE = mean per-joint distance. Target ≤ "
+    md += [f"{len(rows)} pairs; each copy retargeted by its own joint map at 120 fps and canonicalised like a "
+           "corpus clip (canonical bone lengths, floor, facing +Z), then aligned in time (±0.2 s) and space (yaw "
+           "+ translation); MPJPE = mean per-joint distance. Target ≤ "
            f"{TARGET_M * 100:.0f} cm.", ""]
     table = []
     for (kept, copy), group in sorted(Counter((r["kept"], r["copy"]) for r in ok).items()):

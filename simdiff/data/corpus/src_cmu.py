@@ -4,7 +4,8 @@ extra CMU BVH of ``shared/extra/cmu-bvh`` (Motionbuilder and Daz rigs, acLSTM da
 Every copy of one CMU trial gets the trial key ``cmu:SS_TT``; the registry keeps the best
 (:data:`RANKS`: AMC, then Character-Creator BVH, Motionbuilder BVH, Daz BVH, DeepMimic) and
 keeps the others as cross-checks. Captions of CMU trials come per window (KIT-ML, else CMU's
-description) in :mod:`.build`; acLSTM takes (trial ids unknown) get folder captions.
+description) in :mod:`.clips`: ``cmu/manifest.jsonl``'s KIT-ML sentence plus every other
+KIT-ML sentence of the trial in ``kitml/annotations.json``; acLSTM takes (trial ids unknown) get folder captions.
 """
 
 from __future__ import annotations
@@ -74,9 +75,12 @@ def discover(shared: Path, cache: Path) -> list[Item]:
     items: list[Item] = []
     src = shared / "cmu"
     trials: dict[str, Trial] = {}
+    kitml = read_kitml(shared)
     if src.is_dir() and any((src / d).exists() for d in ("amc", "bvh", "bvh.tar.xz", "deepmimic")):
         for trial in discover_cmu(src, cache / "cmu"):
             trials[trial.trial] = trial
+            known = {" ".join(str(k["text"]).split()) for k in trial.kitml}
+            trial.kitml = list(trial.kitml) + [k for k in kitml.get(trial.trial, []) if k["text"] not in known]
             for rig, path in sorted(trial.files.items()):
                 if rig == "amc" and trial.asf is None:
                     continue
@@ -87,7 +91,6 @@ def discover(shared: Path, cache: Path) -> list[Item]:
         return items
     rates, csv_desc = _read_rates(src) if src.is_dir() else ({}, {})
     descriptions = {**csv_desc, **(_read_descriptions(src) if src.is_dir() else {})}
-    kitml = read_kitml(shared)
     for folder, source in (("motionbuilder", "cmu-mb"), ("daz", "cmu-daz")):
         for path in sorted((extra / folder).glob("*.bvh")):
             name = normalise_trial(path.stem)
