@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pytest
 import torch
 
@@ -13,23 +12,9 @@ from simdiff.eval.testing import write_tiny_corpus
 from simdiff.model.generator import MotionGenerator
 from simdiff.train.pipeline import budget_config, run_pipeline
 from simdiff.train.pipeline.config import set_option
-from simdiff.train.testing import HashTextEncoder
+from simdiff.train.testing import EchoProjector, HashTextEncoder
 
 STAGES = ["corpus", "augment", "backbone", "adapters", "evaluator", "evaluation", "export"]
-
-
-class EchoProjector:
-    """Stands in for the simulator: the rollout is the reference itself; every pair passes the filter."""
-
-    def __init__(self) -> None:
-        self.pairs = 0
-
-    def __call__(self, motions, envs):
-        for m in motions:
-            self.pairs += 1
-            yield np.asarray(m, dtype=np.float32), {"success": True, "d_l2_pose": 0.5, "d_l2": 0.5,
-                                                     "residual": {"force_mean_n": 1.0, "force_mean_mg": 0.01},
-                                                     "cpu_s": 0.0}
 
 
 @pytest.fixture(autouse=True)

@@ -151,7 +151,7 @@ def unpack(path: str | Path, out: str | Path) -> int:
         for sub in ("new_joint_vecs", "new_joints", "texts"):
             (tmp / sub).mkdir(parents=True)
         for clip, offset, frames in index["clips"]:
-            f = np.asarray(features[offset: offset + frames], dtype=np.float32)
+            f = np.array(features[offset: offset + frames], dtype=np.float32)
             np.save(tmp / "new_joint_vecs" / f"{clip}.npy", f)
             np.save(tmp / "new_joints" / f"{clip}.npy", np.asarray(features_to_joints(f), dtype=np.float32))
             if clip in index["texts"]:
