@@ -106,3 +106,16 @@ def test_bad_settings_are_one_line_errors(corpus) -> None:
     with pytest.raises(SimdiffError, match="must be int"):
         set_option(config, "backbone.steps=many")
     assert budget_config("gpu").backbone.size == "mdm" and budget_config("gpu").augment.workers == 16
+
+
+def test_cli_dry_run_prints_the_plan(corpus, tmp_path, capsys) -> None:
+    from simdiff.cli.main import main
+
+    argv = ["train", "pipeline", "--budget", "quick", "--corpus", str(corpus), "--out", str(tmp_path / "r"), "--dry-run"]
+    assert main(argv + ["--set", "backbone.steps=3", "--seed", "4"]) == 0
+    lines = [line.split() for line in capsys.readouterr().out.strip().splitlines()]
+    assert [line[0] for line in lines] == STAGES and all(line[1] == "run" for line in lines)
+    assert not (tmp_path / "r").exists()
+    assert main(argv + ["--set", "backbone.nope=1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "unknown setting" in err

@@ -6,9 +6,6 @@ import argparse
 from pathlib import Path
 
 from simdiff.cli.main import command_group
-from simdiff.data.augment.filter import FilterConfig
-
-FILTER_DEFAULTS = FilterConfig()
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -31,10 +28,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=0, help="parallel simulations (default: all cores)")
     p.add_argument("--backend", choices=["process", "ray", "serial"], default="process", help="parallel backend (default process)")
     p.add_argument("--seed", type=int, default=0, help="seed of the environment draw (default 0)")
-    p.add_argument("--max-pose-d-l2", type=float, default=FILTER_DEFAULTS.max_pose_d_l2,
-                   help=f"largest pose d_L2 against the re-timed source (default {FILTER_DEFAULTS.max_pose_d_l2})")
-    p.add_argument("--max-residual-n", type=float, default=FILTER_DEFAULTS.max_residual_n,
-                   help=f"largest mean root residual force kept, newtons, any gravity (default {FILTER_DEFAULTS.max_residual_n})")
+    # Defaults come from FilterConfig when the command runs: importing simdiff.data.augment here would
+    # pull torch into every CLI start (`simdiff generate` validates its options without torch).
+    p.add_argument("--max-pose-d-l2", type=float,
+                   help="largest pose d_L2 against the re-timed source (default: FilterConfig.max_pose_d_l2)")
+    p.add_argument("--max-residual-n", type=float,
+                   help="largest mean root residual force kept, newtons, any gravity (default: FilterConfig.max_residual_n)")
     p.add_argument("--max-d-l2", type=float, help="also require the paper's d_L2 <= this (e.g. 7.0; default off)")
     p.add_argument("--max-residual", type=float, help="also require the residual <= this fraction of m*|g_z| (default off)")
     p.add_argument("--residual-bound", type=float, default=0.5,
@@ -52,9 +51,12 @@ def run(args: argparse.Namespace) -> int:
     from simdiff.data.augment.filter import FilterConfig
     from simdiff.data.augment.run import AugmentConfig, augment
 
+    defaults = FilterConfig()
+    pose = defaults.max_pose_d_l2 if args.max_pose_d_l2 is None else args.max_pose_d_l2
+    residual_n = defaults.max_residual_n if args.max_residual_n is None else args.max_residual_n
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
-                           filter=FilterConfig(max_pose_d_l2=args.max_pose_d_l2, max_residual_n=args.max_residual_n,
+                           filter=FilterConfig(max_pose_d_l2=pose, max_residual_n=residual_n,
                                                max_d_l2=args.max_d_l2, max_residual=args.max_residual),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip)
