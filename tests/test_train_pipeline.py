@@ -119,3 +119,18 @@ def test_cli_dry_run_prints_the_plan(corpus, tmp_path, capsys) -> None:
     assert main(argv + ["--set", "backbone.nope=1"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "unknown setting" in err
+
+
+def test_wall_clock_cap_stops_training_at_a_checkpoint(tmp_path) -> None:
+    from simdiff.train import Trainer, synthetic_dataset
+    from simdiff.train.pipeline.context import PipelineContext
+    from simdiff.train.pipeline.stages import _train
+    from simdiff.train.state import latest_checkpoint
+    from simdiff.train.testing import tiny_run_config
+
+    trainer = Trainer(tmp_path, tiny_run_config(9, save_every=3), synthetic_dataset(4, 30, max_frames=30),
+                      text_encoder=HashTextEncoder())
+    ctx = PipelineContext(out=tmp_path, config=budget_config("quick"), progress=False)
+    summary = _train(ctx, trainer, max_minutes=1e-9)
+    assert summary["step"] == 3 and summary["steps"] == 9
+    assert latest_checkpoint(tmp_path).name == "step_000000003"

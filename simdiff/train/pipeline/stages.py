@@ -98,8 +98,10 @@ def _train(ctx: PipelineContext, trainer: Any, max_minutes: float) -> dict[str, 
         trainer.train(progress=ctx.progress)
     else:
         chunk = max(1, tc.save_every or 100)
-        while trainer.step < tc.steps and time.monotonic() - start < 60.0 * max_minutes:
+        while trainer.step < tc.steps:  # at least one chunk, then stop at the first checkpoint past the cap
             trainer.train(until=trainer.step + chunk, progress=ctx.progress)
+            if time.monotonic() - start >= 60.0 * max_minutes:
+                break
     tail = trainer.history[-10:]
     return {"step": trainer.step, "steps": tc.steps, "wall_s": round(time.monotonic() - start, 2),
             "final_loss": round(sum(tail) / len(tail), 6) if tail else None}
