@@ -180,9 +180,10 @@ def run_evaluation(ctx: PipelineContext) -> dict[str, Any]:
     dataset = HumanML3D(ctx.corpus_dir(), "test", normalizer=None, seed=seed)
     config = ProtocolConfig(replications=ev.replications, batch_size=ev.batch_size, samples_limit=ev.samples_limit,
                             seed=seed)
-    result = evaluate_t2m(evaluator, dataset, generator_fn(generator, env=list(ev.env), sampler=ev.sampler,
-                                                           steps=ev.steps, guidance=ev.guidance), config,
-                          progress=ctx.progress)
+    categorical = ctx.config.adapters.sim_mode == "categorical"  # category 0: the source (Earth) clips
+    generate = generator_fn(generator, env=None if categorical else list(ev.env), env_index=0 if categorical else None,
+                            sampler=ev.sampler, steps=ev.steps, guidance=ev.guidance)
+    result = evaluate_t2m(evaluator, dataset, generate, config, progress=ctx.progress)
     write_json(ctx.out / "evaluation" / "evaluation.json", result)
     gen = result["summary"].get("generated", {})
     return {k: gen[k]["mean"] for k in ("r_precision_top3", "fid", "sliding", "skate_ratio") if k in gen}
