@@ -29,10 +29,19 @@ DESIGNS: dict[str, dict[str, Any]] = {
     "small_plain": dict(size="small", batch_size=32, lr=1e-4, losses=GeometricLossConfig(), crop=CropConfig()),
     "small_geo_crop": dict(size="small", batch_size=64, lr=2e-4, losses=_GEO, crop=_CROP),
     "mdm_geo_crop": dict(size="mdm", batch_size=64, lr=1e-4, losses=_GEO, crop=_CROP),
+    "small_lowfps2": dict(size="small", batch_size=64, lr=2e-4, losses=_GEO, crop=CropConfig(max_frames=60, trim_padding=True),
+                          factor=2),
     "tiny_plain": dict(size="tiny", batch_size=8, lr=1e-3, losses=GeometricLossConfig(), crop=CropConfig()),
+    "tiny_lowfps2": dict(size="tiny", batch_size=8, lr=1e-3, losses=GeometricLossConfig(), crop=CropConfig(), factor=2),
 }
 """Named backbone/training designs: MDM's transformer (``mdm`` 8×512 or ``small`` 4×256) with or
-without MDM's velocity/foot-contact losses and 120-frame crops. ``tiny_plain`` is for smoke tests."""
+without MDM's velocity/foot-contact losses and 120-frame crops; ``factor`` 2: the cheaper design,
+trained at 10 fps and upsampled to 20 fps (:mod:`simdiff.train.lowfps`). ``tiny_*`` for smoke tests."""
+
+
+def design_factor(name: str) -> int:
+    """Frame-rate reduction of design ``name`` (1: trained at 20 fps)."""
+    return int(DESIGNS.get(name, {}).get("factor", 1))
 
 
 def design_config(name: str, text_encoder: str, text_dim: int, seed: int, steps: int = 10**9) -> RunConfig:
@@ -55,8 +64,12 @@ class HeldOut:
     gt: dict[str, float]
 
 
-def held_out(dataset: Any, n: int, seed: int, evaluator: Any = None) -> HeldOut:
-    """``n`` held-out items drawn with a fixed seed, and the GT's sliding, skate ratio (and R@3)."""
+def held_out(dataset: Any, n: int, seed: int, evaluator: Any = None, factor: int = 1) -> HeldOut:
+    """``n`` held-out items drawn with a fixed seed, and the GT's sliding, skate ratio (and R@3).
+
+    With ``factor`` > 1 (a low-frame-rate dataset) the GT metrics are those of the GT upsampled
+    to 20 fps, the floor the design can reach.
+    """
     from simdiff.train.data import collate
 
     rng = np.random.default_rng([seed, 99])
@@ -64,14 +77,27 @@ def held_out(dataset: Any, n: int, seed: int, evaluator: Any = None) -> HeldOut:
     batch = collate([dataset.get(int(i), rng) for i in idx])
     raw = dataset.normalizer.denormalize(batch["motion"]) * batch["mask"][..., None]
     batch["raw"] = raw
-    return HeldOut(batch, _sample_metrics(raw, batch, evaluator))
+    return HeldOut(batch, _sample_metrics(raw, batch, evaluator, factor))
 
 
-def _sample_metrics(raw: torch.Tensor, batch: dict[str, Any], evaluator: Any) -> dict[str, float]:
+def _upsample_batch(raw: torch.Tensor, lengths: torch.Tensor, factor: int) -> tuple[torch.Tensor, torch.Tensor]:
+    """Low-rate (B, L, 263) raw features → 20 fps (B, L·factor, 263) and their lengths."""
+    from simdiff.train.lowfps import upsample_features
+
+    ups = [upsample_features(raw[i, : int(n)].double().numpy(), factor) for i, n in enumerate(lengths)]
+    out = torch.zeros(len(ups), max(len(u) for u in ups), raw.shape[-1])
+    for i, u in enumerate(ups):
+        out[i, : len(u)] = torch.from_numpy(np.asarray(u, dtype=np.float32))
+    return out, torch.tensor([len(u) for u in ups])
+
+
+def _sample_metrics(raw: torch.Tensor, batch: dict[str, Any], evaluator: Any, factor: int = 1) -> dict[str, float]:
     from simdiff.motion.features import features_to_joints
     from simdiff.motion.metrics import physics_metrics
 
     lengths = batch["lengths"]
+    if factor > 1:
+        raw, lengths = _upsample_batch(raw, lengths, factor)
     joints = features_to_joints(raw.detach().double())
     phys = physics_metrics(joints.numpy(), lengths.clamp(min=2).numpy())
     out: dict[str, Any] = {"sliding": phys["sliding"], "skate_ratio": phys["skate_ratio"], "r_precision_top3": None}
@@ -106,7 +132,8 @@ def heldout_loss(trainer: Any, held: HeldOut, draws: int = 4) -> float:
     return total / draws
 
 
-def sample_metrics(trainer: Any, held: HeldOut, evaluator: Any, steps: int, guidance: float) -> dict[str, float]:
+def sample_metrics(trainer: Any, held: HeldOut, evaluator: Any, steps: int, guidance: float,
+                   factor: int = 1) -> dict[str, float]:
     """Metrics of DDIM samples (the exported, EMA weights) for the held-out captions and lengths."""
     from simdiff.model.checkpoint import build_network
     from simdiff.model.generator import MotionGenerator
@@ -116,11 +143,12 @@ def sample_metrics(trainer: Any, held: HeldOut, evaluator: Any, steps: int, guid
     gen = MotionGenerator(net, trainer.config.model, trainer.text, trainer.mean, trainer.std, trainer.device)
     lengths = [int(n) for n in held.batch["lengths"]]
     feats = gen.generate(held.batch["captions"], lengths, steps=steps, guidance=guidance, seed=0).features.cpu()
-    return _sample_metrics(feats, {**held.batch, "lengths": torch.tensor(lengths)}, evaluator)
+    return _sample_metrics(feats, {**held.batch, "lengths": torch.tensor(lengths)}, evaluator, factor)
 
 
 def run_curve(trainer: Any, held: HeldOut, minutes: float, points: int, *, evaluator: Any = None,
-              sample_steps: int = 20, guidance: float = 2.5, log: Callable[[str], None] = print) -> list[dict[str, Any]]:
+              sample_steps: int = 20, guidance: float = 2.5, factor: int = 1,
+              log: Callable[[str], None] = print) -> list[dict[str, Any]]:
     """Train for ``minutes`` of CPU time (training only), evaluating ``points`` times evenly; returns the points."""
     budget = 60.0 * minutes
     rows: list[dict[str, Any]] = []
@@ -136,7 +164,7 @@ def run_curve(trainer: Any, held: HeldOut, minutes: float, points: int, *, evalu
             wall += time.perf_counter() - w0
         row = {"step": trainer.step, "cpu_s": round(cpu, 2), "cpu_h": cpu / 3600.0, "wall_s": round(wall, 2),
                "train_loss": float(np.mean(losses)) if losses else None, "heldout_loss": heldout_loss(trainer, held)}
-        row.update(sample_metrics(trainer, held, evaluator, sample_steps, guidance))
+        row.update(sample_metrics(trainer, held, evaluator, sample_steps, guidance, factor))
         rows.append(row)
         log(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
     return rows
