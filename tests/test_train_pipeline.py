@@ -134,3 +134,21 @@ def test_wall_clock_cap_stops_training_at_a_checkpoint(tmp_path) -> None:
     summary = _train(ctx, trainer, max_minutes=1e-9)
     assert summary["step"] == 3 and summary["steps"] == 9
     assert latest_checkpoint(tmp_path).name == "step_000000003"
+
+
+class RejectingProjector(EchoProjector):
+    """Every rollout fails the faithfulness test."""
+
+    def __call__(self, motions, envs):
+        for rollout, info in super().__call__(motions, envs):
+            yield rollout, {**info, "d_l2_pose": 99.0}
+
+
+def test_empty_augmented_corpus_is_a_clear_error(corpus, tmp_path) -> None:
+    config = budget_config("quick")
+    config.corpus.path = str(corpus)
+    with pytest.raises(SimdiffError, match="kept no training clip.*report.md"):
+        run_pipeline(config, tmp_path, text_encoder=HashTextEncoder(), projector=RejectingProjector(), progress=False,
+                     log=lambda line: None)
+    assert json.loads((tmp_path / "stages" / "backbone.json").read_text())["key"]  # upstream work is kept
+    assert not (tmp_path / "stages" / "adapters.json").exists()

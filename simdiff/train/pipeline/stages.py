@@ -140,6 +140,9 @@ def run_adapters(ctx: PipelineContext) -> dict[str, Any]:
     train = TrainConfig(mode="adapters", steps=a.steps, batch_size=a.batch_size, seed=seed, ema=a.ema,
                         ema_decay=a.ema_decay, save_every=a.save_every, optim=OptimConfig(lr=a.lr))
     dataset = open_training_dataset(ctx.augmented_dir(), "train", seed)
+    if len(dataset) == 0:
+        raise SimdiffError(f"{ctx.augmented_dir()}: the augmented corpus kept no training clip "
+                           f"(see its report.md; loosen the filter or augment more clips, e.g. --set augment.limit=64)")
     trainer = Trainer(ctx.out / "adapters", RunConfig(model=model, train=train), dataset, text_encoder=ctx.text(),
                       device=ctx.device, init_model=init)
     return _train(ctx, trainer, a.max_minutes)
