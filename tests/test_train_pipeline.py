@@ -69,6 +69,12 @@ def test_quick_pipeline_runs_skips_and_reruns_downstream(corpus, tmp_path) -> No
     assert (out / "backbone" / "model" / "model.safetensors").stat().st_mtime_ns == mtime
     assert json.loads((out / "stages" / "adapters.json").read_text())["summary"]["step"] == 5
 
+    set_option(config, "augment.filter.max_pose_d_l2=3.0")  # the simulation starts afresh, the backbone is kept
+    refiltered, _ = _run(config, out)
+    assert refiltered["augment"] == "run" and refiltered["backbone"] == "current" and refiltered["adapters"] == "run"
+    settings = json.loads((out / "augmented" / "augment_settings.json").read_text())
+    assert settings["filter"]["max_pose_d_l2"] == 3.0
+
     config.seed += 1
     dry, lines = _run(config, out, dry_run=True)
     assert dry["corpus"] == "current" and all(dry[s] == "run" for s in STAGES[1:])
@@ -106,6 +112,10 @@ def test_bad_settings_are_one_line_errors(corpus) -> None:
     with pytest.raises(SimdiffError, match="must be int"):
         set_option(config, "backbone.steps=many")
     assert budget_config("gpu").backbone.size == "mdm" and budget_config("gpu").augment.workers == 16
+    set_option(config, "augment.filter.max_pose_d_l2=4")  # a frozen section: replaced, not mutated
+    set_option(config, "evaluation.env=[-3.7, 0, 0]")
+    assert config.augment.filter.max_pose_d_l2 == 4.0 and config.evaluation.env == (-3.7, 0, 0)
+    assert budget_config("quick").augment.filter.max_pose_d_l2 != 4.0
 
 
 def test_cli_dry_run_prints_the_plan(corpus, tmp_path, capsys) -> None:

@@ -6,6 +6,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
+from simdiff.data.augment.filter import FilterConfig
 from simdiff.errors import SimdiffError
 from simdiff.train.geometric import CropConfig, GeometricLossConfig
 
@@ -30,7 +31,11 @@ class CorpusStage:
 
 @dataclass
 class AugmentStage:
-    """Simulator augmentation (``simdiff.data.augment``); ``path``: use an existing augmented corpus/pack."""
+    """Simulator augmentation (``simdiff.data.augment``); ``path``: use an existing augmented corpus/pack.
+
+    ``filter``: the keep thresholds (``max_pose_d_l2`` is in normalised feature units, so it depends
+    on the corpus's Std).
+    """
 
     path: str = ""
     mode: str = "paired"
@@ -39,6 +44,7 @@ class AugmentStage:
     shard_size: int = 4
     residual_bound: float = 0.5
     workers: int = 0
+    filter: FilterConfig = field(default_factory=FilterConfig)
 
 
 @dataclass
@@ -189,10 +195,12 @@ def set_option(config: PipelineConfig, assignment: str) -> None:
         value = raw
     target: Any = config
     parts = dotted.split(".")
+    chain: list[Any] = [config]
     for part in parts[:-1]:
         if not dataclasses.is_dataclass(target) or not hasattr(target, part):
             raise SimdiffError(f"--set {assignment!r}: no section {part!r}")
         target = getattr(target, part)
+        chain.append(target)
     if not dataclasses.is_dataclass(target) or parts[-1] not in {f.name for f in dataclasses.fields(target)}:
         raise SimdiffError(f"--set {assignment!r}: unknown setting {dotted!r}")
     old = getattr(target, parts[-1])
@@ -202,4 +210,11 @@ def set_option(config: PipelineConfig, assignment: str) -> None:
         value = float(value)
     if old is not None and value is not None and not isinstance(value, type(old)):
         raise SimdiffError(f"--set {assignment!r}: {dotted} must be {type(old).__name__}, got {value!r}")
-    setattr(target, parts[-1], value)
+    # frozen sections (FilterConfig) are replaced, and the replacement is set on their parent
+    for depth in range(len(parts) - 1, -1, -1):
+        holder = chain[depth]
+        if not getattr(holder, "__dataclass_params__").frozen:
+            setattr(holder, parts[depth], value)
+            return
+        value = dataclasses.replace(holder, **{parts[depth]: value})
+    raise SimdiffError(f"--set {assignment!r}: the config is frozen")

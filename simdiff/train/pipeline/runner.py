@@ -57,10 +57,21 @@ def format_plan(plans: list[StagePlan]) -> str:
     return "\n".join(f"{p.name:<11} {p.status:<8} {p.key[:12]}" for p in plans)
 
 
-def _reset(ctx: PipelineContext, name: str) -> None:
-    """Drop a stale stage's own outputs (never an input folder given by path)."""
+def _reset(ctx: PipelineContext, name: str, settings: dict[str, Any]) -> None:
+    """Drop a stale stage's own outputs (never an input folder given by path).
+
+    The pipeline's own augmented corpus is kept when only ``limit`` changed (the augmentation
+    then resumes and extends it); any other change of its settings starts it afresh.
+    """
+    previous = (read_marker(ctx.out, name) or read_marker(ctx.out, name, started=True) or {}).get("settings")
     clear_marker(ctx.out, name)
     folder = OWN_FOLDER.get(name)
+    if name == "augment" and not ctx.config.augment.path and previous is not None:
+        def strip(d: dict[str, Any]) -> dict[str, Any]:
+            return {k: v for k, v in d.items() if k != "limit"}
+
+        if strip(previous) != strip(settings):
+            folder = "augmented"
     if name == "corpus" and ctx.corpus_dir() == ctx.out / "corpus" and ctx.config.corpus.path:
         folder = "corpus"  # an unpacked pack: redo from scratch (a built corpus resumes from its item cache)
     if name == "augment" and ctx.augmented_dir() == ctx.out / "augmented" and ctx.config.augment.path:
@@ -92,7 +103,7 @@ def run_pipeline(config: PipelineConfig, out: str | Path, *, device: torch.devic
             log(f"[{i + 1}/{len(plans)}] {p.name}: current, skipped")
             continue
         if p.status == "run":
-            _reset(ctx, p.name)
+            _reset(ctx, p.name, p.settings)
         write_marker(out, p.name, {"key": p.key, "settings": p.settings}, started=True)
         log(f"[{i + 1}/{len(plans)}] {p.name}: {'resuming' if p.status == 'resume' else 'running'}")
         start = time.monotonic()

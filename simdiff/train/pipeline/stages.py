@@ -71,7 +71,8 @@ def run_augment(ctx: PipelineContext) -> dict[str, Any]:
     from simdiff.data.augment import AugmentConfig, augment
 
     cfg = AugmentConfig(mode=a.mode, conditions=a.conditions, seed=ctx.config.seed, limit=a.limit,
-                        shard_size=a.shard_size, residual_bound=a.residual_bound, workers=a.workers)
+                        shard_size=a.shard_size, residual_bound=a.residual_bound, workers=a.workers,
+                        filter=dataclasses.replace(a.filter))
     report = augment(ctx.corpus_dir(), ctx.augmented_dir(), cfg, projector=ctx.projector, progress=ctx.progress)
     return {"kept": report.get("kept"), "pairs": report.get("pairs")}
 
