@@ -112,10 +112,11 @@ def _clip_frames(path: Path) -> int:
     return int(arr.shape[0])
 
 
-def build_items(root: str | Path, ids: list[str]) -> list[Item]:
+def build_items(root: str | Path, ids: list[str], min_frames: int = MIN_FRAMES) -> list[Item]:
     """Dataset items for ``ids`` under ``root`` by MDM's rules (see module docstring).
 
-    Ids whose motion or text file is missing are skipped, as MDM does.
+    Ids whose motion or text file is missing are skipped, as MDM does. ``min_frames``: shortest
+    clip or segment kept (MDM: 40 frames = 2 s at 20 fps; a 10 fps corpus keeps 2 s with 20).
     """
     root = Path(root)
     items: list[Item] = []
@@ -125,7 +126,7 @@ def build_items(root: str | Path, ids: list[str]) -> list[Item]:
         if not motion_path.is_file() or not text_path.is_file():
             continue
         frames = _clip_frames(motion_path)
-        if frames < MIN_FRAMES or frames >= MAX_CLIP_FRAMES:
+        if frames < min_frames or frames >= MAX_CLIP_FRAMES:
             continue
         whole: list[Caption] = []
         seen: dict[str, int] = {}
@@ -135,7 +136,7 @@ def build_items(root: str | Path, ids: list[str]) -> list[Item]:
                 continue
             start, stop = int(caption.start * FPS), int(caption.end * FPS)
             stop = min(stop, frames)  # Python slicing clips the end the same way
-            if stop - start < MIN_FRAMES or stop - start >= MAX_CLIP_FRAMES:
+            if stop - start < min_frames or stop - start >= MAX_CLIP_FRAMES:
                 continue
             name = f"{clip_id}_{start}_{stop}"
             seen[name] = seen.get(name, 0) + 1
@@ -170,6 +171,7 @@ class HumanML3D(Dataset):
         max_frames: padded length (196).
         seed: seeds the caption/crop generator; each DataLoader worker (and each epoch of
             non-persistent workers) derives its own stream from it and the worker's seed.
+        min_frames: shortest clip kept (MDM: 40; lower for a lower-frame-rate corpus).
     """
 
     def __init__(
@@ -180,6 +182,7 @@ class HumanML3D(Dataset):
         unit_length: int = 4,
         max_frames: int = MAX_FRAMES,
         seed: int = 0,
+        min_frames: int = MIN_FRAMES,
     ) -> None:
         self.root = Path(root)
         if not self.root.is_dir():
@@ -198,7 +201,7 @@ class HumanML3D(Dataset):
         self.unit_length = unit_length
         self.max_frames = max_frames
         self.seed = seed
-        self.items = build_items(self.root, ids)
+        self.items = build_items(self.root, ids, min_frames)
         self._rng: np.random.Generator | None = None
         self._rng_key: int | None = None
 

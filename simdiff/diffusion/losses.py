@@ -29,15 +29,21 @@ def masked_mse(pred: Tensor, target: Tensor, mask: Tensor) -> Tensor:
     return per_sample.mean()
 
 
+def diffusion_prediction(denoiser: Denoiser, scheduler: BaseScheduler, x0: Tensor, cond: Condition,
+                         generator: torch.Generator | None = None) -> Tensor:
+    """Draw t ~ U{0..T−1} and ε ~ N(0, I), noise ``x0`` to x_t and return the predicted x₀ (B, T, F)."""
+    b = x0.shape[0]
+    gen_device = generator.device if generator is not None else x0.device
+    t = torch.randint(0, scheduler.num_train_timesteps, (b,), generator=generator, device=gen_device).to(x0.device)
+    noise = torch.randn(x0.shape, generator=generator, device=gen_device).to(x0.device)
+    x_t = scheduler.add_noise(x0, noise, t)
+    return denoiser(x_t, t, cond)
+
+
 def diffusion_loss(denoiser: Denoiser, scheduler: BaseScheduler, x0: Tensor, cond: Condition, mask: Tensor,
                    generator: torch.Generator | None = None) -> Tensor:
     """One Monte-Carlo draw of the loss: t ~ U{0..T−1}, ε ~ N(0, I), predict x₀ from x_t.
 
     x0: (B, T, F) normalised, zero-padded; mask: (B, T) valid frames.
     """
-    b = x0.shape[0]
-    gen_device = generator.device if generator is not None else x0.device
-    t = torch.randint(0, scheduler.num_train_timesteps, (b,), generator=generator, device=gen_device).to(x0.device)
-    noise = torch.randn(x0.shape, generator=generator, device=gen_device).to(x0.device)
-    x_t = scheduler.add_noise(x0, noise, t)
-    return masked_mse(denoiser(x_t, t, cond), x0, mask)
+    return masked_mse(diffusion_prediction(denoiser, scheduler, x0, cond, generator), x0, mask)

@@ -86,12 +86,18 @@ def read_config(folder: str | os.PathLike[str]) -> ModelConfig:
 
 
 def load_pretrained(folder: str | os.PathLike[str], device: torch.device | str = "cpu") -> tuple[nn.Module, ModelConfig, dict[str, Tensor]]:
-    """Load a model folder; returns ``(network, config, extra_tensors)`` with the network on ``device``."""
+    """Load a model folder (whole ``model.safetensors`` or shards with an index); returns
+    ``(network, config, extra_tensors)`` with the network on ``device``."""
     config = read_config(folder)
     path = Path(folder) / WEIGHTS_NAME
-    if not path.is_file():
+    from simdiff.model.shards import INDEX_NAME, load_sharded
+
+    if path.is_file():
+        tensors = load_file(str(path), device="cpu")
+    elif (Path(folder) / INDEX_NAME).is_file():
+        tensors = load_sharded(folder)
+    else:
         raise SimdiffError(f"{path}: no such file")
-    tensors = load_file(str(path), device="cpu")
     network = build_network(config)
     own = set(network.state_dict())
     extra = {k: v for k, v in tensors.items() if k not in own}

@@ -38,6 +38,8 @@ def check_model_dir(model: str | os.PathLike[str] | None = None) -> Path:
     """
     folder = default_model_dir(model)
     for name in ("config.json", "model.safetensors"):
+        if name == "model.safetensors" and (folder / "model.safetensors.index.json").is_file():
+            continue  # sharded weights
         if not (folder / name).is_file():
             if model is None and not os.environ.get(MODEL_ENV_VAR):
                 raise SimdiffError(f"no default model installed ({folder / name} is missing); "

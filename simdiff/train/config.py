@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from simdiff.model.config import ModelConfig
+from simdiff.train.geometric import CropConfig, GeometricLossConfig
 
 
 @dataclass
@@ -32,6 +33,8 @@ class TrainConfig:
         save_every: checkpoint period in steps (0: only at the end).
         keep_checkpoints: how many step folders to keep.
         log_every: loss averaging window for the progress bar.
+        losses: MDM's geometric loss weights (all 0 by default: plain x₀ MSE).
+        crop: length-cropped batches (off by default).
     """
 
     mode: str = "backbone"
@@ -45,6 +48,8 @@ class TrainConfig:
     keep_checkpoints: int = 2
     log_every: int = 10
     optim: OptimConfig = field(default_factory=OptimConfig)
+    losses: GeometricLossConfig = field(default_factory=GeometricLossConfig)
+    crop: CropConfig = field(default_factory=CropConfig)
 
 
 @dataclass

@@ -35,3 +35,20 @@ def tiny_run_config(steps: int = 10, mode: str = "backbone", sim: bool = False, 
     train.setdefault("batch_size", 4)
     train.setdefault("save_every", 0)
     return RunConfig(model=model, train=TrainConfig(mode=mode, steps=steps, optim=OptimConfig(lr=lr), **train))
+
+
+class EchoProjector:
+    """Stands in for the simulator in tests: the rollout is the reference itself and every pair
+    passes the keep filter (small pose distance and residual)."""
+
+    def __init__(self) -> None:
+        self.pairs = 0
+
+    def __call__(self, motions: Sequence[Any], envs: Sequence[Any]) -> Any:
+        import numpy as np
+
+        for m in motions:
+            self.pairs += 1
+            yield np.asarray(m, dtype=np.float32), {"success": True, "d_l2_pose": 0.5, "d_l2": 0.5,
+                                                     "residual": {"force_mean_n": 1.0, "force_mean_mg": 0.01},
+                                                     "cpu_s": 0.0}

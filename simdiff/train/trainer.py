@@ -21,7 +21,7 @@ import torch
 from torch import Tensor, nn
 
 from simdiff.diffusion.ddpm import DDPMScheduler
-from simdiff.diffusion.losses import diffusion_loss
+from simdiff.diffusion.losses import diffusion_prediction, masked_mse
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import build_network, load_pretrained, save_pretrained
 from simdiff.model.condition import Condition
@@ -30,6 +30,7 @@ from simdiff.text.cache import CachedTextEncoder
 from simdiff.train.config import RunConfig
 from simdiff.train.data import MotionDataset, StepBatcher, collate, fetch
 from simdiff.train.ema import EMA
+from simdiff.train.geometric import crop_batch, geometric_loss
 from simdiff.train.state import latest_checkpoint, read_checkpoint, write_checkpoint
 
 
@@ -158,7 +159,8 @@ class Trainer:
     def batch(self, step: int) -> dict[str, Any]:
         """The collated batch of step ``step`` for this process."""
         rng = np.random.default_rng([self.config.train.seed, step, self.rank])
-        return collate([fetch(self.dataset, i, rng) for i in self.batcher.indices(step)])
+        batch = collate([fetch(self.dataset, i, rng) for i in self.batcher.indices(step)])
+        return crop_batch(batch, self.config.train.crop, rng)
 
     def condition(self, batch: dict[str, Any], generator: torch.Generator) -> Condition:
         """Text vectors with per-sample dropout (p = ``cond_mask_prob``) and φ (never dropped)."""
@@ -187,7 +189,10 @@ class Trainer:
         torch.manual_seed(dropout_seed)
         x0 = batch["motion"].to(self.device)
         mask = batch["mask"].to(self.device)
-        loss = diffusion_loss(self.model, self.scheduler, x0, cond, mask, generator=generator)
+        pred = diffusion_prediction(self.model, self.scheduler, x0, cond, generator=generator)
+        loss = masked_mse(pred, x0, mask)
+        if tc.losses.active:
+            loss = loss + geometric_loss(pred, x0, mask, self.mean, self.std, tc.losses)
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
         if tc.optim.grad_clip > 0:

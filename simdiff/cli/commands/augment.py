@@ -49,12 +49,13 @@ def run(args: argparse.Namespace) -> int:
     from simdiff.data.augment.filter import FilterConfig
     from simdiff.data.augment.run import AugmentConfig, augment
 
+    defaults = FilterConfig()
+    pose = defaults.max_pose_d_l2 if args.max_pose_d_l2 is None else args.max_pose_d_l2
+    residual_n = defaults.max_residual_n if args.max_residual_n is None else args.max_residual_n
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
-                           filter=FilterConfig(
-                               max_pose_d_l2=FilterConfig.max_pose_d_l2 if args.max_pose_d_l2 is None else args.max_pose_d_l2,
-                               max_residual_n=FilterConfig.max_residual_n if args.max_residual_n is None else args.max_residual_n,
-                               max_d_l2=args.max_d_l2, max_residual=args.max_residual),
+                           filter=FilterConfig(max_pose_d_l2=pose, max_residual_n=residual_n,
+                                               max_d_l2=args.max_d_l2, max_residual=args.max_residual),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)

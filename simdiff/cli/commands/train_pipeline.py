@@ -1,0 +1,102 @@
+"""``simdiff train pipeline`` (every stage, resumable, skips current stages) and ``train pack`` / ``unpack``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from simdiff.cli.main import command_group
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    group = command_group(subparsers, "train", "train the diffusion backbone or SimDiff's adapters")
+    p = group.add_parser("pipeline", help="corpus → augmentation → backbone → adapters → evaluator → evaluation → export",
+                         description="Run every stale stage of the training pipeline into --out. Each stage leaves "
+                                     "stages/<name>.json (hash of its settings and inputs) and is skipped when current; "
+                                     "interrupted stages resume.")
+    p.add_argument("--budget", choices=["quick", "cpu", "gpu"], default="cpu", help="settings preset (default cpu)")
+    p.add_argument("--out", type=Path, required=True, help="run folder")
+    p.add_argument("--corpus", help="HumanML3D-layout corpus or pack folder (else --shared builds one)")
+    p.add_argument("--shared", help="shared data root to build the corpus from")
+    p.add_argument("--augmented", help="an existing augmented corpus or pack (skips the simulation)")
+    p.add_argument("--config", type=Path, help="a pipeline config JSON (as written to <out>/pipeline_config.json)")
+    p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                   help="override a setting, e.g. backbone.steps=500 (repeatable)")
+    p.add_argument("--seed", type=int, help="seed of every stage (default 10)")
+    p.add_argument("--sim-workers", type=int, help="simulation processes (0 = all cores)")
+    p.add_argument("--device", default="cpu", help="torch device for training and evaluation (cpu, cuda)")
+    p.add_argument("--dry-run", action="store_true", help="print the plan (stage, current/resume/run, key) and stop")
+    p.add_argument("--no-progress", action="store_true", help="hide progress bars")
+    p.set_defaults(func=run_pipeline_cmd)
+
+    k = group.add_parser("pack", help="write a corpus as compact arrays (for carrying to a GPU machine)")
+    k.add_argument("corpus", type=Path, help="HumanML3D-layout corpus folder")
+    k.add_argument("--out", type=Path, required=True, help="pack folder")
+    k.add_argument("--dtype", choices=["float16", "float32"], default="float16", help="feature dtype (float32: exact)")
+    k.add_argument("--splits", nargs="+", help="pack only these split files' clips (default all)")
+    k.add_argument("--budget-mib", type=float, default=64.0, help="refuse a pack larger than this (0: no check)")
+    k.set_defaults(func=run_pack)
+
+    u = group.add_parser("unpack", help="restore a pack as a HumanML3D-layout corpus folder")
+    u.add_argument("pack", type=Path, help="pack folder")
+    u.add_argument("--out", type=Path, required=True, help="corpus folder to write")
+    u.set_defaults(func=run_unpack)
+
+
+def _config(args: argparse.Namespace):
+    import json
+
+    from simdiff.errors import SimdiffError
+    from simdiff.model.config import config_from_dict
+    from simdiff.train.pipeline.config import PipelineConfig, budget_config, set_option
+
+    if args.config is not None:
+        try:
+            config = config_from_dict(json.loads(args.config.read_text()), PipelineConfig)
+        except (OSError, json.JSONDecodeError) as exc:
+            raise SimdiffError(f"{args.config}: cannot read pipeline config ({type(exc).__name__})") from None
+    else:
+        config = budget_config(args.budget)
+    for flag, setting in (("corpus", "corpus.path"), ("shared", "corpus.shared"), ("augmented", "augment.path")):
+        if getattr(args, flag):
+            set_option(config, f"{setting}={json.dumps(str(getattr(args, flag)))}")
+    if args.seed is not None:
+        config.seed = args.seed
+    if args.sim_workers is not None:
+        config.augment.workers = config.corpus.workers = args.sim_workers
+    for assignment in args.set:
+        set_option(config, assignment)
+    if isinstance(config.evaluation.env, list):
+        config.evaluation.env = tuple(config.evaluation.env)
+    return config
+
+
+def run_pipeline_cmd(args: argparse.Namespace) -> int:
+    import torch
+
+    from simdiff.errors import SimdiffError
+    from simdiff.train.pipeline import run_pipeline
+
+    try:
+        device = torch.device(args.device)
+    except RuntimeError:
+        raise SimdiffError(f"unknown device {args.device!r}") from None
+    run_pipeline(_config(args), args.out, device=device, dry_run=args.dry_run, progress=not args.no_progress)
+    return 0
+
+
+def run_pack(args: argparse.Namespace) -> int:
+    from simdiff.data.pack import pack
+
+    info = pack(args.corpus, args.out, dtype=args.dtype, budget_mib=args.budget_mib, splits=args.splits)
+    print(f"packed {info['clips']} clips, {info['frames']} frames ({info['dtype']}): "
+          f"{info['bytes'] / 2**20:.2f} MiB in {args.out}")
+    return 0
+
+
+def run_unpack(args: argparse.Namespace) -> int:
+    from simdiff.data.pack import unpack
+
+    n = unpack(args.pack, args.out)
+    print(f"unpacked {n} clips into {args.out}")
+    return 0

@@ -1,0 +1,53 @@
+"""Learning-curve tooling: points are measured in training CPU time, written as JSON and a PNG."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+import torch
+
+from simdiff.errors import SimdiffError
+from simdiff.eval.testing import write_tiny_corpus
+from simdiff.train.curves import DESIGNS, design_config
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(autouse=True)
+def _one_thread():
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+def test_train_curves_script_writes_json_and_png(tmp_path) -> None:
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=8, n_val=4, n_test=4, frames=48)
+    spec = importlib.util.spec_from_file_location("train_curves", ROOT / "benchmarks" / "train_curves.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    out = tmp_path / "reports"
+    argv = ["--corpus", str(corpus), "--design", "tiny_plain", "--minutes", "0.02", "--points", "2",
+            "--text-encoder", "hash", "--out", str(out), "--heldout", "4", "--sample-steps", "2"]
+    assert module.main(argv) == 0
+    curves = json.loads((out / "curves.json").read_text())
+    pts = curves["tiny_plain"]["points"]
+    assert len(pts) == 2 and pts[1]["step"] > pts[0]["step"] >= 1 and pts[1]["cpu_s"] >= 1.2
+    for row in pts:
+        assert row["heldout_loss"] > 0 and row["sliding"] >= 0 and 0 <= row["skate_ratio"] <= 1
+        assert row["r_precision_top3"] is None  # no evaluator given: not measured
+    assert curves["tiny_plain"]["heldout_split"] == "val"
+    assert (out / "curves.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_designs_are_mdm_transformers_with_optional_geometric_losses() -> None:
+    assert design_config("mdm_geo_crop", "minilm", 384, 0).model.backbone.num_layers == 8
+    geo = design_config("small_geo_crop", "minilm", 384, 0).train
+    assert geo.losses.velocity > 0 and geo.crop.max_frames == 120
+    assert not design_config("small_plain", "minilm", 384, 0).train.losses.active
+    assert set(DESIGNS) >= {"small_plain", "small_geo_crop", "mdm_geo_crop"}
+    with pytest.raises(SimdiffError, match="unknown design"):
+        design_config("latent", "minilm", 384, 0)

@@ -1,0 +1,143 @@
+"""GPU packaging on CPU: corpus pack/unpack, weight shards, and the device script's tiny-step rehearsal."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from simdiff.cli.main import main
+from simdiff.data.augment import AugmentConfig, augment
+from simdiff.data.pack import pack, unpack
+from simdiff.errors import SimdiffError
+from simdiff.eval.testing import write_tiny_corpus
+from simdiff.model.checkpoint import build_network, load_pretrained, save_pretrained
+from simdiff.model.config import ModelConfig, SimConfig, backbone_preset
+from simdiff.model.generator import MotionGenerator
+from simdiff.model.shards import INDEX_NAME, load_sharded, shard_model_folder, shard_tensors
+from simdiff.motion.features import features_to_joints
+from simdiff.train.testing import EchoProjector, HashTextEncoder
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(autouse=True)
+def _one_thread():
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+@pytest.fixture(scope="module")
+def corpus(tmp_path_factory):
+    return write_tiny_corpus(tmp_path_factory.mktemp("corpus"), n_train=8, n_val=4, n_test=4, frames=48)
+
+
+def _clips(folder: Path) -> dict[str, np.ndarray]:
+    return {p.stem: np.load(p) for p in sorted((folder / "new_joint_vecs").glob("*.npy"))}
+
+
+@pytest.mark.parametrize("dtype", ["float32", "float16"])
+def test_pack_unpack_round_trip(corpus, tmp_path, dtype) -> None:
+    info = pack(corpus, tmp_path / "pack", dtype=dtype)
+    assert info["clips"] == 16 and info["bytes"] < 2**20
+    n = unpack(tmp_path / "pack", tmp_path / "back")
+    assert n == 16
+    src, back = _clips(corpus), _clips(tmp_path / "back")
+    assert sorted(src) == sorted(back)
+    for clip, f in src.items():
+        assert back[clip].dtype == np.float32 and back[clip].shape == f.shape
+        if dtype == "float32":
+            assert np.array_equal(back[clip], f)
+        else:  # float16 rounding: relative 2^-11, absolute 6e-8 for subnormals
+            assert np.allclose(back[clip], f, rtol=2.0**-11, atol=6e-8)
+        joints = np.load(tmp_path / "back" / "new_joints" / f"{clip}.npy")
+        assert np.array_equal(joints, features_to_joints(back[clip]))
+        assert (tmp_path / "back" / "texts" / f"{clip}.txt").read_bytes() == (corpus / "texts" / f"{clip}.txt").read_bytes()
+    for name in ("Mean.npy", "Std.npy"):
+        assert np.array_equal(np.load(tmp_path / "back" / name), np.load(corpus / name))
+    for split in ("train", "val", "test", "all"):
+        assert (tmp_path / "back" / f"{split}.txt").read_text() == (corpus / f"{split}.txt").read_text()
+
+
+def test_pack_budget_and_bad_inputs(corpus, tmp_path) -> None:
+    with pytest.raises(SimdiffError, match="over the 0.01 MiB budget"):
+        pack(corpus, tmp_path / "p", budget_mib=0.01)
+    assert not (tmp_path / "p").exists()
+    with pytest.raises(SimdiffError, match="Mean.npy"):
+        pack(tmp_path, tmp_path / "p")
+    with pytest.raises(SimdiffError, match="not a simdiff-pack|cannot read pack index"):
+        (tmp_path / "bad").mkdir()
+        (tmp_path / "bad" / "pack.json").write_text("{}")
+        unpack(tmp_path / "bad", tmp_path / "o")
+    assert main(["train", "pack", str(corpus), "--out", str(tmp_path / "cli"), "--splits", "test"]) == 0
+    assert main(["train", "unpack", str(tmp_path / "cli"), "--out", str(tmp_path / "cli_back")]) == 0
+    assert sorted(_clips(tmp_path / "cli_back")) == (corpus / "test.txt").read_text().split()
+
+
+def test_shards_reassemble_bit_exactly(tmp_path) -> None:
+    g = torch.Generator().manual_seed(0)
+    tensors = {f"layer{i}.weight": torch.randn(64, 100, generator=g) for i in range(6)}
+    tensors["count"] = torch.arange(7)
+    files = shard_tensors(tensors, tmp_path, max_bytes=60_000)
+    assert len(files) >= 3 and all((tmp_path / f).stat().st_size <= 60_000 for f in files)
+    index = json.loads((tmp_path / INDEX_NAME).read_text())
+    assert set(index["weight_map"]) == set(tensors)
+    back = load_sharded(tmp_path)
+    assert all(torch.equal(back[k], v) and back[k].dtype == v.dtype for k, v in tensors.items())
+    with pytest.raises(SimdiffError, match="does not fit"):
+        shard_tensors({"big": torch.zeros(100_000)}, tmp_path / "big", max_bytes=60_000)
+    (tmp_path / files[-1]).unlink()
+    with pytest.raises(SimdiffError, match="missing"):
+        load_sharded(tmp_path)
+
+
+def test_sharded_checkpoint_loads_into_the_generator(tmp_path) -> None:
+    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())
+    torch.manual_seed(0)
+    net = build_network(config)
+    save_pretrained(tmp_path / "whole", net, config, {"normalizer.mean": torch.zeros(263), "normalizer.std": torch.ones(263)})
+    shard_model_folder(tmp_path / "whole", tmp_path / "sharded", 200_000)
+    assert not (tmp_path / "sharded" / "model.safetensors").exists()
+    a, _, extra_a = load_pretrained(tmp_path / "whole")
+    b, _, extra_b = load_pretrained(tmp_path / "sharded")
+    assert all(torch.equal(x, y) for x, y in zip(a.state_dict().values(), b.state_dict().values()))
+    assert torch.equal(extra_a["normalizer.std"], extra_b["normalizer.std"])
+    outs = []
+    for folder in ("whole", "sharded"):
+        gen = MotionGenerator.load(tmp_path / folder, load_text=False)
+        gen.text_encoder = HashTextEncoder()
+        outs.append(gen.generate(["a person walks"], 20, env=[-5.0, 0.0, 0.0], steps=3, seed=1).features)
+    assert torch.equal(outs[0], outs[1])
+
+
+def test_gpu_script_rehearsal_two_steps_from_packs(corpus, tmp_path) -> None:
+    """scripts/gpu_budget.sh with BUDGET=quick on CPU: unpack both packs, 2 backbone + 2 adapter steps, shards back."""
+    aug = tmp_path / "aug"
+    augment(corpus, aug, AugmentConfig(mode="paired", conditions=1, shard_size=4), projector=EchoProjector(), progress=False)
+    pack(corpus, tmp_path / "packs" / "corpus")
+    pack(aug, tmp_path / "packs" / "augmented")
+    out = tmp_path / "OUT"
+    out.mkdir()
+    env = {**os.environ, "OUT": str(out), "PACK": str(tmp_path / "packs" / "corpus"),
+           "AUG_PACK": str(tmp_path / "packs" / "augmented"), "BUDGET": "quick", "DEVICE": "cpu", "SIM_WORKERS": "1",
+           "PIP": "0", "PYTHON": sys.executable, "RUN": str(tmp_path / "run"), "OMP_NUM_THREADS": "1",
+           "EXTRA": "--set backbone.steps=2 --set adapters.steps=2 --set export.shard_mib=0.25",
+           "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_budget.sh")], env=env, capture_output=True, text=True,
+                          timeout=240)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    result = out / "result"
+    assert (result / "model" / INDEX_NAME).is_file() and (result / "evaluation.json").is_file()
+    assert json.loads((result / "stages" / "adapters.json").read_text())["summary"]["step"] == 2
+    assert all(p.stat().st_size <= 0.25 * 2**20 for p in (result / "model").glob("model-*.safetensors"))
+    gen = MotionGenerator.load(result / "model", load_text=False)
+    assert gen.is_simdiff
+    assert "wall_s=" in (out / "pipeline.log").read_text()
