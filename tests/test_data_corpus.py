@@ -18,7 +18,6 @@ import pytest
 
 from simdiff.cli.main import main
 from simdiff.data.corpus.build import CorpusConfig, build
-from simdiff.data.corpus.flight import flight_stats
 from simdiff.data.corpus.item import LICENCE_SETS
 from simdiff.data.corpus.registry import discover_all
 from simdiff.data.corpus.splits import assign_stratified
@@ -249,19 +248,25 @@ def test_bad_options_are_one_line_errors(shared: Path, tmp_path: Path) -> None:
 
 
 def test_flight_counts_airborne_frames() -> None:
+    """The corpus report counts flights with the shared rule (simdiff.motion.flight) on real frames."""
+    from simdiff.data.corpus.report import _flight
+
     stand = np.zeros((40, 22, 3), dtype=np.float32)
     stand[..., 1] = np.linspace(0.0, 1.6, 22)  # lowest joints on the floor
     stand[:, [7, 8], 1] = 0.08
     stand[:, [10, 11], 1] = 0.0
-    assert flight_stats(stand) == {"flight_s": 0.0, "longest_flight_s": 0.0}
+    assert _flight(stand) == {"flight_s": 0.0, "longest_flight_s": 0.0}
     jump = stand.copy()
     jump[10:16, :, 1] += 0.3  # 6 frames = 0.3 s in the air
     jump[30:32, :, 1] += 0.3  # 0.1 s hop
-    stats = flight_stats(jump)
+    stats = _flight(jump)
     assert stats["longest_flight_s"] == pytest.approx(0.3) and stats["flight_s"] == pytest.approx(0.4)
-    hands = jump.copy()
-    hands[10:16, 20, 1] = 0.0  # a hand on the floor: not flight
-    assert flight_stats(hands)["longest_flight_s"] == pytest.approx(0.1)
+    lifted = jump.copy()
+    lifted[..., 1] += 0.4  # a floor 40 cm up (a generated motion): same flights
+    assert _flight(lifted) == stats
+    handstand = stand.copy()
+    handstand[:, [7, 8, 10, 11], 1] = 1.5  # feet up the whole clip: their own level is up, not flight
+    assert _flight(handstand)["flight_s"] == 0.0
 
 
 def test_real_shared_deepmimic_duplicates(shared_data: Path, tmp_path: Path) -> None:

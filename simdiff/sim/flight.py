@@ -1,4 +1,8 @@
-"""Flights that follow gravity: the reference clock waits while the simulation flies.
+"""Flights that follow gravity: the reference clock waits while the simulation flies (online).
+
+This is the tracker's clock on simulated contacts during a rollout; the offline definition of
+flight on a finished motion (corpus report, augment signal, eval response) is
+:mod:`simdiff.motion.flight`.
 
 Under φ the simulated flight lasts as long as the take-off speed and g_z make it
 (t = 2·v/|g|), not as long as the mocap's. :class:`FlightClock` maps every control step of a

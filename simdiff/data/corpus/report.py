@@ -1,7 +1,7 @@
 """Report of a corpus built by ``simdiff data build`` (``simdiff data report``): markdown + PNG.
 
 Sections: hours by source, licence, motion type and split (originals and with mirrors);
-split stratification; captions per origin; flight time (:mod:`.flight`); physics metrics
+split stratification; captions per origin; flight time (:mod:`simdiff.motion.flight`); physics metrics
 per source with the worst clips named; canonical-frame checks; dedupe cross-checks (kept
 copy vs other copies of a trial); filmstrips per source; skipped items. Per-clip numbers
 go to ``clip_metrics.csv``.
@@ -22,10 +22,12 @@ from simdiff.data.cmu.report import (
 )
 from simdiff.data.cmu.writer import write_text
 from simdiff.data.corpus.crosscheck import TARGET_M, crosscheck_items
-from simdiff.data.corpus.flight import ANKLE_HEIGHT, GROUND_PERCENTILE, MIN_FLIGHT_S, TOE_HEIGHT, flight_stats
 from simdiff.data.corpus.item import LICENCES
 from simdiff.errors import SimdiffError
+from simdiff.motion.flight import GROUND_PERCENTILE, LIFT, LIFT_EDGE, MIN_FRAMES, flight_stats
 
+MIN_FLIGHT_S: float = 0.2
+"""A flight phase this long (s) or longer marks the clip as having real flight."""
 SPLITS: tuple[str, ...] = ("train", "val", "test")
 METRICS: tuple[str, ...] = ("penetration", "floating", "sliding", "skate_ratio")
 
@@ -48,11 +50,18 @@ def _stratification(originals: list[dict[str, Any]]) -> str:
     return _table(["motion type", "train trials", "val trials", "test trials"], rows)
 
 
+def _flight(joints: np.ndarray) -> dict[str, float]:
+    """Total and longest flight (s) of one clip, the two columns of ``clip_metrics.csv``."""
+    stats = flight_stats(joints)
+    return {"flight_s": stats["flight_total_s"], "longest_flight_s": stats["flight_s"]}
+
+
 def _flight_section(originals: list[dict[str, Any]], flights: dict[str, dict[str, float]]) -> list[str]:
     md = ["## Flight (both feet off the floor)", "",
-          f"A frame is airborne when both ankles are above {ANKLE_HEIGHT * 100:.0f} cm and both toes and every "
-          f"other joint above {TOE_HEIGHT * 100:.0f} cm over the clip's ground (the {GROUND_PERCENTILE:g}th "
-          "percentile of the per-frame lowest joint), heights only (`simdiff.data.corpus.flight`). Original "
+          f"A flight is a run of at least {MIN_FRAMES} frames where every foot joint (both ankles and toes) is "
+          f"more than {LIFT * 100:.0f} cm above its own ground level (its {GROUND_PERCENTILE:g}th percentile "
+          f"height over the clip), extended to where all are still {LIFT_EDGE * 100:.0f} cm up; heights only "
+          "(`simdiff.motion.flight`, the rule also used for augmented and generated motions). Original "
           "clips with `support: floor` only (a mirror flies as its original; `props` clips, hanging or "
           "climbing, are left out).", ""]
     originals = [c for c in originals if c.get("support", "floor") == "floor"]
@@ -145,7 +154,7 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
         raise SimdiffError(f"{corpus}/manifest.json lists no clips")
     originals = [c for c in clips if c["mirror_of"] is None]
     metrics = clip_metrics(corpus, originals)
-    flights = {c["id"]: flight_stats(np.load(corpus / "new_joints" / f"{c['id']}.npy")) for c in originals}
+    flights = {c["id"]: _flight(np.load(corpus / "new_joints" / f"{c['id']}.npy")) for c in originals}
     for row in metrics:
         row.update(flights[row["id"]])
     by_id = {m["id"]: m for m in metrics}
