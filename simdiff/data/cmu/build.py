@@ -28,9 +28,9 @@ from simdiff.data.cmu.sources import RIGS, Trial, discover
 from simdiff.data.cmu.splits import assign_splits
 from simdiff.data.cmu.windows import MAX_WINDOW, MIN_WINDOW, Window, plan_windows
 from simdiff.data.cmu.writer import write_json
-from simdiff.data.clip_files import (  # noqa: F401  (ground_contact, support_of: re-exported)
-    CONTACT_HEIGHT, MIN_GROUND_FRACTION, Pending, clip_variants, files_exist, ground_contact, load_record,
-    remove_stale, support_of, write_clip, write_splits, write_stats,
+from simdiff.data.clip_files import (
+    Pending, clip_variants, files_exist, ground_contact, load_record, remove_stale, support_of, write_clip,
+    write_splits, write_stats,
 )
 from simdiff.errors import SimdiffError
 from simdiff.fsio import file_digest
