@@ -22,6 +22,7 @@ from simdiff.data.corpus.item import LICENCE_SETS
 from simdiff.data.corpus.registry import discover_all
 from simdiff.data.corpus.splits import assign_stratified
 from simdiff.data.humanml3d import read_captions
+from mocap_fixtures import POS_ROT, bvh_text
 from test_data_cmu_build import _amc, _asf, _bvh, _deepmimic
 
 _BANDAI = [  # name, parent, offset (cm): the Bandai game rig's joint names
@@ -41,25 +42,10 @@ _BANDAI = [  # name, parent, offset (cm): the Bandai game rig's joint names
 
 def _bandai_bvh(seconds: float, speed: float, fps: int = 30) -> str:
     """A Bandai-style BVH in cm: static ``joint_Root``, ``Hips`` moving forward with swinging legs."""
-    lines = ["HIERARCHY"]
-
-    def emit(index: int, depth: int) -> None:
-        name, parent, offset = _BANDAI[index]
-        pad = "\t" * depth
-        lines.extend([f"{pad}{'ROOT' if parent is None else 'JOINT'} {name}", pad + "{",
-                      f"{pad}\tOFFSET {offset[0]} {offset[1]} {offset[2]}",
-                      f"{pad}\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"])
-        kids = [i for i, j in enumerate(_BANDAI) if j[1] == name]
-        for kid in kids:
-            emit(kid, depth + 1)
-        if not kids:
-            lines.extend([f"{pad}\tEnd Site", pad + "\t{", f"{pad}\t\tOFFSET 0 0 0", pad + "\t}"])
-        lines.append(pad + "}")
-
-    emit(0, 0)
-    frames = int(seconds * fps)
-    lines += ["MOTION", f"Frames: {frames}", f"Frame Time: {1 / fps:.6f}"]
-    for k in range(frames):
+    joints = [(name, parent, offset, POS_ROT) for name, parent, offset in _BANDAI]
+    leaves = {name: (0.0, 0.0, 0.0) for name, _, _ in _BANDAI if all(p != name for _, p, _ in _BANDAI)}
+    rows = []
+    for k in range(int(seconds * fps)):
         t = k / fps
         swing = 25 * np.sin(2 * np.pi * t * max(speed, 1.0))
         values: list[float] = []
@@ -69,8 +55,8 @@ def _bandai_bvh(seconds: float, speed: float, fps: int = 30) -> str:
                 pos = [offset[0], offset[1], offset[2] + 100.0 * speed * t]
             rot = {"UpperLeg_L": swing, "UpperLeg_R": -swing}.get(name, 0.0)
             values += pos + [0.0, rot, 0.0]
-        lines.append(" ".join(f"{v:.4f}" for v in values))
-    return "\n".join(lines) + "\n"
+        rows.append(values)
+    return bvh_text(joints, np.asarray(rows), round(1 / fps, 6), leaves)
 
 
 @pytest.fixture(scope="module")

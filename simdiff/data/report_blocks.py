@@ -8,6 +8,8 @@ figure and the filmstrips.
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 from collections import defaultdict
 from pathlib import Path
@@ -15,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from simdiff.data.cmu.writer import write_text
 from simdiff.errors import SimdiffError
 from simdiff.fsio import atomic_path
 from simdiff.motion.skeleton import FPS
@@ -193,3 +196,17 @@ def open_report(corpus: str | Path, out: str | Path | None) -> tuple[Path, dict[
     if not clips:
         raise SimdiffError(f"{corpus}/manifest.json lists no clips")
     return corpus, manifest, folder, clips
+
+
+def write_report_files(out: Path, md: list[str], metrics: list[dict[str, Any]]) -> Path:
+    """Write ``report.md`` (the Markdown lines) and ``clip_metrics.csv`` (floats with 4 decimals)
+    into ``out``; returns the path of ``report.md``."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(metrics[0].keys()), lineterminator="\n")
+    writer.writeheader()
+    for row in metrics:
+        writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
+    write_text(out / "clip_metrics.csv", buffer.getvalue())
+    report = out / "report.md"
+    write_text(report, "\n".join(md) + "\n")
+    return report

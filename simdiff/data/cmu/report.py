@@ -8,8 +8,6 @@ each source and motion type. Per-clip numbers go to ``clip_metrics.csv``.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 from collections import defaultdict
 from pathlib import Path
@@ -17,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.data.cmu.writer import write_json, write_text
+from simdiff.data.cmu.writer import write_json
 from simdiff.data.report_blocks import (
-    clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table,
+    clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table, write_report_files,
 )
 from simdiff.errors import SimdiffError
 from simdiff.fsio import file_digest
@@ -267,12 +265,4 @@ def write_report(
         md += [f"- {reason}: {len(ids)} ({', '.join(ids)})" for reason, ids in sorted(reasons.items())]
         md += [""]
 
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=list(metrics[0].keys()), lineterminator="\n")
-    writer.writeheader()
-    for row in metrics:
-        writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
-    write_text(out / "clip_metrics.csv", buffer.getvalue())
-    report = out / "report.md"
-    write_text(report, "\n".join(md) + "\n")
-    return report
+    return write_report_files(out, md, metrics)

@@ -9,19 +9,16 @@ go to ``clip_metrics.csv``.
 
 from __future__ import annotations
 
-import csv
-import io
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from simdiff.data.cmu.writer import write_text
 from simdiff.data.corpus.crosscheck import TARGET_M, crosscheck_items
 from simdiff.data.corpus.item import LICENCES
 from simdiff.data.report_blocks import (
-    clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table,
+    clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table, write_report_files,
 )
 from simdiff.motion.flight import GROUND_PERCENTILE, LIFT, LIFT_EDGE, MIN_FRAMES, flight_stats
 
@@ -207,12 +204,4 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
             reasons.setdefault(reason, []).append(item["id"])
         md += ["## Skipped items", ""]
         md += [f"- {r}: {len(ids)} ({', '.join(ids[:12])}{', …' if len(ids) > 12 else ''})" for r, ids in sorted(reasons.items())]
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=list(metrics[0].keys()), lineterminator="\n")
-    writer.writeheader()
-    for row in metrics:
-        writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
-    write_text(out / "clip_metrics.csv", buffer.getvalue())
-    report = out / "report.md"
-    write_text(report, "\n".join(md) + "\n")
-    return report
+    return write_report_files(out, md, metrics)
