@@ -20,12 +20,12 @@ import json
 import os
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from jsonl_runs import done_keys, run_appending, write_summary  # noqa: E402
 
 
 def sample_clips(n: int) -> list[str]:
@@ -133,31 +133,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--summary", type=Path)
     args = ap.parse_args(argv)
     if args.summary:
-        s = summary(args.summary)
-        args.summary.with_suffix(".summary.json").write_text(json.dumps(s, indent=1))
-        print(json.dumps(s, indent=1))
-        return 0
+        return write_summary(args.summary, summary)
     from simdiff.data.augment.conditions import paired_conditions
 
-    done = set()
-    if args.out.exists():
-        for line in args.out.read_text().splitlines():
-            if line.strip():
-                r = json.loads(line)
-                done.add((r["clip"], r["index"], r["clock"]))
+    done = done_keys(args.out, lambda r: (r["clip"], r["index"], r["clock"]))
     tasks = []
     for clip in sample_clips(args.clips):
         conds = [c.to_dict() for c in paired_conditions(clip, args.k, seed=0)]
         tasks += [(clip, c, True, args.max_frames) for c in conds] + [(clip, conds[0], False, args.max_frames)]
     tasks = [t for t in tasks if (t[0], t[1]["index"], t[2]) not in done]
-    args.out.parent.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    with ProcessPoolExecutor(args.workers) as ex, args.out.open("a") as f:
-        for rec in ex.map(run_task, tasks, chunksize=1):
-            f.write(json.dumps(rec) + "\n")
-            f.flush()
-            st = rec["info"]["status"] if isinstance(rec["info"], dict) else rec["info"]
-            print(rec["clip"], rec["env"], rec["clock"], st, flush=True)
+    run_appending(tasks, run_task, args.out, args.workers, lambda rec: " ".join(str(v) for v in (
+        rec["clip"], rec["env"], rec["clock"], rec["info"]["status"] if isinstance(rec["info"], dict) else rec["info"])))
     print("wall_s", time.perf_counter() - t0)
     return 0
 

@@ -16,12 +16,12 @@ import argparse
 import json
 import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from jsonl_runs import done_keys, run_appending, write_summary  # noqa: E402
 
 JUMPS = ["13_11", "13_13", "13_19", "13_39", "13_40", "16_02", "16_03", "16_05", "16_06", "16_07", "16_09",
          "16_10", "49_03", "105_39", "105_40", "105_41", "105_42", "105_43", "105_44", "105_45", "105_46",
@@ -45,14 +45,9 @@ def _com(model, qpos: np.ndarray) -> np.ndarray:
 
 def flight_record(model, res, g: float) -> dict:
     """Longest airborne run of a rollout and its ballistic comparison."""
-    air = np.append(res.airborne, False)
-    runs, start = [], None
-    for i, a in enumerate(air):
-        if a and start is None:
-            start = i
-        elif not a and start is not None:
-            runs.append((start, i))
-            start = None
+    from simdiff.motion.flight import runs as true_runs
+
+    runs = true_runs(res.airborne)
     rec = {"flight_s": 0.0, "takeoff_vz": None, "apex_gain_m": None}
     if not runs:
         return rec
@@ -142,26 +137,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--summary", type=Path, help="print the summary of a finished --out and exit")
     args = ap.parse_args(argv)
     if args.summary:
-        s = summary(args.summary)
-        args.summary.with_suffix(".summary.json").write_text(json.dumps(s, indent=1))
-        print(json.dumps(s, indent=1))
-        return 0
-    done = set()
-    if args.out.exists():
-        for line in args.out.read_text().splitlines():
-            if line.strip():
-                r = json.loads(line)
-                done.add((r["clip"], r["g"], r["clock"]))
+        return write_summary(args.summary, summary)
+    done = done_keys(args.out, lambda r: (r["clip"], r["g"], r["clock"]))
     clocks = (True,) if args.no_baseline else (True, False)
     tasks = [(c, g, k, args.max_frames) for c in args.clips for g in args.gravities for k in clocks
              if (c, g, k) not in done]
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with ProcessPoolExecutor(args.workers) as ex, args.out.open("a") as f:
-        for rec in ex.map(run_task, tasks, chunksize=1):
-            f.write(json.dumps(rec) + "\n")
-            f.flush()
-            print(rec["clip"], rec["g"], rec["clock"], rec["status"], round(rec["flight_s"], 3), rec.get("takeoff_vz"),
-                  flush=True)
+    run_appending(tasks, run_task, args.out, args.workers, lambda rec: " ".join(str(v) for v in (
+        rec["clip"], rec["g"], rec["clock"], rec["status"], round(rec["flight_s"], 3), rec.get("takeoff_vz"))))
     return 0
 
 

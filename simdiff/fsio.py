@@ -155,3 +155,15 @@ def save_npy(path: str | Path, array: np.ndarray) -> Path:
             handle.flush()
             os.fsync(handle.fileno())
     return Path(path)
+
+
+def file_digest(paths: list[Path]) -> str:
+    """SHA-1 (hex) of the concatenated bytes of ``paths``, read in 1 MiB blocks."""
+    import hashlib
+
+    sha = hashlib.sha1()
+    for path in paths:
+        with open(path, "rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                sha.update(block)
+    return sha.hexdigest()

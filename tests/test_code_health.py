@@ -25,3 +25,18 @@ def _imported_modules(path: Path) -> list[str]:
 def test_production_code_imports_no_test_helper(path: Path) -> None:
     bad = [m for m in _imported_modules(path) if m.split(".")[-1] == "testing" and m.startswith("simdiff")]
     assert not bad, f"{path.relative_to(PACKAGE)} imports {bad[0]}"
+
+
+MAX_LINES: int = 500
+"""Issue 16: no module in simdiff/ over this many lines."""
+MODULES = sorted(PACKAGE.rglob("*.py"))
+
+
+def test_the_package_has_modules() -> None:
+    assert len(MODULES) > 50 and PACKAGE / "motion" / "flight.py" in MODULES
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_module_is_at_most_500_lines(path: Path) -> None:
+    lines = len(path.read_text(encoding="utf-8").splitlines())
+    assert lines <= MAX_LINES, f"{path.relative_to(PACKAGE)} has {lines} lines (> {MAX_LINES}): split it"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simdiff.data.cmu.build import CONTACT_HEIGHT, ground_contact, support_of
+from simdiff.data.clip_files import CONTACT_HEIGHT, ground_contact, support_of
 from simdiff.data.cmu.load import MAX_LIFT, lift_penetrations, read_source_rig, source_frame
 from simdiff.data.cmu.sources import Trial
 

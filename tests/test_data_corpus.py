@@ -18,11 +18,11 @@ import pytest
 
 from simdiff.cli.main import main
 from simdiff.data.corpus.build import CorpusConfig, build
-from simdiff.data.corpus.flight import flight_stats
 from simdiff.data.corpus.item import LICENCE_SETS
 from simdiff.data.corpus.registry import discover_all
 from simdiff.data.corpus.splits import assign_stratified
 from simdiff.data.humanml3d import read_captions
+from mocap_fixtures import POS_ROT, bvh_text
 from test_data_cmu_build import _amc, _asf, _bvh, _deepmimic
 
 _BANDAI = [  # name, parent, offset (cm): the Bandai game rig's joint names
@@ -42,25 +42,10 @@ _BANDAI = [  # name, parent, offset (cm): the Bandai game rig's joint names
 
 def _bandai_bvh(seconds: float, speed: float, fps: int = 30) -> str:
     """A Bandai-style BVH in cm: static ``joint_Root``, ``Hips`` moving forward with swinging legs."""
-    lines = ["HIERARCHY"]
-
-    def emit(index: int, depth: int) -> None:
-        name, parent, offset = _BANDAI[index]
-        pad = "\t" * depth
-        lines.extend([f"{pad}{'ROOT' if parent is None else 'JOINT'} {name}", pad + "{",
-                      f"{pad}\tOFFSET {offset[0]} {offset[1]} {offset[2]}",
-                      f"{pad}\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"])
-        kids = [i for i, j in enumerate(_BANDAI) if j[1] == name]
-        for kid in kids:
-            emit(kid, depth + 1)
-        if not kids:
-            lines.extend([f"{pad}\tEnd Site", pad + "\t{", f"{pad}\t\tOFFSET 0 0 0", pad + "\t}"])
-        lines.append(pad + "}")
-
-    emit(0, 0)
-    frames = int(seconds * fps)
-    lines += ["MOTION", f"Frames: {frames}", f"Frame Time: {1 / fps:.6f}"]
-    for k in range(frames):
+    joints = [(name, parent, offset, POS_ROT) for name, parent, offset in _BANDAI]
+    leaves = {name: (0.0, 0.0, 0.0) for name, _, _ in _BANDAI if all(p != name for _, p, _ in _BANDAI)}
+    rows = []
+    for k in range(int(seconds * fps)):
         t = k / fps
         swing = 25 * np.sin(2 * np.pi * t * max(speed, 1.0))
         values: list[float] = []
@@ -70,8 +55,8 @@ def _bandai_bvh(seconds: float, speed: float, fps: int = 30) -> str:
                 pos = [offset[0], offset[1], offset[2] + 100.0 * speed * t]
             rot = {"UpperLeg_L": swing, "UpperLeg_R": -swing}.get(name, 0.0)
             values += pos + [0.0, rot, 0.0]
-        lines.append(" ".join(f"{v:.4f}" for v in values))
-    return "\n".join(lines) + "\n"
+        rows.append(values)
+    return bvh_text(joints, np.asarray(rows), round(1 / fps, 6), leaves)
 
 
 @pytest.fixture(scope="module")
@@ -249,19 +234,25 @@ def test_bad_options_are_one_line_errors(shared: Path, tmp_path: Path) -> None:
 
 
 def test_flight_counts_airborne_frames() -> None:
+    """The corpus report counts flights with the shared rule (simdiff.motion.flight) on real frames."""
+    from simdiff.data.corpus.report import _flight
+
     stand = np.zeros((40, 22, 3), dtype=np.float32)
     stand[..., 1] = np.linspace(0.0, 1.6, 22)  # lowest joints on the floor
     stand[:, [7, 8], 1] = 0.08
     stand[:, [10, 11], 1] = 0.0
-    assert flight_stats(stand) == {"flight_s": 0.0, "longest_flight_s": 0.0}
+    assert _flight(stand) == {"flight_s": 0.0, "longest_flight_s": 0.0}
     jump = stand.copy()
     jump[10:16, :, 1] += 0.3  # 6 frames = 0.3 s in the air
     jump[30:32, :, 1] += 0.3  # 0.1 s hop
-    stats = flight_stats(jump)
+    stats = _flight(jump)
     assert stats["longest_flight_s"] == pytest.approx(0.3) and stats["flight_s"] == pytest.approx(0.4)
-    hands = jump.copy()
-    hands[10:16, 20, 1] = 0.0  # a hand on the floor: not flight
-    assert flight_stats(hands)["longest_flight_s"] == pytest.approx(0.1)
+    lifted = jump.copy()
+    lifted[..., 1] += 0.4  # a floor 40 cm up (a generated motion): same flights
+    assert _flight(lifted) == stats
+    handstand = stand.copy()
+    handstand[:, [7, 8, 10, 11], 1] = 1.5  # feet up the whole clip: their own level is up, not flight
+    assert _flight(handstand)["flight_s"] == 0.0
 
 
 def test_real_shared_deepmimic_duplicates(shared_data: Path, tmp_path: Path) -> None:

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from simdiff.errors import SimdiffError
+from simdiff.motion.flight import runs
 from simdiff.sim.flight import FlightClock, FlightConfig, aligned_source, reference_flights
 
 
@@ -99,15 +100,8 @@ def test_aligned_source_holds_the_source_while_the_clock_waits():
 
 
 def _longest_flight(res) -> tuple[int, int]:
-    air = np.append(res.airborne, False)
-    runs, start = [], None
-    for i, a in enumerate(air):
-        if a and start is None:
-            start = i
-        elif not a and start is not None:
-            runs.append((start, i))
-            start = None
-    return max(runs, key=lambda r: r[1] - r[0]) if runs else (0, 0)
+    found = runs(res.airborne)
+    return max(found, key=lambda r: r[1] - r[0]) if found else (0, 0)
 
 
 def test_synthetic_jump_follows_ballistics_at_three_gravities_and_lands():

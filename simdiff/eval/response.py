@@ -55,8 +55,9 @@ def factor(env: Sequence[float]) -> str:
 def quantities(joints: np.ndarray, env: Sequence[float], fps: float = 20.0) -> dict[str, float]:
     """Physical quantities of one motion (T, 22, 3), metres, Y-up, 20 fps, frame of φ's wind.
 
-    apex_m: highest root height; flight_s: longest flight; step_length_m: mean step length
-    (:func:`simdiff.data.augment.signal.measure`); drift_x_m / drift_z_m: root displacement first →
+    apex_m: highest root height; flight_s: longest flight (the offline rule of
+    :mod:`simdiff.motion.flight`, ground estimated per foot joint, so an offset floor is fine);
+    step_length_m: mean step length (:func:`simdiff.data.augment.signal.measure`); drift_x_m / drift_z_m: root displacement first →
     last frame; drift_along_wind_m: that displacement along φ's wind direction (0 without wind).
     """
     from simdiff.data.augment.signal import measure

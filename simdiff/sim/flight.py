@@ -1,4 +1,8 @@
-"""Flights that follow gravity: the reference clock waits while the simulation flies.
+"""Flights that follow gravity: the reference clock waits while the simulation flies (online).
+
+This is the tracker's clock on simulated contacts during a rollout; the offline definition of
+flight on a finished motion (corpus report, augment signal, eval response) is
+:mod:`simdiff.motion.flight`.
 
 Under φ the simulated flight lasts as long as the take-off speed and g_z make it
 (t = 2·v/|g|), not as long as the mocap's. :class:`FlightClock` maps every control step of a
@@ -27,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.motion.flight import runs
 
 
 @dataclass(frozen=True)
@@ -66,15 +71,7 @@ def reference_flights(contact: np.ndarray, min_frames: int = 2) -> list[tuple[in
     if contact.ndim != 2:
         raise SimdiffError(f"contact must be (K, boxes), got shape {contact.shape}")
     air = ~contact.any(axis=1)
-    out, start = [], None
-    for t, a in enumerate(air):
-        if a and start is None:
-            start = t
-        elif not a and start is not None:
-            if start > 0 and t - start >= min_frames:
-                out.append((start, t))
-            start = None
-    return out
+    return [(s, e) for s, e in runs(air) if s > 0 and e < len(air) and e - s >= min_frames]
 
 
 class FlightClock:

@@ -78,9 +78,10 @@ def run_build(args: argparse.Namespace) -> int:
 
 
 def run_report(args: argparse.Namespace) -> int:
-    from simdiff.data.cmu.report import load_manifest, write_report
+    from simdiff.data.cmu.report import write_report
     from simdiff.data.corpus.build import FORMAT
     from simdiff.data.corpus.report import write_corpus_report
+    from simdiff.data.report_blocks import load_manifest
 
     if load_manifest(args.corpus).get("format") == FORMAT:  # built by `simdiff data build`
         path = write_corpus_report(args.corpus, args.out, seed=args.seed, crosscheck=not args.no_crosscheck)

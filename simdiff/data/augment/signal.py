@@ -1,7 +1,8 @@
 """The physics signal of an augmented corpus: what φ changed, against each clip's own Earth rollout.
 
 :func:`measure` reads a motion (T, 22, 3) (HumanML3D joints, metres, Y-up, 20 fps, in the
-source's frame, so that wind directions are those of φ): flights, apex, steps, drift.
+source's frame, so that wind directions are those of φ): flights (the one offline rule,
+:mod:`simdiff.motion.flight`), apex, steps, drift.
 :func:`signal_table` aggregates, per condition bin, over kept pairs whose clip's Earth rollout
 was also tracked: apex and flight-time change on clips with flight, step length and cadence
 change on walks/runs, and the horizontal drift along the wind per 10 N.
@@ -14,27 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.errors import SimdiffError
+from simdiff.motion.flight import FEET, feet_up, flight_stats
 
-FEET: tuple[int, ...] = (7, 10, 8, 11)
-"""HumanML3D left ankle, left foot, right ankle, right foot."""
-LIFT: float = 0.05
-"""m: a foot joint this far above its own low level (5th percentile) is off the floor."""
-LIFT_EDGE: float = 0.01
-"""m: a flight found with :data:`LIFT` extends to the frames where every foot joint is this far up."""
 GRAVITY_EDGES: tuple[float, ...] = (-20.0, -15.0, -11.0, -8.5, -5.0, -3.0, -1.0)
 WIND_EDGES: tuple[float, ...] = (-10.0, -5.0, 0.0, 5.0, 10.0)
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    out, start = [], None
-    for t, v in enumerate(np.append(mask, False)):
-        if v and start is None:
-            start = t
-        elif not v and start is not None:
-            out.append((start, t))
-            start = None
-    return out
 
 
 def measure(joints: np.ndarray, fps: float = 20.0) -> dict[str, float]:
@@ -43,8 +27,8 @@ def measure(joints: np.ndarray, fps: float = 20.0) -> dict[str, float]:
     Args:
         joints: (T, 22, 3) metres, Y-up, ``fps`` frames per second.
     Returns:
-        duration_s; flights (count of airborne runs ≥ 2 frames), flight_s (longest, s),
-        flight_total_s; apex_gain_m (root height gain over take-off in the longest flight);
+        duration_s; flights (count), flight_s (longest, s), flight_total_s, apex_gain_m (root
+        height gain over take-off in the longest flight), all from :mod:`simdiff.motion.flight`;
         apex_m (highest root); speed (mean horizontal root speed, m/s); steps (foot
         touchdowns), cadence (touchdowns per second), step_length_m (mean horizontal distance
         between successive touchdowns of alternating feet); drift_x, drift_z (root
@@ -53,32 +37,13 @@ def measure(joints: np.ndarray, fps: float = 20.0) -> dict[str, float]:
         SimdiffError: not (T, 22, 3) with T ≥ 2.
     """
     j = np.asarray(joints, dtype=np.float64)
-    if j.ndim != 3 or j.shape[1:] != (22, 3) or j.shape[0] < 2:
-        raise SimdiffError(f"expected joints of shape (T>=2, 22, 3), got {j.shape}")
+    stats = flight_stats(j, fps)
     T = j.shape[0]
-    h = j[:, FEET, 1]
-    low = np.percentile(h, 5, axis=0)
-    up = h > low + LIFT
-    air = up.all(axis=1)
-    edge = (h > low + LIFT_EDGE).all(axis=1)
-    flights = []
-    for s, e in _runs(air):
-        while s > 1 and edge[s - 1]:
-            s -= 1
-        while e < T and edge[e]:
-            e += 1
-        if e - s >= 2 and s > 0 and (not flights or s >= flights[-1][1]):
-            flights.append((s, e))
     root = j[:, 0]
-    out: dict[str, float] = {"duration_s": (T - 1) / fps, "flights": float(len(flights)),
-                             "flight_s": 0.0, "flight_total_s": float(sum(e - s for s, e in flights) / fps),
-                             "apex_gain_m": 0.0, "apex_m": float(root[:, 1].max())}
-    if flights:
-        s, e = max(flights, key=lambda r: r[1] - r[0])
-        out["flight_s"] = (e - s) / fps
-        out["apex_gain_m"] = float(root[s:e, 1].max() - root[s - 1, 1])
+    out: dict[str, float] = {"duration_s": (T - 1) / fps, **stats, "apex_m": float(root[:, 1].max())}
     out["speed"] = float(np.linalg.norm(np.diff(root[:, [0, 2]], axis=0), axis=1).mean() * fps)
     # touchdowns: a foot (ankle or toe joint) that comes down after being up
+    up = feet_up(j)
     down = ~(up[:, [0, 1]].all(axis=1)), ~(up[:, [2, 3]].all(axis=1))
     events: list[tuple[int, int]] = []
     for side, d in enumerate(down):

@@ -22,15 +22,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from simdiff.data.cmu import captions as cap
 from simdiff.data.cmu.load import load_source, source_frame
 from simdiff.data.cmu.sources import RIGS, Trial, discover
-from simdiff.data.cmu.splits import SPLIT_NAMES, assign_splits
+from simdiff.data.cmu.splits import assign_splits
 from simdiff.data.cmu.windows import MAX_WINDOW, MIN_WINDOW, Window, plan_windows
-from simdiff.data.cmu.writer import write_json, write_lines, write_npy, write_text
+from simdiff.data.cmu.writer import write_json
+from simdiff.data.clip_files import (
+    Pending, clip_variants, files_exist, ground_contact, load_record, remove_stale, support_of, write_clip,
+    write_splits, write_stats,
+)
 from simdiff.errors import SimdiffError
+from simdiff.fsio import file_digest
 from simdiff.motion.skeleton import FPS
 
 PIPELINE_VERSION: int = 3
@@ -78,15 +81,6 @@ class BuildResult:
     split_counts: dict[str, int] = field(default_factory=dict)
 
 
-def _digest(paths: list[Path]) -> str:
-    sha = hashlib.sha1()
-    for path in paths:
-        with open(path, "rb") as handle:
-            for block in iter(lambda: handle.read(1 << 20), b""):
-                sha.update(block)
-    return sha.hexdigest()
-
-
 def _trial_key(trial: Trial, rig: str, cfg: BuildConfig) -> str:
     files = [trial.files[rig]] + ([trial.asf] if rig == "amc" and trial.asf else [])
     settings = {
@@ -101,30 +95,11 @@ def _trial_key(trial: Trial, rig: str, cfg: BuildConfig) -> str:
         "kitml": trial.kitml,
         "segments": [[s.hml_id, s.start20, s.end20] for s in trial.segments],
     }
-    blob = json.dumps(settings, sort_keys=True) + _digest([Path(p) for p in files])
+    blob = json.dumps(settings, sort_keys=True) + file_digest([Path(p) for p in files])
     return hashlib.sha1(blob.encode()).hexdigest()
 
 
-CONTACT_HEIGHT: float = 0.15
-"""A frame touches the ground when its lowest joint is within this height (m) of the trial's floor."""
-MIN_GROUND_FRACTION: float = 0.5
-"""Clips whose fraction of ground-touching frames is below this are marked ``support: props``."""
-
-
-def ground_contact(joints: np.ndarray, floor: float = 0.0) -> float:
-    """Fraction of frames of (T, 22, 3) joints whose lowest joint is within
-    :data:`CONTACT_HEIGHT` of ``floor`` (the trial's floor, not the clip's own lowest joint)."""
-    lowest = np.asarray(joints, dtype=np.float64)[..., 1].min(axis=-1)
-    return float(np.mean(lowest - floor <= CONTACT_HEIGHT)) if lowest.size else 0.0
-
-
-def support_of(contact: float) -> str:
-    """"floor" when the body stands on the ground most of the clip, else "props" (hanging
-    from bars or playground equipment, sitting on a prop): physics augmentation skips those."""
-    return "floor" if contact >= MIN_GROUND_FRACTION else "props"
-
-
-def _kit_for_window(trial: Trial, window: Window) -> list[str]:
+def kit_for_window(trial: Trial, window: Window) -> list[str]:
     """KIT-ML sentences whose time span covers at least half of the window."""
     start, stop = window.start / FPS, window.stop / FPS
     out: list[str] = []
@@ -141,7 +116,7 @@ def _kit_for_window(trial: Trial, window: Window) -> list[str]:
 
 def clip_captions(trial: Trial, window: Window, clip_id: str, cfg: BuildConfig) -> tuple[list[str], str]:
     """Captions of one clip and their origin ("kitml" or "generated")."""
-    human = _kit_for_window(trial, window)
+    human = kit_for_window(trial, window)
     if human:
         return human, "kitml"
     return cap.describe(trial.description, n=cfg.generated_captions, seed=cfg.seed, key=clip_id), "generated"
@@ -154,27 +129,8 @@ def _relative(path: Path, root: Path) -> str:
         return path.name if path.parent.name != "bvh" else f"bvh/{path.name}"
 
 
-def _process_clip(clip_id: str, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Features (n-1, 263) and the joints they give back (n-1, 22, 3) of (n, 22, 3) joints."""
-    from simdiff.motion.features import features_to_joints, process_joints
-
-    features = process_joints(joints).features.astype(np.float32)
-    if not np.all(np.isfinite(features)):
-        raise SimdiffError(f"clip {clip_id}: non-finite features")
-    return features, np.asarray(features_to_joints(features), dtype=np.float32)
-
-
-def _write_clip(out: Path, clip_id: str, features: np.ndarray, joints: np.ndarray, lines: list[str]) -> None:
-    """Write one clip's three files (atomically each)."""
-    write_npy(out / "new_joint_vecs" / f"{clip_id}.npy", features)
-    write_npy(out / "new_joints" / f"{clip_id}.npy", joints)
-    write_text(out / "texts" / f"{clip_id}.txt", "".join(f"{line}\n" for line in lines))
-
-
 def process_trial(trial: Trial, rig: str, cfg: BuildConfig) -> list[dict[str, Any]]:
     """Retarget, window, mirror and write every clip of a trial; returns clip records."""
-    from simdiff.motion.mirror import mirror_caption, mirror_joints
-
     joints, skipped = load_source(trial, rig)
     windows = plan_windows(joints.shape[0], trial.segments)
     if not windows:
@@ -183,7 +139,7 @@ def process_trial(trial: Trial, rig: str, cfg: BuildConfig) -> list[dict[str, An
         )
     kind = cap.motion_type(trial.description)
     records: list[dict[str, Any]] = []
-    pending: list[tuple[str, np.ndarray, np.ndarray, list[str]]] = []
+    pending: list[Pending] = []
     for k, window in enumerate(windows):
         clip_id = f"{trial.trial}_{k:02d}"
         texts, origin = clip_captions(trial, window, clip_id, cfg)
@@ -203,60 +159,12 @@ def process_trial(trial: Trial, rig: str, cfg: BuildConfig) -> list[dict[str, An
         contact = ground_contact(piece)  # trial joints have the trial's floor at y = 0
         base["ground_contact"] = round(contact, 3)
         base["support"] = support_of(contact)
-        variants = [(clip_id, piece, texts, None)]
-        if cfg.mirror:
-            variants.append((f"M{clip_id}", mirror_joints(piece), [mirror_caption(t) for t in texts], clip_id))
-        for cid, motion, sentences, parent in variants:
-            features, recovered = _process_clip(cid, motion)
-            pending.append((cid, features, recovered, [cap.caption_line(s) for s in sentences]))
-            rows = int(features.shape[0])
-            records.append({**base, "id": cid, "mirror_of": parent, "frames": rows,
-                            "seconds": round(rows / FPS, 3), "captions": sentences})
+        new_records, new_pending = clip_variants(base, clip_id, piece, texts, cfg.mirror, cap.caption_line)
+        records += new_records
+        pending += new_pending
     for cid, features, recovered, lines in pending:  # only once every clip of the trial worked
-        _write_clip(cfg.out, cid, features, recovered, lines)
+        write_clip(cfg.out, cid, features, recovered, lines)
     return records
-
-
-def _load_record(path: Path) -> dict[str, Any] | None:
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-
-
-def _files_exist(out: Path, clips: list[dict[str, Any]]) -> bool:
-    return all(
-        (out / sub / f"{c['id']}{ext}").is_file()
-        for c in clips
-        for sub, ext in (("new_joint_vecs", ".npy"), ("new_joints", ".npy"), ("texts", ".txt"))
-    )
-
-
-def _remove_stale(out: Path, keep: set[str], candidates: set[str]) -> int:
-    """Delete clip files once written by this tool (previous manifest or trial records) but not produced now."""
-    old = _load_record(out / "manifest.json")
-    candidates = candidates | {str(c.get("id", "")) for c in (old or {}).get("clips", [])}
-    removed = 0
-    for cid in sorted(candidates):
-        if cid and cid not in keep and "/" not in cid and ".." not in cid:
-            for sub, ext in (("new_joint_vecs", ".npy"), ("new_joints", ".npy"), ("texts", ".txt")):
-                path = out / sub / f"{cid}{ext}"
-                if path.is_file():
-                    path.unlink()
-                    removed += 1
-    return removed
-
-
-def _write_stats(out: Path, train_ids: list[str]) -> None:
-    """Mean.npy / Std.npy with HumanML3D's grouped std over the train clips."""
-    from simdiff.motion.normalize import group_std
-
-    if not train_ids:
-        raise SimdiffError(f"no train clips in {out}: cannot compute Mean/Std")
-    mean, std = group_std(np.load(out / "new_joint_vecs" / f"{cid}.npy") for cid in train_ids)
-    std = np.where(std < 1e-6, 1e-6, std).astype(np.float32)  # a constant group (e.g. no contact) must not divide by 0
-    write_npy(out / "Mean.npy", mean.astype(np.float32))
-    write_npy(out / "Std.npy", std)
 
 
 def build_corpus(cfg: BuildConfig) -> BuildResult:
@@ -297,10 +205,10 @@ def build_corpus(cfg: BuildConfig) -> BuildResult:
         except OSError as exc:
             skipped.append({"trial": trial.trial, "error": f"{trial.files[rig]}: {exc.strerror}"})
             continue
-        record = _load_record(record_path)
+        record = load_record(record_path)
         if record:
             stale.update(str(c["id"]) for c in record.get("clips", []))
-        if record and record.get("key") == key and (record.get("error") or _files_exist(cfg.out, record["clips"])):
+        if record and record.get("key") == key and (record.get("error") or files_exist(cfg.out, record["clips"])):
             reused += 1
         else:
             bar.set_postfix_str(f"{trial.trial} {rig}")
@@ -327,17 +235,9 @@ def build_corpus(cfg: BuildConfig) -> BuildResult:
         if clip["mirror_of"] is None:
             durations[clip["trial"]] = durations.get(clip["trial"], 0.0) + clip["seconds"]
     split_of = assign_splits(durations, hml3d, seed=cfg.seed)
-    ids: dict[str, list[str]] = {name: [] for name in SPLIT_NAMES}
-    for clip in clips:
-        clip["split"] = split_of[clip["trial"]]
-        ids[clip["split"]].append(clip["id"])
-    for name in SPLIT_NAMES:
-        ids[name].sort()
-        write_lines(cfg.out / f"{name}.txt", ids[name])
-    write_lines(cfg.out / "train_val.txt", sorted(ids["train"] + ids["val"]))
-    write_lines(cfg.out / "all.txt", sorted(c["id"] for c in clips))
-    _remove_stale(cfg.out, {c["id"] for c in clips}, stale)
-    _write_stats(cfg.out, ids["train"])
+    ids = write_splits(cfg.out, clips, split_of)
+    remove_stale(cfg.out, {c["id"] for c in clips}, stale)
+    write_stats(cfg.out, ids["train"])
 
     result = BuildResult(clips=clips, skipped=skipped, reused=reused, processed=processed,
                          split_counts={k: len(v) for k, v in ids.items()})

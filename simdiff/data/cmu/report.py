@@ -8,8 +8,6 @@ each source and motion type. Per-clip numbers go to ``clip_metrics.csv``.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 from collections import defaultdict
 from pathlib import Path
@@ -17,96 +15,23 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.fsio import atomic_path
-from simdiff.data.cmu.writer import write_json, write_text
+from simdiff.data.cmu.writer import write_json
+from simdiff.data.report_blocks import (
+    clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table, write_report_files,
+)
 from simdiff.errors import SimdiffError
+from simdiff.fsio import file_digest
 from simdiff.motion.skeleton import FPS, JOINT_NAMES
 
 AGREEMENT_TARGET: float = 0.03
 """Wanted mean per-joint distance between the AMC and BVH versions (metres)."""
 
 
-def load_manifest(corpus: Path) -> dict[str, Any]:
-    """The ``manifest.json`` written by build-cmu."""
-    path = corpus / "manifest.json"
-    if not path.is_file():
-        raise SimdiffError(f"not a build-cmu corpus (no manifest.json): {corpus}")
-    try:
-        return json.loads(path.read_text())
-    except ValueError as exc:
-        raise SimdiffError(f"{path}: invalid JSON ({exc})") from None
-
-
-def _table(header: list[str], rows: list[list[object]]) -> str:
-    def cell(v: object) -> str:
-        if isinstance(v, float):
-            return f"{v:.2f}"
-        return str(v)
-
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in rows]
-    return "\n".join(lines)
-
-
-def _group(clips: list[dict[str, Any]], key: str) -> dict[str, list[dict[str, Any]]]:
-    out: dict[str, list[dict[str, Any]]] = defaultdict(list)
-    for clip in clips:
-        out[str(clip[key])].append(clip)
-    return dict(sorted(out.items()))
-
-
-def _hours(clips: list[dict[str, Any]]) -> float:
-    return sum(float(c["seconds"]) for c in clips) / 3600
-
-
-def frame_checks(joints: np.ndarray) -> dict[str, float]:
-    """Canonical-frame checks of one (T, 22, 3) clip.
-
-    Returns:
-        floor (min y, m), facing0 (frame-0 facing angle from +Z, degrees), upright (fraction
-        of frames whose head is above the pelvis), root_xz0 (frame-0 pelvis distance from the
-        origin, m).
-    """
-    from simdiff.motion.kinematics import facing_direction
-    from simdiff.motion.skeleton import FACE_JOINTS
-
-    forward = facing_direction(joints[:1].astype(np.float64), FACE_JOINTS)[0]
-    return {
-        "floor": float(joints[..., 1].min()),
-        "facing0": float(np.degrees(np.arctan2(forward[0], forward[2]))),
-        "upright": float(np.mean(joints[:, 15, 1] > joints[:, 0, 1])),
-        "root_xz0": float(np.hypot(joints[0, 0, 0], joints[0, 0, 2])),
-    }
-
-
-def clip_metrics(corpus: Path, clips: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Physics metrics and frame checks of every clip, read from ``new_joints``."""
-    from tqdm import tqdm
-
-    from simdiff.motion.metrics import per_sample_physics_metrics
-
-    rows = []
-    for clip in tqdm(clips, desc="metrics", unit="clip", dynamic_ncols=True, leave=False):
-        joints = np.load(corpus / "new_joints" / f"{clip['id']}.npy")
-        physics = {k: float(v[0]) for k, v in per_sample_physics_metrics(joints).items()}
-        rows.append({
-            "id": clip["id"], "trial": clip["trial"], "rig": clip["rig"], "split": clip["split"],
-            "motion_type": clip["motion_type"], "frames": clip["frames"], "support": clip.get("support", ""),
-            "ground_contact": clip.get("ground_contact", ""), **physics, **frame_checks(joints),
-        })
-    return rows
-
-
-def _stats(values: list[float]) -> list[float]:
-    arr = np.asarray(values, dtype=np.float64)
-    return [float(arr.mean()), float(np.median(arr)), float(np.percentile(arr, 95))]
-
-
 def _crosscheck(corpus: Path, src: Path) -> list[Any]:
     """AMC/BVH agreement of every trial with both files (cached in ``.build``)."""
     from tqdm import tqdm
 
-    from simdiff.data.cmu.build import BUILD_DIR, _digest
+    from simdiff.data.cmu.build import BUILD_DIR
     from simdiff.data.cmu.crosscheck import Agreement, crosscheck_trial
     from simdiff.data.cmu.sources import discover
 
@@ -123,7 +48,7 @@ def _crosscheck(corpus: Path, src: Path) -> list[Any]:
     trials = [t for t in discover(src, corpus / BUILD_DIR) if "amc" in t.files and "bvh" in t.files and t.asf]
     out = []
     for trial in tqdm(trials, desc="amc-vs-bvh", unit="trial", dynamic_ncols=True, leave=False):
-        key = _digest([trial.files["amc"], trial.files["bvh"], trial.asf, *code])  # type: ignore[list-item]
+        key = file_digest([trial.files["amc"], trial.files["bvh"], trial.asf, *code])  # type: ignore[list-item]
         entry = cache.get(trial.trial)
         if entry and entry.get("key") == key:
             out.append(Agreement.from_dict(entry["result"]))
@@ -157,80 +82,6 @@ def _explain(agreement: Any, median: float) -> str:
     return "; ".join(notes)
 
 
-def _summary_figure(path: Path, clips: list[dict[str, Any]], metrics: list[dict[str, Any]]) -> None:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(13, 7.5), dpi=100, facecolor="white")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(2, 3)
-    originals = [c for c in clips if c["mirror_of"] is None]
-    for ax, key, title in ((axes[0, 0], "split", "hours per split"), (axes[0, 1], "rig", "hours per source"),
-                           (axes[0, 2], "motion_type", "hours per motion type")):
-        groups = _group(clips, key)
-        ax.bar(list(groups), [_hours(v) for v in groups.values()], color="#4477aa")
-        ax.set_title(f"{title} (with mirrors)")
-        ax.tick_params(axis="x", rotation=0 if key == "split" else 45, labelsize=8)
-    ax = axes[1, 0]
-    ax.hist([c["frames"] / FPS for c in originals], bins=30, color="#66aa55")
-    ax.set_title("clip length (s, originals)")
-    by_id = {m["id"]: m for m in metrics}
-    for ax, key, title in ((axes[1, 1], "skate_ratio", "foot skate ratio per clip"),
-                           (axes[1, 2], "floating", "floating per clip (mm)")):
-        for rig, group in _group(originals, "rig").items():
-            ax.hist([by_id[c["id"]][key] for c in group], bins=30, alpha=0.6, label=rig)
-        ax.set_title(title)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, facecolor="white")
-
-
-def _pick(clips: list[dict[str, Any]], rng: np.random.Generator, n: int) -> list[dict[str, Any]]:
-    """Up to ``n`` original clips, preferring distinct trials and motion types."""
-    pool = [c for c in clips if c["mirror_of"] is None]
-    order = rng.permutation(len(pool))
-    chosen, types, trials = [], set(), set()
-    for strict in (True, False):
-        for i in order:
-            c = pool[int(i)]
-            if c in chosen or len(chosen) >= n:
-                continue
-            if strict and (c["motion_type"] in types or c["trial"] in trials):
-                continue
-            chosen.append(c)
-            types.add(c["motion_type"])
-            trials.add(c["trial"])
-    return chosen
-
-
-def _shown_caption(clip: dict[str, Any]) -> str:
-    """The caption shown in figures: generated text, or a placeholder for third-party KIT-ML text."""
-    return "[KIT-ML human caption]" if clip["caption_origin"] == "kitml" else str(clip["captions"][0])
-
-
-def _filmstrips(corpus: Path, out: Path, clips: list[dict[str, Any]], seed: int) -> list[tuple[str, Path]]:
-    from simdiff.viz.stick import render_filmstrip
-
-    rng = np.random.default_rng(seed)
-    images = []
-    groups = {f"source: {rig}": _pick(group, rng, 3) for rig, group in _group(clips, "rig").items()}
-    by_type = [_pick(group, rng, 1)[0] for group in _group(clips, "motion_type").values() if _pick(group, rng, 1)]
-    groups["one clip per motion type"] = by_type
-    mirror = next((c for c in clips if c["mirror_of"] is not None and c["mirror_of"] == by_type[0]["id"]), None)
-    if mirror is not None:
-        original = next(c for c in clips if c["id"] == mirror["mirror_of"])
-        groups["a clip and its mirror"] = [original, mirror]
-    for title, chosen in groups.items():
-        if not chosen:
-            continue
-        name = "filmstrip_" + title.split(":")[-1].strip().replace(" ", "_") + ".png"
-        motions = [np.load(corpus / "new_joints" / f"{c['id']}.npy") for c in chosen]
-        captions = [f"{c['id']} ({c['rig']}, {c['motion_type']}): {_shown_caption(c)}" for c in chosen]
-        images.append((title, render_filmstrip(motions, out / name, captions=captions, n_frames=8)))
-    return images
-
-
 def write_report(
     corpus: str | Path, out: str | Path | None = None, *, src: str | Path | None = None,
     seed: int = 0, crosscheck: bool = True,
@@ -246,13 +97,7 @@ def write_report(
     Returns:
         Path of ``report.md``.
     """
-    corpus = Path(corpus)
-    manifest = load_manifest(corpus)
-    out = Path(out) if out is not None else corpus / "report"
-    out.mkdir(parents=True, exist_ok=True)
-    clips: list[dict[str, Any]] = manifest["clips"]
-    if not clips:
-        raise SimdiffError(f"{corpus}/manifest.json lists no clips")
+    corpus, manifest, out, clips = open_report(corpus, out)
     originals = [c for c in clips if c["mirror_of"] is None]
     metrics = clip_metrics(corpus, clips)
     by_id = {m["id"]: m for m in metrics}
@@ -264,31 +109,31 @@ def write_report(
     )
     md += ["", "## Overview", ""]
     trials = {c["trial"] for c in clips}
-    md.append(_table(["clips", "of which originals", "trials", "hours", "hours (originals)", "skipped trials"], [[
-        len(clips), len(originals), len(trials), _hours(clips), _hours(originals), len(manifest.get("skipped", []))]]))
+    md.append(table(["clips", "of which originals", "trials", "hours", "hours (originals)", "skipped trials"], [[
+        len(clips), len(originals), len(trials), hours(clips), hours(originals), len(manifest.get("skipped", []))]]))
     md += ["", "![summary](summary.png)", "", "## Per split", ""]
     rows = []
     for split in ("train", "val", "test"):
         group = [c for c in clips if c["split"] == split]
-        rows.append([split, len({c["trial"] for c in group}), len(group), _hours(group),
+        rows.append([split, len({c["trial"] for c in group}), len(group), hours(group),
                      sum(1 for c in group if c["caption_origin"] == "kitml")])
-    md.append(_table(["split", "trials", "clips", "hours", "clips with human captions"], rows))
+    md.append(table(["split", "trials", "clips", "hours", "clips with human captions"], rows))
     md += ["", "Splits are by trial; a trial with a HumanML3D test (val, train) segment follows HumanML3D.",
            "", "## Per source (primary rig of each trial)", ""]
-    rows = [[rig, len({c["trial"] for c in g}), len(g), _hours(g), _stats([by_id[c["id"]]["frames"] / FPS for c in g])[0]]
-            for rig, g in _group(clips, "rig").items()]
-    md.append(_table(["rig", "trials", "clips", "hours", "mean clip s"], rows))
+    rows = [[rig, len({c["trial"] for c in g}), len(g), hours(g), stats([by_id[c["id"]]["frames"] / FPS for c in g])[0]]
+            for rig, g in group_by(clips, "rig").items()]
+    md.append(table(["rig", "trials", "clips", "hours", "mean clip s"], rows))
     md += ["", "## Per motion type", ""]
     rows = []
-    for kind, g in _group(clips, "motion_type").items():
-        rows.append([kind, len({c["trial"] for c in g}), len(g), _hours(g),
+    for kind, g in group_by(clips, "motion_type").items():
+        rows.append([kind, len({c["trial"] for c in g}), len(g), hours(g),
                      *[len([c for c in g if c["split"] == s]) for s in ("train", "val", "test")]])
-    md.append(_table(["type", "trials", "clips", "hours", "train", "val", "test"], rows))
+    md.append(table(["type", "trials", "clips", "hours", "train", "val", "test"], rows))
 
     human = [c for c in clips if c["caption_origin"] == "kitml"]
     generated = [c for c in clips if c["caption_origin"] != "kitml"]
     md += ["", "## Captions", ""]
-    md.append(_table(["origin", "clips", "caption lines", "distinct sentences"], [
+    md.append(table(["origin", "clips", "caption lines", "distinct sentences"], [
         ["human (KIT-ML)", len(human), sum(len(c["captions"]) for c in human), len({s for c in human for s in c["captions"]})],
         ["generated from CMU description", len(generated), sum(len(c["captions"]) for c in generated),
          len({s for c in generated for s in c["captions"]})],
@@ -302,7 +147,7 @@ def write_report(
     floor = [m["floor"] for m in metrics]
     facing = [abs(m["facing0"]) for m in metrics]
     upright = [m["upright"] for m in metrics]
-    md.append(_table(["check", "result"], [
+    md.append(table(["check", "result"], [
         ["lowest joint over the clip (m)", f"min {min(floor):.4f}, max {max(floor):.4f}"],
         ["frame-0 facing angle from +Z (deg)", f"max {max(facing):.2f}"],
         ["frame-0 pelvis distance from origin XZ (m)", f"max {max(m['root_xz0'] for m in metrics):.4f}"],
@@ -314,17 +159,17 @@ def write_report(
            "5 mm), sliding (mm per frame of the lowest joint while on the ground), skate ratio (GMD). "
            "mean / median / p95 over original clips.", ""]
     rows = []
-    for rig, g in [("all", originals)] + list(_group(originals, "rig").items()):
+    for rig, g in [("all", originals)] + list(group_by(originals, "rig").items()):
         vals = [by_id[c["id"]] for c in g]
-        rows.append([rig, len(g)] + [" / ".join(f"{x:.2f}" for x in _stats([v[k] for v in vals]))
+        rows.append([rig, len(g)] + [" / ".join(f"{x:.2f}" for x in stats([v[k] for v in vals]))
                                     for k in ("penetration", "floating", "sliding", "skate_ratio")])
-    md.append(_table(["rig", "clips", "penetration mm", "floating mm", "sliding mm/frame", "skate ratio"], rows))
+    md.append(table(["rig", "clips", "penetration mm", "floating mm", "sliding mm/frame", "skate ratio"], rows))
     md += [""]
     rows = []
-    for kind, g in _group(originals, "motion_type").items():
+    for kind, g in group_by(originals, "motion_type").items():
         vals = [by_id[c["id"]] for c in g]
         rows.append([kind, len(g)] + [float(np.mean([v[k] for v in vals])) for k in ("floating", "sliding", "skate_ratio")])
-    md.append(_table(["type", "clips", "floating mm", "sliding mm/frame", "skate ratio"], rows))
+    md.append(table(["type", "clips", "floating mm", "sliding mm/frame", "skate ratio"], rows))
     worst = sorted(originals, key=lambda c: -by_id[c["id"]]["floating"])[:5]
     md += ["", "Most floating clips (lowest joint stays above the floor: hanging, climbing, jumping):", ""]
     md += [f"- `{c['id']}` ({c['rig']}, {c['description']}): floating {by_id[c['id']]['floating']:.1f} mm, "
@@ -338,10 +183,10 @@ def write_report(
     floor_clips = [c for c in originals if c.get("support", "floor") == "floor"]
     if props and floor_clips:
         rows = []
-        for rig, g in [("all", floor_clips)] + list(_group(floor_clips, "rig").items()):
-            rows.append([rig, len(g), " / ".join(f"{x:.2f}" for x in _stats([by_id[c["id"]]["floating"] for c in g]))])
+        for rig, g in [("all", floor_clips)] + list(group_by(floor_clips, "rig").items()):
+            rows.append([rig, len(g), " / ".join(f"{x:.2f}" for x in stats([by_id[c["id"]]["floating"] for c in g]))])
         md += ["", "Floating of the `support: floor` clips only:", ""]
-        md.append(_table(["rig", "clips", "floating mm (mean / median / p95)"], rows))
+        md.append(table(["rig", "clips", "floating mm (mean / median / p95)"], rows))
     worst = sorted(originals, key=lambda c: -by_id[c["id"]]["skate_ratio"])[:5]
     md += ["", "Highest skate ratio:", ""]
     md += [f"- `{c['id']}` ({c['rig']}, {c['description']}): skate {by_id[c['id']]['skate_ratio']:.2f}, "
@@ -385,7 +230,7 @@ def write_report(
                      r.root_relative * 100, r.floor_offset * 100, f"{r.worst_joint} {r.per_joint.max() * 100:.1f}",
                      _explain(r, med) if r.mpjpe > max(AGREEMENT_TARGET, 1.25 * med) else ""]
                     for r in results]
-            md.append(_table(["trial", "frames@120", "lag ms", "yaw °", "MPJPE cm", "pose-only cm",
+            md.append(table(["trial", "frames@120", "lag ms", "yaw °", "MPJPE cm", "pose-only cm",
                               "pelvis height Δ cm", "worst joint cm", "outlier reading"], rows))
             pj = np.mean([r.per_joint for r in results], axis=0) * 100
             md += ["", "Mean distance per joint (cm): " + ", ".join(
@@ -397,17 +242,17 @@ def write_report(
                 md += ["", "Constant part of the disagreement: mean BVH − AMC offset in the body frame "
                        "(cm; x left, y up, z forward), joints over 1.5 cm. A constant offset means the two "
                        "joint maps put that joint at different anatomical points:", ""]
-                md.append(_table(["joint", "left", "up", "forward", "norm"], [
+                md.append(table(["joint", "left", "up", "forward", "norm"], [
                     [JOINT_NAMES[j], *[float(v) for v in mean_off[j]], float(np.linalg.norm(mean_off[j]))] for j in big]))
         else:
             md.append("Skipped: no source folder with both AMC and BVH files was found.")
     else:
         md.append("Skipped (--no-crosscheck).")
 
-    _summary_figure(out / "summary.png", clips, metrics)
+    summary_figure(out / "summary.png", clips, metrics)
     md += ["", "## Filmstrips", "", "Each row: 8 evenly spaced frames of one clip, as stored in `new_joints` "
            "(canonical: floor at y = 0, facing +Z at frame 0).", ""]
-    for title, image in _filmstrips(corpus, out, clips, seed):
+    for title, image in filmstrips(corpus, out, clips, seed):
         md += [f"### {title}", "", f"![{title}]({image.name})", ""]
     skipped = manifest.get("skipped", [])
     if skipped:
@@ -420,12 +265,4 @@ def write_report(
         md += [f"- {reason}: {len(ids)} ({', '.join(ids)})" for reason, ids in sorted(reasons.items())]
         md += [""]
 
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=list(metrics[0].keys()), lineterminator="\n")
-    writer.writeheader()
-    for row in metrics:
-        writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
-    write_text(out / "clip_metrics.csv", buffer.getvalue())
-    report = out / "report.md"
-    write_text(report, "\n".join(md) + "\n")
-    return report
+    return write_report_files(out, md, metrics)

@@ -14,19 +14,20 @@ import hashlib
 import json
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from simdiff.data.cmu.build import BUILD_DIR, _files_exist, _load_record, _remove_stale, _write_stats
-from simdiff.data.cmu.splits import SPLIT_NAMES
+from simdiff.data.clip_files import files_exist, load_record, remove_stale, write_splits, write_stats
+from simdiff.data.cmu.build import BUILD_DIR, BuildResult
 from simdiff.data.cmu.windows import MAX_WINDOW, MIN_WINDOW
-from simdiff.data.cmu.writer import write_json, write_lines
-from simdiff.data.corpus.clips import ClipSettings, process_item
-from simdiff.data.corpus.item import LICENCE_SETS, Item, file_digest
+from simdiff.data.cmu.writer import write_json
+from simdiff.data.corpus.clips import ClipSettings, process_item, source_relative
+from simdiff.data.corpus.item import LICENCE_SETS, Item
 from simdiff.data.corpus.registry import SOURCES, discover_all
 from simdiff.data.corpus.splits import assign_stratified
 from simdiff.errors import SimdiffError
+from simdiff.fsio import file_digest
 from simdiff.motion.skeleton import FPS
 
 PIPELINE_VERSION: int = 2
@@ -62,16 +63,8 @@ class CorpusConfig:
     progress: bool = True
 
 
-@dataclass
-class CorpusResult:
-    """Summary of a build."""
-
-    clips: list[dict[str, Any]]
-    skipped: list[dict[str, str]]
-    reused: int = 0
-    processed: int = 0
-    elapsed: float = 0.0
-    split_counts: dict[str, int] = field(default_factory=dict)
+CorpusResult = BuildResult
+"""Summary of a build (the same record as ``build-cmu``'s)."""
 
 
 def code_digest() -> str:
@@ -113,9 +106,7 @@ def _run_item(item: Item, settings: ClipSettings) -> tuple[list[dict[str, Any]],
 
 
 def _alternates(item: Item, shared: Path) -> list[dict[str, Any]]:
-    from simdiff.data.corpus.clips import _relative
-
-    return [{"source": a.source, "file": _relative(a.path, shared)} for a in item.alternates]
+    return [{"source": a.source, "file": source_relative(a.path, shared)} for a in item.alternates]
 
 
 def build(cfg: CorpusConfig) -> CorpusResult:
@@ -142,10 +133,10 @@ def build(cfg: CorpusConfig) -> CorpusResult:
     code = code_digest()
     for item in items:
         key = item_key(item, settings, code)
-        record = _load_record(cache / "items" / f"{item.id}.json")
+        record = load_record(cache / "items" / f"{item.id}.json")
         if record:
             stale.update(str(c["id"]) for c in record.get("clips", []))
-        if record and record.get("key") == key and (record.get("error") or _files_exist(out, record["clips"])):
+        if record and record.get("key") == key and (record.get("error") or files_exist(out, record["clips"])):
             records[item.id] = record
             reused += 1
         else:
@@ -201,17 +192,9 @@ def _finish(cfg: CorpusConfig, items: list[Item], records: dict[str, dict[str, A
     if not clips:
         raise SimdiffError(f"no clip could be built from {shared} ({len(skipped)} item(s) skipped)")
     split_of = assign_stratified(durations, strata, fixed, seed=cfg.seed)
-    ids: dict[str, list[str]] = {name: [] for name in SPLIT_NAMES}
-    for clip in clips:
-        clip["split"] = split_of[clip["trial"]]
-        ids[clip["split"]].append(clip["id"])
-    for name in SPLIT_NAMES:
-        ids[name].sort()
-        write_lines(out / f"{name}.txt", ids[name])
-    write_lines(out / "train_val.txt", sorted(ids["train"] + ids["val"]))
-    write_lines(out / "all.txt", sorted(c["id"] for c in clips))
-    _remove_stale(out, {c["id"] for c in clips}, stale)
-    _write_stats(out, ids["train"])
+    ids = write_splits(out, clips, split_of)
+    remove_stale(out, {c["id"] for c in clips}, stale)
+    write_stats(out, ids["train"])
     result = CorpusResult(clips=clips, skipped=skipped, reused=reused, processed=processed,
                           split_counts={k: len(v) for k, v in ids.items()})
     by_licence: dict[str, float] = {}

@@ -8,8 +8,9 @@ from typing import Any
 
 import numpy as np
 
+from simdiff.data.clip_files import Pending, clip_variants, ground_contact, support_of, write_clip
 from simdiff.data.cmu import captions as cmu_captions
-from simdiff.data.cmu.build import _kit_for_window, _process_clip, _write_clip, ground_contact, support_of
+from simdiff.data.cmu.build import kit_for_window
 from simdiff.data.cmu.windows import MIN_WINDOW, Window, plan_windows
 from simdiff.data.corpus.item import Item
 from simdiff.data.corpus.load import load_item, source_fps
@@ -61,7 +62,7 @@ def window_captions(item: Item, window: Window, clip_id: str, cfg: ClipSettings)
     n = max(cfg.captions, MIN_CAPTIONS)
     trial = item.meta.get("cmu_trial")
     if trial is not None:
-        human = _kit_for_window(trial, window)  # type: ignore[arg-type]
+        human = kit_for_window(trial, window)  # type: ignore[arg-type]
         generated = cmu_captions.describe(trial.description, n=n, seed=cfg.seed, key=clip_id)  # type: ignore[attr-defined]
         if len(human) >= MIN_CAPTIONS:
             return human, "kitml"
@@ -72,7 +73,7 @@ def window_captions(item: Item, window: Window, clip_id: str, cfg: ClipSettings)
                      key=clip_id), item.caption_origin
 
 
-def _relative(path: Path, shared: Path) -> str:
+def source_relative(path: Path, shared: Path) -> str:
     """Path of a source file relative to the shared root ("extra/<archive>/..." when extracted)."""
     try:
         return str(path.resolve().relative_to(shared.resolve()))
@@ -92,8 +93,6 @@ def process_item(item: Item, cfg: ClipSettings) -> list[dict[str, Any]]:
     Raises:
         SimdiffError: unreadable or too short source (files are written only when all clips work).
     """
-    from simdiff.motion.mirror import mirror_caption, mirror_joints
-
     joints, skipped = load_item(item)
     taken = joints.shape[0]
     before = 0
@@ -107,7 +106,7 @@ def process_item(item: Item, cfg: ClipSettings) -> list[dict[str, Any]]:
         raise SimdiffError(f"{item.path}: {taken} frames at 20 fps, shorter than {MIN_TAKE / FPS:g} s")
     fps = source_fps(item)
     records: list[dict[str, Any]] = []
-    pending: list[tuple[str, np.ndarray, np.ndarray, list[str]]] = []
+    pending: list[Pending] = []
     for k, window in enumerate(windows):
         clip_id = f"{item.id}_{k:02d}"
         texts, origin = window_captions(item, window, clip_id, cfg)
@@ -118,21 +117,15 @@ def process_item(item: Item, cfg: ClipSettings) -> list[dict[str, Any]]:
         base = {
             "trial": item.trial, "source": item.source, "rig": item.source, "licence": item.licence,
             "motion_type": item.motion_type, "caption_origin": origin, "description": item.description,
-            "file": _relative(item.path, cfg.shared), "fps": fps, "start20": window.start, "stop20": window.stop,
+            "file": source_relative(item.path, cfg.shared), "fps": fps, "start20": window.start, "stop20": window.stop,
             "source_frames": None if fps is None else [  # held (padded) frames map to the take's ends
                 int(round(min(max(t - before, 0), taken) * fps / FPS)) + skipped for t in (window.start, window.stop)],
             "window": window.origin, "padded_frames": padded,
             "ground_contact": round(contact, 3), "support": support_of(contact),
         }
-        variants = [(clip_id, piece, texts, None)]
-        if cfg.mirror:
-            variants.append((f"M{clip_id}", mirror_joints(piece), [mirror_caption(t) for t in texts], clip_id))
-        for cid, motion, lines, parent in variants:
-            features, recovered = _process_clip(cid, motion)
-            pending.append((cid, features, recovered, [cmu_captions.caption_line(s) for s in lines]))
-            rows = int(features.shape[0])
-            records.append({**base, "id": cid, "mirror_of": parent, "frames": rows,
-                            "seconds": round(rows / FPS, 3), "captions": lines})
+        new_records, new_pending = clip_variants(base, clip_id, piece, texts, cfg.mirror, cmu_captions.caption_line)
+        records += new_records
+        pending += new_pending
     for cid, features, recovered, lines in pending:
-        _write_clip(cfg.out, cid, features, recovered, lines)
+        write_clip(cfg.out, cid, features, recovered, lines)
     return records

@@ -18,8 +18,9 @@ import numpy as np
 
 from simdiff.data.cmu.crosscheck import CHECK_FPS
 from simdiff.data.cmu.writer import write_json
-from simdiff.data.corpus.item import Item, file_digest
+from simdiff.data.corpus.item import Item
 from simdiff.errors import SimdiffError
+from simdiff.fsio import file_digest
 
 VERSION: int = 2
 """Bump when the comparison changes (invalidates the cache)."""

@@ -3,7 +3,6 @@ licence table and the motion types shared by every source."""
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -79,13 +78,3 @@ class Item:
     def files(self) -> list[Path]:
         """Every file the item's output depends on."""
         return [self.path] + ([self.asf] if self.asf is not None else [])
-
-
-def file_digest(paths: list[Path]) -> str:
-    """SHA-1 of the concatenated bytes of ``paths``."""
-    sha = hashlib.sha1()
-    for path in paths:
-        with open(path, "rb") as handle:
-            for block in iter(lambda: handle.read(1 << 20), b""):
-                sha.update(block)
-    return sha.hexdigest()

@@ -1,7 +1,7 @@
 """Report of a corpus built by ``simdiff data build`` (``simdiff data report``): markdown + PNG.
 
 Sections: hours by source, licence, motion type and split (originals and with mirrors);
-split stratification; captions per origin; flight time (:mod:`.flight`); physics metrics
+split stratification; captions per origin; flight time (:mod:`simdiff.motion.flight`); physics metrics
 per source with the worst clips named; canonical-frame checks; dedupe cross-checks (kept
 copy vs other copies of a trial); filmstrips per source; skipped items. Per-clip numbers
 go to ``clip_metrics.csv``.
@@ -9,60 +9,65 @@ go to ``clip_metrics.csv``.
 
 from __future__ import annotations
 
-import csv
-import io
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from simdiff.data.cmu.report import (
-    _filmstrips, _group, _hours, _stats, _summary_figure, _table, clip_metrics, load_manifest,
-)
-from simdiff.data.cmu.writer import write_text
 from simdiff.data.corpus.crosscheck import TARGET_M, crosscheck_items
-from simdiff.data.corpus.flight import ANKLE_HEIGHT, GROUND_PERCENTILE, MIN_FLIGHT_S, TOE_HEIGHT, flight_stats
 from simdiff.data.corpus.item import LICENCES
-from simdiff.errors import SimdiffError
+from simdiff.data.report_blocks import (
+    clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table, write_report_files,
+)
+from simdiff.motion.flight import GROUND_PERCENTILE, LIFT, LIFT_EDGE, MIN_FRAMES, flight_stats
 
+MIN_FLIGHT_S: float = 0.2
+"""A flight phase this long (s) or longer marks the clip as having real flight."""
 SPLITS: tuple[str, ...] = ("train", "val", "test")
 METRICS: tuple[str, ...] = ("penetration", "floating", "sliding", "skate_ratio")
 
 
 def _hours_table(clips: list[dict[str, Any]], key: str) -> str:
     rows = []
-    for name, group in _group(clips, key).items():
+    for name, group in group_by(clips, key).items():
         originals = [c for c in group if c["mirror_of"] is None]
-        rows.append([name, len({c["trial"] for c in group}), len(originals), _hours(originals), _hours(group),
-                     *[_hours([c for c in originals if c["split"] == s]) for s in SPLITS]])
-    return _table([key, "trials", "clips (originals)", "hours (originals)", "hours (with mirrors)",
+        rows.append([name, len({c["trial"] for c in group}), len(originals), hours(originals), hours(group),
+                     *[hours([c for c in originals if c["split"] == s]) for s in SPLITS]])
+    return table([key, "trials", "clips (originals)", "hours (originals)", "hours (with mirrors)",
                    "h train", "h val", "h test"], rows)
 
 
 def _stratification(originals: list[dict[str, Any]]) -> str:
     rows = []
-    for kind, group in _group(originals, "motion_type").items():
+    for kind, group in group_by(originals, "motion_type").items():
         trials = {s: {c["trial"] for c in group if c["split"] == s} for s in SPLITS}
         rows.append([kind, *[len(trials[s]) for s in SPLITS]])
-    return _table(["motion type", "train trials", "val trials", "test trials"], rows)
+    return table(["motion type", "train trials", "val trials", "test trials"], rows)
+
+
+def _flight(joints: np.ndarray) -> dict[str, float]:
+    """Total and longest flight (s) of one clip, the two columns of ``clip_metrics.csv``."""
+    stats = flight_stats(joints)
+    return {"flight_s": stats["flight_total_s"], "longest_flight_s": stats["flight_s"]}
 
 
 def _flight_section(originals: list[dict[str, Any]], flights: dict[str, dict[str, float]]) -> list[str]:
     md = ["## Flight (both feet off the floor)", "",
-          f"A frame is airborne when both ankles are above {ANKLE_HEIGHT * 100:.0f} cm and both toes and every "
-          f"other joint above {TOE_HEIGHT * 100:.0f} cm over the clip's ground (the {GROUND_PERCENTILE:g}th "
-          "percentile of the per-frame lowest joint), heights only (`simdiff.data.corpus.flight`). Original "
+          f"A flight is a run of at least {MIN_FRAMES} frames where every foot joint (both ankles and toes) is "
+          f"more than {LIFT * 100:.0f} cm above its own ground level (its {GROUND_PERCENTILE:g}th percentile "
+          f"height over the clip), extended to where all are still {LIFT_EDGE * 100:.0f} cm up; heights only "
+          "(`simdiff.motion.flight`, the rule also used for augmented and generated motions). Original "
           "clips with `support: floor` only (a mirror flies as its original; `props` clips, hanging or "
           "climbing, are left out).", ""]
     originals = [c for c in originals if c.get("support", "floor") == "floor"]
     rows = []
-    for source, group in [("all", originals)] + list(_group(originals, "source").items()):
+    for source, group in [("all", originals)] + list(group_by(originals, "source").items()):
         f = [flights[c["id"]] for c in group]
         rows.append([source, len(group), sum(x["flight_s"] for x in f) / 60,
                      sum(1 for x in f if x["longest_flight_s"] >= MIN_FLIGHT_S - 1e-9),
                      max((x["longest_flight_s"] for x in f), default=0.0)])
-    md.append(_table(["source", "clips", "flight time (min)", f"clips with a flight >= {MIN_FLIGHT_S} s",
+    md.append(table(["source", "clips", "flight time (min)", f"clips with a flight >= {MIN_FLIGHT_S} s",
                       "longest flight (s)"], rows))
     longest = sorted(originals, key=lambda c: (-flights[c["id"]]["longest_flight_s"], c["id"]))[:8]
     md += ["", "Longest flights (check: a wrong floor also reads as flight):", ""]
@@ -77,10 +82,10 @@ def _physics_section(originals: list[dict[str, Any]], by_id: dict[str, dict[str,
           "sliding (mm per frame of the lowest joint on the ground), skate ratio. mean / median / p95 over "
           "original clips.", ""]
     rows = []
-    for source, group in [("all", originals)] + list(_group(originals, "source").items()):
+    for source, group in [("all", originals)] + list(group_by(originals, "source").items()):
         vals = [by_id[c["id"]] for c in group]
-        rows.append([source, len(group)] + [" / ".join(f"{x:.2f}" for x in _stats([v[k] for v in vals])) for k in METRICS])
-    md.append(_table(["source", "clips", "penetration mm", "floating mm", "sliding mm/frame", "skate ratio"], rows))
+        rows.append([source, len(group)] + [" / ".join(f"{x:.2f}" for x in stats([v[k] for v in vals])) for k in METRICS])
+    md.append(table(["source", "clips", "penetration mm", "floating mm", "sliding mm/frame", "skate ratio"], rows))
     md += ["", "Worst clips per metric:", ""]
     for key in METRICS:
         if max(by_id[c["id"]][key] for c in originals) <= 0:
@@ -90,7 +95,7 @@ def _physics_section(originals: list[dict[str, Any]], by_id: dict[str, dict[str,
         md.append(f"- {key}: " + "; ".join(
             f"`{c['id']}` ({c['source']}, {c['description']}) {by_id[c['id']][key]:.2f}" for c in worst))
     md += ["", "Worst floating clip of each source:", ""]
-    for source, group in _group(originals, "source").items():
+    for source, group in group_by(originals, "source").items():
         c = max(group, key=lambda c: (by_id[c["id"]]["floating"], c["id"]))
         md.append(f"- {source}: `{c['id']}` ({c['description']}, support {c.get('support')}): floating "
                   f"{by_id[c['id']]['floating']:.1f} mm, skate {by_id[c['id']]['skate_ratio']:.2f}")
@@ -113,14 +118,14 @@ def _crosscheck_section(manifest: dict[str, Any], corpus: Path, progress: bool) 
            "corpus clip (canonical bone lengths, floor, facing +Z), then aligned in time (±0.2 s) and space (yaw "
            "+ translation); MPJPE = mean per-joint distance. Target ≤ "
            f"{TARGET_M * 100:.0f} cm.", ""]
-    table = []
+    pair_rows = []
     for (kept, copy), group in sorted(Counter((r["kept"], r["copy"]) for r in ok).items()):
         del group
         vals = np.array([r["mpjpe"] for r in ok if (r["kept"], r["copy"]) == (kept, copy)])
         pose = np.array([r["pose_only"] for r in ok if (r["kept"], r["copy"]) == (kept, copy)])
-        table.append([f"{kept} vs {copy}", len(vals), vals.mean() * 100, float(np.median(vals)) * 100,
+        pair_rows.append([f"{kept} vs {copy}", len(vals), vals.mean() * 100, float(np.median(vals)) * 100,
                       pose.mean() * 100, f"{int(np.sum(vals <= TARGET_M))}/{len(vals)}"])
-    md.append(_table(["pair", "trials", "MPJPE mean cm", "MPJPE median cm", "pose-only mean cm", "<= target"], table))
+    md.append(table(["pair", "trials", "MPJPE mean cm", "MPJPE median cm", "pose-only mean cm", "<= target"], pair_rows))
     worst = sorted(ok, key=lambda r: -r["mpjpe"])[:6]
     md += ["", "Largest disagreements: " + "; ".join(
         f"`{r['trial']}` {r['kept']} vs {r['copy']} {r['mpjpe'] * 100:.1f} cm (worst joint {r['worst_joint']})"
@@ -136,16 +141,10 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
                         crosscheck: bool = True, progress: bool = True) -> Path:
     """Write ``report.md``, ``summary.png``, filmstrips and ``clip_metrics.csv`` into ``out``
     (default ``corpus/report``); returns the path of ``report.md``."""
-    corpus = Path(corpus)
-    manifest = load_manifest(corpus)
-    out = Path(out) if out is not None else corpus / "report"
-    out.mkdir(parents=True, exist_ok=True)
-    clips: list[dict[str, Any]] = manifest["clips"]
-    if not clips:
-        raise SimdiffError(f"{corpus}/manifest.json lists no clips")
+    corpus, manifest, out, clips = open_report(corpus, out)
     originals = [c for c in clips if c["mirror_of"] is None]
     metrics = clip_metrics(corpus, originals)
-    flights = {c["id"]: flight_stats(np.load(corpus / "new_joints" / f"{c['id']}.npy")) for c in originals}
+    flights = {c["id"]: _flight(np.load(corpus / "new_joints" / f"{c['id']}.npy")) for c in originals}
     for row in metrics:
         row.update(flights[row["id"]])
     by_id = {m["id"]: m for m in metrics}
@@ -155,8 +154,8 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
           f"`{manifest.get('licence')}`, seed {manifest.get('seed')}, sources {', '.join(manifest.get('sources', []))}). "
           "HumanML3D layout, 20 fps, 22 joints, 263-dim features; every clip has a mirrored `M…` copy.", "",
           "## Overview", ""]
-    md.append(_table(["clips", "originals", "trials", "hours (originals)", "hours (with mirrors)", "skipped items"], [[
-        len(clips), len(originals), len({c["trial"] for c in clips}), _hours(originals), _hours(clips),
+    md.append(table(["clips", "originals", "trials", "hours (originals)", "hours (with mirrors)", "skipped items"], [[
+        len(clips), len(originals), len({c["trial"] for c in clips}), hours(originals), hours(clips),
         counts.get("skipped_items", len(manifest.get("skipped", [])))]]))
     md += ["", "![summary](summary.png)", "", "## Hours by licence", ""]
     md.append(_hours_table(clips, "licence"))
@@ -168,22 +167,22 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
     md += ["", "## Splits", "", "By trial (a trial's windows and mirrors share a split); CMU trials with "
            "HumanML3D segments follow HumanML3D; the rest are stratified by (source, motion type) so that every "
            "stratum of >= 3 trials has a test and a val trial.", ""]
-    md.append(_table(["split", "clips", "trials", "hours (originals)"], [
+    md.append(table(["split", "clips", "trials", "hours (originals)"], [
         [s, len([c for c in clips if c["split"] == s]), len({c["trial"] for c in clips if c["split"] == s}),
-         _hours([c for c in originals if c["split"] == s])] for s in SPLITS]))
+         hours([c for c in originals if c["split"] == s])] for s in SPLITS]))
     md += ["", _stratification(originals), "", "## Captions", ""]
-    md.append(_table(["origin", "clips", "captions per clip (min / mean)", "distinct sentences"], [
+    md.append(table(["origin", "clips", "captions per clip (min / mean)", "distinct sentences"], [
         [origin, len(g), f"{min(len(c['captions']) for c in g)} / {np.mean([len(c['captions']) for c in g]):.2f}",
-         len({s for c in g for s in c["captions"]})] for origin, g in _group(clips, "caption_origin").items()]))
+         len({s for c in g for s in c["captions"]})] for origin, g in group_by(clips, "caption_origin").items()]))
     md += ["", "Examples of generated captions (KIT-ML human text is not reproduced here):", ""]
-    for source, group in _group(originals, "source").items():
+    for source, group in group_by(originals, "source").items():
         c = next((c for c in group if not c["caption_origin"].startswith("kitml")), None)
         if c is not None:
             md.append(f"- {source} `{c['id']}` ({c['description']}): " + " / ".join(f"“{s}”" for s in c["captions"]))
     md += [""] + _flight_section(originals, flights) + [""] + _physics_section(originals, by_id)
     floor = [m["floor"] for m in metrics]
     md += ["", "## Canonical frame checks (original clips)", ""]
-    md.append(_table(["check", "result"], [
+    md.append(table(["check", "result"], [
         ["lowest joint over the clip (m)", f"min {min(floor):.4f}, max {max(floor):.4f}"],
         ["frame-0 facing angle from +Z (deg)", f"max {max(abs(m['facing0']) for m in metrics):.2f}"],
         ["frames with head above pelvis", f"mean {np.mean([m['upright'] for m in metrics]) * 100:.1f} %"],
@@ -193,9 +192,9 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
     if padded:
         md += ["", f"Short takes (0.5-2 s) padded to 2 s by holding their first and last pose: {len(padded)} clips "
                f"({', '.join(f'{k} {v}' for k, v in sorted(Counter(c['source'] for c in padded).items()))})."]
-    _summary_figure(out / "summary.png", clips, metrics)
+    summary_figure(out / "summary.png", clips, metrics)
     md += ["", "## Filmstrips", "", "Each row: 8 evenly spaced frames of one clip as stored in `new_joints`.", ""]
-    for title, image in _filmstrips(corpus, out, clips, seed):
+    for title, image in filmstrips(corpus, out, clips, seed):
         md += [f"### {title}", "", f"![{title}]({image.name})", ""]
     skipped = manifest.get("skipped", [])
     if skipped:
@@ -205,12 +204,4 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
             reasons.setdefault(reason, []).append(item["id"])
         md += ["## Skipped items", ""]
         md += [f"- {r}: {len(ids)} ({', '.join(ids[:12])}{', …' if len(ids) > 12 else ''})" for r, ids in sorted(reasons.items())]
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=list(metrics[0].keys()), lineterminator="\n")
-    writer.writeheader()
-    for row in metrics:
-        writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
-    write_text(out / "clip_metrics.csv", buffer.getvalue())
-    report = out / "report.md"
-    write_text(report, "\n".join(md) + "\n")
-    return report
+    return write_report_files(out, md, metrics)

@@ -7,7 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from simdiff.data.corpus.archive import source_dir
-from simdiff.data.corpus.item import Item, file_digest
+from simdiff.data.corpus.item import Item
+from simdiff.fsio import file_digest
 
 NAMES: dict[str, tuple[str, tuple[str, ...]]] = {
     "backflip": ("acrobatics", ("does a backflip", "flips backwards in the air")),

@@ -21,10 +21,9 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ModelSpec
 from simdiff.eval.experiments.fig5 import conditions
-from simdiff.eval.experiments.report import fmt_env
+from simdiff.eval.experiments.report import fmt_env, save_figure
 from simdiff.eval.experiments.runner import EARTH, FPS, RowPlan, Runner, safe
 from simdiff.eval.response import additivity, check_grid, effects, quantities, score
-from simdiff.fsio import atomic_path
 
 TITLE = "Environment response — generated effects of φ against the simulator's"
 LABELS: dict[str, str] = {"apex_m": "apex (m)", "flight_s": "flight time (s)", "step_length_m": "step length (m)",
@@ -154,11 +153,7 @@ def figure(rows: list[dict[str, Any]], path: Any) -> Any:
         ax.set_ylabel(f"generated Δ {LABELS[q]}")
         ax.set_title(f"{f}: {LABELS[q]}", fontsize=9)
     axes[0].legend(fontsize=7)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def finish(runner: Runner, report: dict[str, Any]) -> list[str]:

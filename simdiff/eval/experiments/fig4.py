@@ -17,9 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.fsio import atomic_path
 from simdiff.eval.experiments.config import ModelSpec
-from simdiff.eval.experiments.report import speed_comparison, value
+from simdiff.eval.experiments.report import save_figure, speed_comparison, value
 from simdiff.eval.experiments.rows import method_key
 from simdiff.eval.experiments.runner import EARTH, FPS, RowPlan, Runner
 
@@ -113,11 +112,7 @@ def figure(rows: list[dict[str, Any]], ref: float, path: Any) -> Any:
     ax.set_title("batch 1; ratio to MDM-DDIM above each bar; hatched: simulator projection", fontsize=9)
     ax.legend(fontsize=8)
     ax.margins(y=0.2)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def finish(runner: Runner, report: dict[str, Any]) -> list[str]:

@@ -20,12 +20,12 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.fsio import atomic_path, save_npy
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ModelSpec
-from simdiff.eval.experiments.report import fmt_env
+from simdiff.eval.experiments.report import fmt_env, save_figure
 from simdiff.eval.experiments.runner import EARTH, RowPlan, Runner, env_key, safe
 from simdiff.eval.stats import t_interval
+from simdiff.fsio import save_npy
 
 TITLE = "Figure 5 — environment control"
 STANDING_FRAMES: int = 5
@@ -130,11 +130,7 @@ def sweep_figure(rows: list[dict[str, Any]], path: Path) -> Path:
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
     axes[0].legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def _on_axis(row: dict[str, Any], factor: str) -> bool:
@@ -175,11 +171,7 @@ def combination_figure(rows: list[dict[str, Any]], path: Path) -> Path:
         ax.axhline(0, color="black", lw=0.6)
         ax.set_xticks(range(len(keys)), [t for _, t in keys])
         ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def filmstrips(runner: Runner, rows: list[dict[str, Any]]) -> list[Path]:

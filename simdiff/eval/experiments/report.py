@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
+
+from simdiff.fsio import atomic_path
 
 T2M_METRICS: tuple[tuple[str, str], ...] = (
     ("r_precision_top1", "R@1↑"), ("r_precision_top2", "R@2↑"), ("r_precision_top3", "R@3↑"), ("fid", "FID↓"),
@@ -102,3 +105,14 @@ def header(report: dict[str, Any], title: str) -> list[str]:
     lines.append(f"* rows: {len(rows)} ({sum(1 for r in rows if r.get('reused_from'))} reused from other reports); "
                  f"measurement time {duration(measured)} (estimated {duration(estimate)})")
     return lines + [""]
+
+
+def save_figure(fig: Any, path: Path, dpi: int = 110) -> Path:
+    """Lay out a matplotlib figure, write it to ``path`` atomically and close it; returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi)
+    plt.close(fig)
+    return path

@@ -16,9 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.fsio import atomic_path
 from simdiff.eval.experiments.config import ModelSpec
-from simdiff.eval.experiments.report import fmt_env, value
+from simdiff.eval.experiments.report import fmt_env, save_figure, value
 from simdiff.eval.experiments.runner import EARTH, RowPlan, Runner, env_key, safe
 
 TITLE = "Closed loop — re-tracking generated motions under their φ"
@@ -118,11 +117,7 @@ def figure(rows: list[dict[str, Any]], path: Any) -> Any:
         ax.set_title(title, fontsize=10)
     axes[0].set_ylim(0, 1.05)
     axes[0].legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def finish(runner: Runner, report: dict[str, Any]) -> list[str]:

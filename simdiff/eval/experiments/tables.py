@@ -5,8 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from simdiff.fsio import atomic_path
-from simdiff.eval.experiments.report import FID_NOTE, INTERVAL_NOTE, PHYS_ERR_NOTE, PHYSICS_METRICS, T2M_METRICS, mean_ci, value
+from simdiff.eval.experiments.report import FID_NOTE, INTERVAL_NOTE, PHYS_ERR_NOTE, PHYSICS_METRICS, T2M_METRICS, mean_ci, save_figure, value
 from simdiff.eval.experiments.rows import phys_err, phys_err_ci
 
 
@@ -68,11 +67,7 @@ def alpha_figure(rows: list[dict[str, Any]], path: Path, best: float | None = No
         ax.set_xlabel("adapter scale α")
         ax.set_title(title, fontsize=10)
     axes[0].legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def method_figure(rows: list[dict[str, Any]], path: Path) -> Path:
@@ -94,8 +89,4 @@ def method_figure(rows: list[dict[str, Any]], path: Path) -> Path:
     axes[1].set_title("Phys-Err = penetrate + slide + |float − GT float| (mm) ↓", fontsize=9)
     for ax in axes:
         ax.set_xticks(range(len(rows)), labels, fontsize=7, rotation=45, ha="right")
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -1,14 +1,8 @@
-"""Acclaim ASF skeleton + AMC motion reader (the CMU mocap format).
+"""Acclaim AMC motion reader (the CMU mocap format) on an ASF skeleton.
 
-Units: ASF ``:units length L`` means a stored length ``v`` is ``v / L`` inches, so metres
-are ``v / L * 0.0254`` (CMU: L = 0.45). The root translation in AMC uses the same unit.
-Angles are degrees unless ``angle rad`` (ASF) or ``:RADIANS`` (AMC). CMU data is Y-up.
-
-Rotation conventions (column vectors): a bone's local frame is ``C`` = its ``axis`` angles
-applied in the stated order (``axis 0 0 20 XYZ`` -> Rz @ Ry @ Rx); its motion ``M`` is its
-``dof`` angles applied in the listed order (``dof rx ry rz`` -> Rz @ Ry @ Rx). The global
-rotation is ``G = G_parent @ C @ M @ C^-1`` and the bone's end lies at
-``parent_end + G @ direction * length``.
+The skeleton, its units (``:units length``, metres = ``v / L * 0.0254``) and the rotation
+conventions (``G = G_parent @ C @ M @ C^-1``) are documented in :mod:`simdiff.motion.io.asf`;
+the AMC root translation uses the ASF length unit, angles are degrees unless ``:RADIANS``.
 """
 
 from __future__ import annotations

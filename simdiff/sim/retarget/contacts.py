@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from simdiff.motion.flight import runs
 from simdiff.sim.retarget.config import RetargetConfig
 from simdiff.sim.retarget.ik import IKTask
 from simdiff.sim.retarget.kinematics import box_bottom_corners, foot_geoms
@@ -80,20 +81,6 @@ def ground_level(height: np.ndarray, xy: np.ndarray, fps: float, still_speed: fl
     return float(np.percentile(low, 10))
 
 
-def _intervals(mask: np.ndarray) -> list[tuple[int, int]]:
-    """Half-open [start, end) runs of True."""
-    out, start = [], None
-    for t, v in enumerate(mask):
-        if v and start is None:
-            start = t
-        elif not v and start is not None:
-            out.append((start, t))
-            start = None
-    if start is not None:
-        out.append((start, len(mask)))
-    return out
-
-
 def stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 20.0,
                   max_tilt: float = np.deg2rad(12.0), reach: np.ndarray | None = None) -> list[list[IKTask]]:
     """Per-frame tasks that hold each touching foot box flat, on the floor, at a fixed xy.
@@ -128,7 +115,7 @@ def stance_tasks(model, qpos: np.ndarray, contact: np.ndarray, weight: float = 2
             flat[t, k] = R[2, 2] > np.cos(max_tilt)
     tasks: list[list[IKTask]] = [[] for _ in range(qpos.shape[0])]
     for k, b in enumerate(bodies):
-        for s, e in _intervals(contact[:, k] & flat[:, k]):
+        for s, e in runs(contact[:, k] & flat[:, k]):
             p = np.median(pos[s:e, k], axis=0)
             p[2] = rest_h[k]
             y = float(np.angle(np.mean(np.exp(1j * yaw[s:e, k]))))

@@ -57,32 +57,3 @@ def biped_map(names: tuple[str, ...]) -> dict[str, Source] | None:
         if f"{side}_collar" not in out:
             out[f"{side}_collar"] = (neck, str(out[f"{side}_shoulder"]), 0.45)
     return out
-def _normalise(name: str) -> str:
-    """Lower-case, namespace prefix (``mixamorig:``) and separators removed."""
-    name = name.rsplit(":", 1)[-1].rsplit("|", 1)[-1]
-    return "".join(c for c in name.lower() if c.isalnum())
-
-
-def biped_map(names: tuple[str, ...]) -> dict[str, Source] | None:
-    """Joint map for a BVH with common biped names, or None when joints are missing."""
-    lookup = {}
-    for name in names:
-        lookup.setdefault(_normalise(name), name)
-    out: dict[str, Source] = {}
-    for target, candidates in _BIPED_CANDIDATES.items():
-        found = next((lookup[c] for c in candidates if c in lookup), None)
-        if found is not None:
-            out[target] = found
-    optional = ("left_foot", "right_foot", "left_collar", "right_collar")
-    if any(t not in out for t in _BIPED_CANDIDATES if t not in optional):
-        return None
-    spine = [lookup[s] for s in _BIPED_SPINE if s in lookup]
-    pelvis, neck = str(out["pelvis"]), str(out["neck"])
-    # spine1..3 at the given spine joints, or at 0.25/0.5/0.6 of pelvis -> neck
-    fallbacks = ((pelvis, neck, 0.25), (pelvis, neck, 0.5), (pelvis, neck, 0.6))
-    for k, target in enumerate(("spine1", "spine2", "spine3")):
-        out[target] = spine[k] if k < len(spine) else fallbacks[k]
-    for side in ("left", "right"):
-        if f"{side}_collar" not in out:
-            out[f"{side}_collar"] = (neck, str(out[f"{side}_shoulder"]), 0.45)
-    return out
