@@ -7,7 +7,6 @@ import json
 from pathlib import Path
 
 import pytest
-import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.eval.testing import write_tiny_corpus
@@ -16,12 +15,7 @@ from simdiff.train.curves import DESIGNS, design_config
 ROOT = Path(__file__).resolve().parent.parent
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def test_train_curves_script_writes_json_and_png(tmp_path) -> None:

@@ -14,12 +14,7 @@ from simdiff.train.geometric import CropConfig, GeometricLossConfig, crop_batch,
 from simdiff.train.testing import HashTextEncoder, tiny_run_config
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def _walk_batch() -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:

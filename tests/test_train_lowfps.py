@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import torch
 
 from simdiff.data.humanml3d import HumanML3D
 from simdiff.errors import SimdiffError
@@ -20,12 +19,7 @@ from simdiff.train.lowfps import build_lowfps_corpus, downsample_features, upsam
 ROOT = Path(__file__).resolve().parent.parent
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def test_resampling_shapes_and_exact_keyframes() -> None:

@@ -16,7 +16,6 @@ from simdiff.cli.main import main
 from simdiff.data.augment import AugmentConfig, augment
 from simdiff.data.pack import pack, unpack
 from simdiff.errors import SimdiffError
-from simdiff.eval.testing import write_tiny_corpus
 from simdiff.model.checkpoint import build_network, load_pretrained, save_pretrained
 from simdiff.model.config import ModelConfig, SimConfig, backbone_preset
 from simdiff.model.generator import MotionGenerator
@@ -27,17 +26,13 @@ from simdiff.train.testing import EchoProjector, HashTextEncoder
 ROOT = Path(__file__).resolve().parent.parent
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
+
 
 
 @pytest.fixture(scope="module")
-def corpus(tmp_path_factory):
-    return write_tiny_corpus(tmp_path_factory.mktemp("corpus"), n_train=8, n_val=4, n_test=4, frames=48)
+def corpus(tiny_corpus):
+    return tiny_corpus
 
 
 def _clips(folder: Path) -> dict[str, np.ndarray]:

@@ -5,10 +5,8 @@ from __future__ import annotations
 import json
 
 import pytest
-import torch
 
 from simdiff.errors import SimdiffError
-from simdiff.eval.testing import write_tiny_corpus
 from simdiff.model.generator import MotionGenerator
 from simdiff.train.pipeline import budget_config, run_pipeline
 from simdiff.train.pipeline.config import set_option
@@ -17,17 +15,13 @@ from simdiff.train.testing import EchoProjector, HashTextEncoder
 STAGES = ["corpus", "augment", "backbone", "adapters", "evaluator", "evaluation", "export"]
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
+
 
 
 @pytest.fixture(scope="module")
-def corpus(tmp_path_factory):
-    return write_tiny_corpus(tmp_path_factory.mktemp("corpus"), n_train=8, n_val=4, n_test=4, frames=48)
+def corpus(tiny_corpus):
+    return tiny_corpus
 
 
 def _run(config, out, **kw):
