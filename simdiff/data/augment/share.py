@@ -1,0 +1,44 @@
+"""Sharing mirrors (``--share-mirrors``): derive the pairs of a mirrored clip ``M<id>`` from ``<id>``'s.
+
+The MuJoCo humanoid and its tracker are left-right symmetric, so the rollout of the mirrored
+clip under the mirrored environment is (up to numerics) the mirror of the original's rollout
+(measured: ``reports/augment/mirror_check.md``). Mirroring negates HumanML3D's X axis (the
+character's left at frame 0); wind ``w_x`` is the force along HumanML3D +X
+(:mod:`simdiff.sim.env`: world y = HumanML3D x, ``gravity_vector`` = (w_y, w_x, g_z)/M), so
+mirror(φ) = (g_z, −w_x, w_y). With sharing, ``M<id>``'s conditions are mirror(``<id>``'s)
+rather than independent draws, and its rollouts are mirror(``<id>``'s rollouts).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from simdiff.data.augment.conditions import AugmentEnv
+from simdiff.motion.mirror import mirror_joints
+from simdiff.sim.env import Environment
+
+MIRROR_PREFIX = "M"
+
+
+def mirror_env(env: Environment) -> Environment:
+    """mirror(φ) = (g_z, −w_x, w_y): the wind component along HumanML3D X flips, the rest stays."""
+    return Environment(env.gravity, -env.wind_x + 0.0, env.wind_y)
+
+
+def mirror_condition(cond: AugmentEnv) -> AugmentEnv:
+    """The same condition index and factor under the mirrored environment."""
+    return AugmentEnv(cond.index, cond.factor, mirror_env(cond.env))
+
+
+def mirror_sources(clips: Sequence[str]) -> dict[str, str]:
+    """{mirrored clip ``M<id>``: its original ``<id>``} for the pairs that are both in ``clips``."""
+    present = set(clips)
+    return {c: c[len(MIRROR_PREFIX):] for c in clips
+            if c.startswith(MIRROR_PREFIX) and c[len(MIRROR_PREFIX):] in present}
+
+
+def mirror_rollout(rollout: np.ndarray | None) -> np.ndarray | None:
+    """(T, 22, 3) rollout joints mirrored (None stays None)."""
+    return None if rollout is None else np.asarray(mirror_joints(np.asarray(rollout, dtype=np.float32)), dtype=np.float32)
