@@ -40,6 +40,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--per-clip", type=int,
                    help="random mode: project each clip under this many of the conditions, balanced "
                         "round-robin (default: all of them; the paper's full cross product)")
+    p.add_argument("--share-mirrors", action="store_true",
+                   help="paired/binary: derive each mirrored clip M<id> from <id>'s rollouts under mirror(phi) "
+                        "(w_x negated) instead of simulating it (the simulator is left-right symmetric: "
+                        "reports/augment/mirror_check.md); M<id>'s conditions are then mirror(<id>'s)")
     p.add_argument("--limit", type=int, help="augment only the first N clips of the split")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(func=run)
@@ -57,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
                            filter=FilterConfig(max_pose_d_l2=pose, max_residual_n=residual_n,
                                                max_d_l2=args.max_d_l2, max_residual=args.max_residual),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
-                           per_clip=args.per_clip)
+                           per_clip=args.per_clip, share_mirrors=args.share_mirrors)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)
     frac = report["kept_fraction"]
     print(f"kept {report['kept']}/{report['pairs']} pairs" + (f" ({100 * frac:.1f} %)" if frac is not None else "")

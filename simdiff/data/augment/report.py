@@ -25,6 +25,10 @@ def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Augment
             ``info``, and in paired mode ``env``, ``signal``, ``content``).
         conditions: the run's shared condition list (paired mode: Earth only).
         config: the :class:`simdiff.data.augment.run.AugmentConfig`.
+
+    Pairs derived from a mirror (``mirrored_from``, ``--share-mirrors``) count in the keep
+    rates and the signal table (they are in the corpus) but not in the simulator CPU time (they
+    cost none) nor in the confound check (their φ is mirror(original φ), not a draw of its own).
     """
     by_index = {c.index: c for c in conditions}
     filt: FilterConfig = getattr(config, "filter", FilterConfig())
@@ -48,18 +52,21 @@ def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Augment
             row[f"rejected_{c}"] += bool(v)
     for row in bins.values():
         row["kept_fraction"] = row["kept"] / row["pairs"] if row["pairs"] else None
-    cpu = [float(r["info"].get("cpu_s", 0.0)) for r in records if isinstance(r["info"], dict)]
-    sim_s = [float(r["info"].get("n_out", 0)) / 20.0 for r in records if isinstance(r["info"], dict)]
+    simulated = [r for r in records if not r.get("mirrored_from")]
+    cpu = [float(r["info"].get("cpu_s", 0.0)) for r in simulated if isinstance(r["info"], dict)]
+    sim_s = [float(r["info"].get("n_out", 0)) / 20.0 for r in simulated if isinstance(r["info"], dict)]
     total_kept = sum(1 for r in records if r["kept"])
     content = {r["clip"]: r["content"] for r in records if r.get("content")}
     table_in = [{"clip": r["clip"], "env": _env(r, by_index), "kept": r["kept"], "signal": r.get("signal")}
                 for r in records]
+    drawn = [t for t, r in zip(table_in, records) if t["kept"] and not r.get("mirrored_from")]
     return {"settings": config.settings(), "pairs": len(records), "kept": total_kept,
+            "mirrored_pairs": len(records) - len(simulated),
             "kept_fraction": total_kept / len(records) if records else None,
             "clips": len({r["clip"] for r in records}), "sim_cpu_s_total": round(sum(cpu), 3),
             "cpu_s_per_sim_s": round(sum(cpu) / sum(sim_s), 4) if sum(sim_s) > 0 else None,
             "per_condition": rows, "per_bin": dict(sorted(bins.items())),
-            "confound": confound_check([t for t in table_in if t["kept"]], content),
+            "confound": confound_check(drawn, content),
             "signal": signal_table(table_in)}
 
 
@@ -70,6 +77,7 @@ def report_markdown(report: dict[str, Any]) -> str:
         "# Simulator-augmented corpus", "",
         f"* pairs: {report['pairs']} from {report['clips']} clips; kept {report['kept']}"
         + (f" ({100 * frac:.1f} %)" if frac is not None else ""),
+        f"* pairs derived from a mirror (not simulated): {report.get('mirrored_pairs', 0)}",
         f"* filter: {report['settings']['filter']}; tracker residual bound {report['settings']['residual_bound']}·m·g",
         f"* simulator CPU time: {report['sim_cpu_s_total']} s ({report.get('cpu_s_per_sim_s')} CPU s per simulated s)", "",
         "## Keep rate per condition bin (each criterion judged on its own)", "",
@@ -80,7 +88,7 @@ def report_markdown(report: dict[str, Any]) -> str:
         lines.append(f"| {b} | {r['pairs']} | {r['kept']} | {pct} | {r['rejected_failed']} | {r['rejected_faithfulness']} "
                      f"| {r['rejected_residual']} | {r['error']} |")
     c = report["confound"]
-    lines += ["", "## Confound check (φ vs clip content over kept pairs)", "",
+    lines += ["", "## Confound check (φ vs clip content over kept pairs with drawn φ)", "",
               f"* max |r| = {c['max_abs_r'] if c['max_abs_r'] is None else round(c['max_abs_r'], 3)} "
               f"({c['worst']}) over {c['pairs']} pairs; passes (≤ {c['bound']}): {c['passes']}", "",
               "## Physics signal (medians, against each clip's own Earth rollout)", "", signal_markdown(report["signal"])]

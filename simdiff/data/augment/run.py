@@ -18,7 +18,9 @@ Output (``out``), in the HumanML3D layout plus φ::
 
 ``env_index``: binary mode labels simulated clips 1 (0 is left for the source, kinematic
 clips, see :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`); random mode uses the
-condition index. Resuming: shards whose file exists with the same clips are skipped; files a
+condition index. ``--share-mirrors`` (:mod:`simdiff.data.augment.share`): a mirrored clip
+``M<id>`` whose original is in the split is not simulated; its pairs are the mirrors of
+``<id>``'s under mirror(φ) (records carry ``mirrored_from``). Resuming: shards whose file exists with the same clips are skipped; files a
 killed shard left behind are overwritten by its re-run, and files of no finished shard are
 deleted when the run finalises.
 """
@@ -40,6 +42,7 @@ from simdiff.fsio import write_text
 from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
 from simdiff.data.augment.filter import FilterConfig, keep_pair
 from simdiff.data.augment.report import build_report, report_markdown
+from simdiff.data.augment.share import group_mirrors, mirror_condition, mirror_info, mirror_rollout, mirror_sources
 from simdiff.data.augment.projector import Projector, SimProjector
 from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_npy
 from simdiff.errors import SimdiffError
@@ -69,6 +72,9 @@ class AugmentConfig:
             (balanced round-robin over the split order) instead of all of them; None = all.
             Round-robin ties each condition to a fixed group of clips (φ confounded with
             content); ``paired`` mode draws per clip instead.
+        share_mirrors: derive each mirrored clip ``M<id>`` (original in the split) from
+            ``<id>``'s rollouts instead of simulating it (paired and binary modes); its
+            conditions are then mirror(``<id>``'s), not independent draws.
 
     Modes (:mod:`simdiff.data.augment.conditions`): ``paired`` (default; Earth + ``conditions``
     (default 6) draws per clip), ``paper`` (every clip under all ``conditions`` (30) random
@@ -86,6 +92,7 @@ class AugmentConfig:
     workers: int = 0
     backend: str = "process"
     per_clip: int | None = None
+    share_mirrors: bool = False
 
     @property
     def n_conditions(self) -> int:
@@ -103,6 +110,8 @@ class AugmentConfig:
                     "filter": dataclasses.asdict(self.filter), "residual_bound": self.residual_bound}
         if self.per_clip is not None:
             settings["per_clip"] = self.per_clip
+        if self.share_mirrors:
+            settings["share_mirrors"] = True
         return settings
 
 
@@ -125,8 +134,13 @@ def conditions_for(clips: Sequence[str], conditions: Sequence[AugmentEnv], confi
                    ) -> dict[str, list[AugmentEnv]]:
     """Conditions of every clip under ``config``'s mode (paired: drawn per clip)."""
     if config.mode == "paired":
-        return {c: paired_conditions(c, config.n_conditions, config.seed) for c in clips}
-    return assign_conditions(clips, conditions, config.per_clip if config.mode == "random" else None)
+        out = {c: paired_conditions(c, config.n_conditions, config.seed) for c in clips}
+    else:
+        out = assign_conditions(clips, conditions, config.per_clip if config.mode == "random" else None)
+    if config.share_mirrors:
+        for mx, x in mirror_sources(clips).items():
+            out[mx] = [mirror_condition(c) for c in out[x]]
+    return out
 
 
 def clip_id_for(clip: str, condition: AugmentEnv) -> str:
@@ -208,6 +222,13 @@ def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[AugmentEn
     if not clips:
         raise SimdiffError(f"{corpus / (config.split + '.txt')}: no clips to augment")
     conditions = make_conditions(config.mode, config.n_conditions, config.seed)
+    if config.share_mirrors:
+        if config.mode not in ("paired", "binary"):
+            raise SimdiffError(f"--share-mirrors needs paired or binary mode, got {config.mode!r} "
+                               "(a shared condition list has no mirrored copy)")
+        units = group_mirrors(clips)  # shard_size originals per shard, each with its mirror
+        shards = [[c for u in units[i : i + config.shard_size] for c in u] for i in range(0, len(units), config.shard_size)]
+        return [c for shard in shards for c in shard], conditions, shards
     shards = [clips[i : i + config.shard_size] for i in range(0, len(clips), config.shard_size)]
     return clips, conditions, shards
 
@@ -224,12 +245,38 @@ def _check_settings(out: Path, config: AugmentConfig, conditions: list[AugmentEn
         write_json(path, settings)
 
 
+def _pair_record(corpus: Path, out: Path, clip: str, cond: AugmentEnv, rollout: np.ndarray | None, info: Any,
+                 kept: bool, reason: str, content: dict[str, float] | None) -> dict[str, Any]:
+    """Write a kept pair's files (features, joints, caption) and return its shard record."""
+    from simdiff.data.augment.signal import measure
+
+    aid = clip_id_for(clip, cond)
+    if kept:
+        try:
+            feats, joints = rollout_to_layout(rollout)
+        except SimdiffError as exc:
+            kept, reason, info = False, "error", str(exc)
+        else:
+            write_npy(out / "new_joint_vecs" / f"{aid}.npy", feats)
+            write_npy(out / "new_joints" / f"{aid}.npy", joints)
+            write_bytes(out / "texts" / f"{aid}.txt", (corpus / "texts" / f"{clip}.txt").read_bytes())
+    signal = None
+    if rollout is not None and bool(getattr(info, "success", False) or (isinstance(info, dict) and info.get("success"))):
+        try:
+            signal = measure(rollout)
+        except SimdiffError:
+            signal = None
+    return {"clip": clip, "condition": cond.index, "id": aid, "kept": kept, "reason": reason, "info": info,
+            "env": list(cond.env.as_tuple()), "factor": cond.factor, "signal": signal, "content": content}
+
+
 def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[AugmentEnv]],
                config: AugmentConfig, projector: Projector, tick: Callable[[int], None]) -> dict[str, Any]:
     """Project, filter and write one shard; returns its record (written by the caller)."""
     from simdiff.data.augment.signal import measure
 
     motions, envs, pairs, load_errors, content = [], [], [], {}, {}
+    derived = mirror_sources(clips) if config.share_mirrors else {}
     for clip in clips:
         conditions = assigned[clip]
         try:
@@ -238,10 +285,13 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: 
         except SimdiffError as exc:
             load_errors[clip] = str(exc)
             continue
+        if derived.get(clip) in content:  # its original (earlier in the shard) loaded: derive, don't simulate
+            continue
         for cond in conditions:
             motions.append(joints)
             envs.append(cond.env)
             pairs.append((clip, cond))
+    derived = {mx: x for mx, x in derived.items() if mx in content and x in content}
     records: list[dict[str, Any]] = []
     for clip, message in load_errors.items():
         conditions = assigned[clip]
@@ -250,32 +300,23 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: 
                             "reason": "error", "info": message, "env": list(cond.env.as_tuple()), "factor": cond.factor})
         tick(len(conditions))
     results = iter(projector(motions, envs)) if motions else iter(())
+    simulated: dict[tuple[str, int], tuple[Any, Any, bool, str]] = {}
     for clip, cond in pairs:
         try:
             rollout, info = next(results)
         except StopIteration:
             raise SimdiffError(f"the projector returned fewer results than the {len(pairs)} motions given") from None
         kept, reason = keep_pair(info, config.filter)
-        aid = clip_id_for(clip, cond)
-        if kept:
-            try:
-                feats, joints = rollout_to_layout(rollout)
-            except SimdiffError as exc:
-                kept, reason, info = False, "error", str(exc)
-            else:
-                write_npy(out / "new_joint_vecs" / f"{aid}.npy", feats)
-                write_npy(out / "new_joints" / f"{aid}.npy", joints)
-                write_bytes(out / "texts" / f"{aid}.txt", (corpus / "texts" / f"{clip}.txt").read_bytes())
-        signal = None
-        if rollout is not None and bool(getattr(info, "success", False) or (isinstance(info, dict) and info.get("success"))):
-            try:
-                signal = measure(rollout)
-            except SimdiffError:
-                signal = None
-        records.append({"clip": clip, "condition": cond.index, "id": aid, "kept": kept, "reason": reason,
-                        "info": _info_dict(info), "env": list(cond.env.as_tuple()), "factor": cond.factor,
-                        "signal": signal, "content": content.get(clip)})
+        simulated[(clip, cond.index)] = (rollout, _info_dict(info), kept, reason)
+        records.append(_pair_record(corpus, out, clip, cond, rollout, _info_dict(info), kept, reason, content.get(clip)))
         tick(1)
+    for mx, x in derived.items():
+        for cond in assigned[mx]:
+            rollout, info, kept, reason = simulated[(x, cond.index)]
+            record = _pair_record(corpus, out, mx, cond, mirror_rollout(rollout), mirror_info(info, cond.env),
+                                  kept, reason, content.get(mx))
+            records.append({**record, "mirrored_from": clip_id_for(x, cond)})
+            tick(1)
     order = {(c, k.index): i for i, (c, k) in enumerate((c, k) for c in clips for k in assigned[c])}
     records.sort(key=lambda r: order[(r["clip"], r["condition"])])
     return {"shard": index, "clips": clips, "records": records}

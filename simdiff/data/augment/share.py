@@ -12,6 +12,7 @@ rather than independent draws, and its rollouts are mirror(``<id>``'s rollouts).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -42,3 +43,25 @@ def mirror_sources(clips: Sequence[str]) -> dict[str, str]:
 def mirror_rollout(rollout: np.ndarray | None) -> np.ndarray | None:
     """(T, 22, 3) rollout joints mirrored (None stays None)."""
     return None if rollout is None else np.asarray(mirror_joints(np.asarray(rollout, dtype=np.float32)), dtype=np.float32)
+
+
+def group_mirrors(clips: Sequence[str]) -> list[list[str]]:
+    """The clips as units ``[<id>, M<id>]`` (both present) or ``[clip]``, in the order of ``<id>``.
+
+    Shards are cut between units, so a mirrored clip is always in its original's shard.
+    """
+    sources = mirror_sources(clips)
+    derived_of: dict[str, str] = {x: mx for mx, x in sources.items()}
+    return [[c, derived_of[c]] if c in derived_of else [c] for c in clips if c not in sources]
+
+
+def mirror_info(info: Any, env: Environment) -> Any:
+    """The original pair's info for the mirrored pair: a copy with ``env`` set to mirror(φ).
+
+    Every other field (success, d_L2, residual, CPU time) is the original rollout's; the
+    rollout is the exact mirror, and the scalar metrics are mirror-invariant up to the
+    normaliser's (small) left/right asymmetry.
+    """
+    if isinstance(info, dict):
+        return {**info, "env": list(env.as_tuple())}
+    return info
