@@ -87,8 +87,8 @@ def test_derived_pair_is_the_mirror_of_the_simulated_one(tmp_path: Path) -> None
         assert rm["mirrored_from"] == rx["id"] and "mirrored_from" not in rx
         assert rm["env"] == list(mirror_env(Environment(*rx["env"])).as_tuple())
         assert rm["info"]["env"] == rm["env"]
-        assert (rm["kept"], rm["reason"], rm["condition"], rm["factor"]) == (rx["kept"], rx["reason"], k, rx["factor"])
-        assert rm["kept"]
+        assert (rm["written"], rm["reason"], rm["condition"], rm["factor"]) == (rx["written"], rx["reason"], k, rx["factor"])
+        assert rm["written"]
         rollout = CountingProjector.response(source, Environment(*rx["env"]))
         feats, joints = rollout_to_layout(mirror_joints(rollout))
         np.testing.assert_allclose(np.load(out / "new_joint_vecs" / f"{rm['id']}.npy"), feats, atol=1e-5)

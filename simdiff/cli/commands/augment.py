@@ -17,7 +17,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "random list (random) or Earth only (binary); flights last as long as gravity makes them. Keep "
                     "pairs that tracked to the end, stay faithful in pose to the re-timed source and need a small "
                     "root residual; write them in the HumanML3D layout with env.json. Sharded and resumable: run "
-                    "the same command again after an interruption.")
+                    "the same command again after an interruption. Every tracked pair's files are written; the "
+                    "filter is applied when the run finalises, so re-running with other thresholds only "
+                    "re-finalises (no simulation).")
     p.add_argument("--corpus", type=Path, required=True, help="source corpus (HumanML3D layout with Mean.npy/Std.npy)")
     p.add_argument("--out", type=Path, required=True, help="output folder (resumed if it exists)")
     p.add_argument("--mode", choices=["paired", "paper", "random", "binary"], default="paired",
@@ -28,8 +30,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=0, help="parallel simulations (default: all cores)")
     p.add_argument("--backend", choices=["process", "ray", "serial"], default="process", help="parallel backend (default process)")
     p.add_argument("--seed", type=int, default=0, help="seed of the environment draw (default 0)")
-    p.add_argument("--max-pose-d-l2", type=float,
-                   help="largest pose d_L2 against the re-timed source (default: FilterConfig's, 5.2)")
+    p.add_argument("--max-pose-d-l2", type=_pose_bound, default="auto",
+                   help="largest pose d_L2 against the re-timed source (normalised units), or 'auto' (default): "
+                        "the smallest bound at which this run's Earth keep rate reaches --earth-keep (when fewer "
+                        "Earth pairs tracked with an acceptable residual: the largest pose d_L2 among those); the "
+                        "report gives the calibrated value and the achieved rate")
+    p.add_argument("--earth-keep", type=float, default=0.66,
+                   help="auto: target Earth keep rate (default 0.66, the previous filter's on the old corpus)")
     p.add_argument("--max-residual-n", type=float,
                    help="largest mean root residual force kept, newtons, at any gravity (default: FilterConfig's, 70.6)")
     p.add_argument("--max-d-l2", type=float, help="also require the paper's d_L2 <= this (e.g. 7.0; default off)")
@@ -49,21 +56,33 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def _pose_bound(text: str) -> float | str:
+    if text == "auto":
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number or 'auto', got {text!r}") from None
+
+
 def run(args: argparse.Namespace) -> int:
     from simdiff.data.augment.filter import FilterConfig
     from simdiff.data.augment.run import AugmentConfig, augment
 
     defaults = FilterConfig()
-    pose = defaults.max_pose_d_l2 if args.max_pose_d_l2 is None else args.max_pose_d_l2
     residual_n = defaults.max_residual_n if args.max_residual_n is None else args.max_residual_n
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
-                           filter=FilterConfig(max_pose_d_l2=pose, max_residual_n=residual_n,
+                           filter=FilterConfig(max_pose_d_l2=args.max_pose_d_l2, earth_keep=args.earth_keep, max_residual_n=residual_n,
                                                max_d_l2=args.max_d_l2, max_residual=args.max_residual),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip, share_mirrors=args.share_mirrors)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)
     frac = report["kept_fraction"]
+    cal = report["filter"].get("calibration")
+    if cal is not None:
+        print(f"pose d_L2 threshold (auto): {cal['max_pose_d_l2']:.4g}; Earth keep rate "
+              f"{100 * cal['earth_keep_achieved']:.1f} % (target {100 * cal['earth_keep_target']:.1f} %)")
     print(f"kept {report['kept']}/{report['pairs']} pairs" + (f" ({100 * frac:.1f} %)" if frac is not None else "")
           + f" from {report['clips']} clips; corpus: {args.out} (report: {args.out / 'report.md'})")
     return 0

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -17,7 +18,8 @@ def _env(r: dict[str, Any], by_index: dict[int, AugmentEnv]) -> list[float]:
     return list(by_index[r["condition"]].env.as_tuple())
 
 
-def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[AugmentEnv], config: Any) -> dict[str, Any]:
+def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[AugmentEnv], config: Any,
+                 filter_summary: dict[str, Any] | None = None) -> dict[str, Any]:
     """Kept fraction and reasons per condition and per condition bin, confound check, signal table.
 
     Args:
@@ -25,13 +27,17 @@ def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Augment
             ``info``, and in paired mode ``env``, ``signal``, ``content``).
         conditions: the run's shared condition list (paired mode: Earth only).
         config: the :class:`simdiff.data.augment.run.AugmentConfig`.
+        filter_summary: from :func:`simdiff.data.augment.decide.decide`: the thresholds used
+            (``thresholds``) and, with ``auto``, the Earth ``calibration``.
 
     Pairs derived from a mirror (``mirrored_from``, ``--share-mirrors``) count in the keep
     rates and the signal table (they are in the corpus) but not in the simulator CPU time (they
     cost none) nor in the confound check (their φ is mirror(original φ), not a draw of its own).
     """
     by_index = {c.index: c for c in conditions}
-    filt: FilterConfig = getattr(config, "filter", FilterConfig())
+    if filter_summary is None:
+        filter_summary = {"thresholds": dataclasses.asdict(getattr(config, "filter", FilterConfig()))}
+    filt = FilterConfig(**filter_summary["thresholds"])
     rows = []
     if config.mode != "paired":
         for cond in conditions:
@@ -60,7 +66,7 @@ def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Augment
     table_in = [{"clip": r["clip"], "env": _env(r, by_index), "kept": r["kept"], "signal": r.get("signal")}
                 for r in records]
     drawn = [t for t, r in zip(table_in, records) if t["kept"] and not r.get("mirrored_from")]
-    return {"settings": config.settings(), "pairs": len(records), "kept": total_kept,
+    return {"settings": config.settings(), "filter": filter_summary, "pairs": len(records), "kept": total_kept,
             "mirrored_pairs": len(records) - len(simulated),
             "kept_fraction": total_kept / len(records) if records else None,
             "clips": len({r["clip"] for r in records}), "sim_cpu_s_total": round(sum(cpu), 3),
@@ -68,6 +74,15 @@ def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Augment
             "per_condition": rows, "per_bin": dict(sorted(bins.items())),
             "confound": confound_check(drawn, content),
             "signal": signal_table(table_in)}
+
+
+def _calibration_lines(cal: dict[str, Any] | None) -> list[str]:
+    if cal is None:
+        return []
+    how = "reached" if cal["reachable"] else "unreachable: every tracked, residual-ok Earth pair kept"
+    return [f"* pose d_L2 threshold calibrated on this run's Earth pairs (auto): {cal['max_pose_d_l2']:.4g}; "
+            f"Earth keep rate target {100 * cal['earth_keep_target']:.1f} %, achieved "
+            f"{100 * cal['earth_keep_achieved']:.1f} % ({cal['earth_kept']}/{cal['earth_pairs']}; {how})"]
 
 
 def report_markdown(report: dict[str, Any]) -> str:
@@ -78,7 +93,8 @@ def report_markdown(report: dict[str, Any]) -> str:
         f"* pairs: {report['pairs']} from {report['clips']} clips; kept {report['kept']}"
         + (f" ({100 * frac:.1f} %)" if frac is not None else ""),
         f"* pairs derived from a mirror (not simulated): {report.get('mirrored_pairs', 0)}",
-        f"* filter: {report['settings']['filter']}; tracker residual bound {report['settings']['residual_bound']}·m·g",
+        f"* filter: {report['filter']['thresholds']}; tracker residual bound {report['settings']['residual_bound']}·m·g",
+        *_calibration_lines(report["filter"].get("calibration")),
         f"* simulator CPU time: {report['sim_cpu_s_total']} s ({report.get('cpu_s_per_sim_s')} CPU s per simulated s)", "",
         "## Keep rate per condition bin (each criterion judged on its own)", "",
         "| bin | pairs | kept | kept % | failed | faithfulness | residual | error |", "|---|---|---|---|---|---|---|---|",

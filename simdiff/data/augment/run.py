@@ -8,13 +8,19 @@ Output (``out``), in the HumanML3D layout plus φ::
     texts/<id>.txt            the source clip's caption file, copied byte for byte
     Mean.npy, Std.npy         copied from the source corpus (the model's normaliser)
     train.txt, all.txt        kept ids (``<clip>_e<condition:02d>``)
+                              (features/joints/texts exist for every tracked pair, kept or not)
     env.json                  {id: {env: [g_z, w_x, w_y], env_index, condition, factor, source}}
     conditions.json           the condition list
     report.json, report.md    kept fraction per condition, reasons, CPU time
     augment_settings.json     what a resumed run must match
-    shards/shard_NNNNN.json   one per group of ``shard_size`` source clips: every pair's outcome
-                              and projection info; written last (temp + os.replace), so a shard
-                              either exists whole or is redone
+    shards/shard_NNNNN.json   one per group of ``shard_size`` source clips: every pair's projection
+                              info and whether its files were written; written last (temp +
+                              os.replace), so a shard either exists whole or is redone
+
+The keep decision is made when the run finalises (:func:`simdiff.data.augment.decide.decide`,
+from the shard records and ``config.filter``), not per shard: the settings a resumed run must
+match leave out the filter thresholds, so re-running the same command with other thresholds
+(or ``--max-pose-d-l2 auto``) re-finalises without simulating.
 
 ``env_index``: binary mode labels simulated clips 1 (0 is left for the source, kinematic
 clips, see :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`); random mode uses the
@@ -40,7 +46,8 @@ import numpy as np
 
 from simdiff.fsio import write_text
 from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
-from simdiff.data.augment.filter import FilterConfig, keep_pair
+from simdiff.data.augment.decide import decide
+from simdiff.data.augment.filter import FilterConfig
 from simdiff.data.augment.report import build_report, report_markdown
 from simdiff.data.augment.share import group_mirrors, mirror_condition, mirror_info, mirror_rollout, mirror_sources
 from simdiff.data.augment.projector import Projector, SimProjector
@@ -65,7 +72,7 @@ class AugmentConfig:
         split: source split to augment (``train``; never the test split).
         shard_size: source clips per shard (each shard holds shard_size × conditions pairs).
         limit: only the first ``limit`` clips of the split (smoke runs).
-        filter: keep thresholds (d_L2 ≤ 7, mean residual ≤ 0.1·m·g).
+        filter: keep thresholds, applied at finalize (not part of :meth:`settings`).
         residual_bound: the tracker's root-residual bound (fraction of m·|g_z|; 0 = strict).
         workers, backend: parallelism of the default projector.
         per_clip: random mode only: project each clip under this many of the conditions
@@ -104,10 +111,10 @@ class AugmentConfig:
         return DEFAULT_PAIRED_K if self.mode == "paired" else 30
 
     def settings(self) -> dict[str, Any]:
-        """The options a resumed run must share (parallelism and limit may change)."""
+        """The options a resumed run must share (parallelism, limit and filter thresholds may change)."""
         settings = {"mode": self.mode, "conditions": self.n_conditions,
                     "seed": self.seed, "split": self.split, "shard_size": self.shard_size,
-                    "filter": dataclasses.asdict(self.filter), "residual_bound": self.residual_bound}
+                    "residual_bound": self.residual_bound}
         if self.per_clip is not None:
             settings["per_clip"] = self.per_clip
         if self.share_mirrors:
@@ -237,7 +244,7 @@ def _check_settings(out: Path, config: AugmentConfig, conditions: list[AugmentEn
     settings = {**config.settings(), "condition_list": [c.to_dict() for c in conditions]}
     path = out / SETTINGS_NAME
     if path.is_file():
-        old = _read_json(path)
+        old = {k: v for k, v in _read_json(path).items() if k != "filter"}  # older runs stored it
         if old != json.loads(json.dumps(settings)):
             changed = sorted(k for k in set(old) | set(settings) if old.get(k) != json.loads(json.dumps(settings)).get(k))
             raise SimdiffError(f"{out} was made with different settings ({', '.join(changed)}); use a new --out")
@@ -245,34 +252,44 @@ def _check_settings(out: Path, config: AugmentConfig, conditions: list[AugmentEn
         write_json(path, settings)
 
 
+def _tracked(info: Any) -> bool:
+    return bool(getattr(info, "success", False) or (isinstance(info, dict) and info.get("success")))
+
+
 def _pair_record(corpus: Path, out: Path, clip: str, cond: AugmentEnv, rollout: np.ndarray | None, info: Any,
-                 kept: bool, reason: str, content: dict[str, float] | None) -> dict[str, Any]:
-    """Write a kept pair's files (features, joints, caption) and return its shard record."""
+                 content: dict[str, float] | None) -> dict[str, Any]:
+    """Write a tracked pair's files (features, joints, caption) and return its shard record.
+
+    The record's ``written`` says whether the files exist; ``reason`` is ``"error"`` when the
+    projection or the conversion failed (None otherwise; the keep decision is made at finalize).
+    """
     from simdiff.data.augment.signal import measure
 
     aid = clip_id_for(clip, cond)
-    if kept:
+    written, reason = False, ("error" if info is None or isinstance(info, str) else None)
+    if reason is None and rollout is not None and _tracked(info):
         try:
             feats, joints = rollout_to_layout(rollout)
         except SimdiffError as exc:
-            kept, reason, info = False, "error", str(exc)
+            reason, info = "error", str(exc)
         else:
             write_npy(out / "new_joint_vecs" / f"{aid}.npy", feats)
             write_npy(out / "new_joints" / f"{aid}.npy", joints)
             write_bytes(out / "texts" / f"{aid}.txt", (corpus / "texts" / f"{clip}.txt").read_bytes())
+            written = True
     signal = None
-    if rollout is not None and bool(getattr(info, "success", False) or (isinstance(info, dict) and info.get("success"))):
+    if written:
         try:
             signal = measure(rollout)
         except SimdiffError:
             signal = None
-    return {"clip": clip, "condition": cond.index, "id": aid, "kept": kept, "reason": reason, "info": info,
+    return {"clip": clip, "condition": cond.index, "id": aid, "written": written, "reason": reason, "info": info,
             "env": list(cond.env.as_tuple()), "factor": cond.factor, "signal": signal, "content": content}
 
 
 def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[AugmentEnv]],
                config: AugmentConfig, projector: Projector, tick: Callable[[int], None]) -> dict[str, Any]:
-    """Project, filter and write one shard; returns its record (written by the caller)."""
+    """Project one shard and write its tracked pairs' files; returns its record (written by the caller)."""
     from simdiff.data.augment.signal import measure
 
     motions, envs, pairs, load_errors, content = [], [], [], {}, {}
@@ -296,25 +313,24 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: 
     for clip, message in load_errors.items():
         conditions = assigned[clip]
         for cond in conditions:
-            records.append({"clip": clip, "condition": cond.index, "id": clip_id_for(clip, cond), "kept": False,
+            records.append({"clip": clip, "condition": cond.index, "id": clip_id_for(clip, cond), "written": False,
                             "reason": "error", "info": message, "env": list(cond.env.as_tuple()), "factor": cond.factor})
         tick(len(conditions))
     results = iter(projector(motions, envs)) if motions else iter(())
-    simulated: dict[tuple[str, int], tuple[Any, Any, bool, str]] = {}
+    simulated: dict[tuple[str, int], tuple[Any, Any]] = {}
     for clip, cond in pairs:
         try:
             rollout, info = next(results)
         except StopIteration:
             raise SimdiffError(f"the projector returned fewer results than the {len(pairs)} motions given") from None
-        kept, reason = keep_pair(info, config.filter)
-        simulated[(clip, cond.index)] = (rollout, _info_dict(info), kept, reason)
-        records.append(_pair_record(corpus, out, clip, cond, rollout, _info_dict(info), kept, reason, content.get(clip)))
+        simulated[(clip, cond.index)] = (rollout, _info_dict(info))
+        records.append(_pair_record(corpus, out, clip, cond, rollout, _info_dict(info), content.get(clip)))
         tick(1)
     for mx, x in derived.items():
         for cond in assigned[mx]:
-            rollout, info, kept, reason = simulated[(x, cond.index)]
+            rollout, info = simulated[(x, cond.index)]
             record = _pair_record(corpus, out, mx, cond, mirror_rollout(rollout), mirror_info(info, cond.env),
-                                  kept, reason, content.get(mx))
+                                  content.get(mx))
             records.append({**record, "mirrored_from": clip_id_for(x, cond)})
             tick(1)
     order = {(c, k.index): i for i, (c, k) in enumerate((c, k) for c in clips for k in assigned[c])}
@@ -364,14 +380,19 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
 
 def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequence[AugmentEnv], n_shards: int,
              wall_s: float = 0.0) -> dict[str, Any]:
-    """Write splits, env.json, Mean/Std and the report from the finished shards; drop orphan files."""
+    """Decide the kept pairs, write splits, env.json, Mean/Std and the report; drop orphan files.
+
+    The decision (:func:`simdiff.data.augment.decide.decide`) uses ``config.filter`` on the
+    records of this run's shards; files of tracked pairs stay whether kept or not.
+    """
     records: list[dict[str, Any]] = []
-    protected: set[str] = set()  # kept ids of every finished shard, also those beyond this run's --limit
+    protected: set[str] = set()  # written ids of every finished shard, also those beyond this run's --limit
     for path in sorted((out / SHARD_DIR).glob("shard_*.json")):
         shard = _read_json(path)
-        protected.update(r["id"] for r in shard["records"] if r["kept"])
+        protected.update(r["id"] for r in shard["records"] if r.get("written", r.get("kept")))
         if int(shard["shard"]) < n_shards:
             records.extend(shard["records"])
+    records, summary = decide(records, config.filter)
     kept = [r for r in records if r["kept"]]
     by_index = {c.index: c for c in conditions}
 
@@ -402,7 +423,7 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
             folder.mkdir(exist_ok=True)
         else:
             folder.mkdir(parents=True)
-    report = build_report(records, conditions, config)
+    report = build_report(records, conditions, config, summary)
     report["wall_s_this_run"] = round(wall_s, 3)
     write_json(out / "report.json", report)
     write_text(out / "report.md", report_markdown(report))
