@@ -155,3 +155,25 @@ def test_share_mirrors_follow_their_original_under_refinalize_and_auto(tmp_path:
     assert cal["earth_pairs"] == 3 and cal["earth_kept"] == 2 and cal["max_pose_d_l2"] == pytest.approx(1.5)
     auto_ids = consistent()
     assert auto_ids != strict_ids and "calibrated on this run's Earth pairs" in (out / "report.md").read_text()
+
+
+def test_older_run_refinalizes_and_never_keeps_a_pair_without_files(tmp_path: Path) -> None:
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=2, n_test=1, frames=48)
+    out = tmp_path / "aug"
+    config = AugmentConfig(mode="random", conditions=8, seed=1, shard_size=2, filter=FilterConfig(max_pose_d_l2=5.2))
+    augment(corpus, out, config, projector=FakeProjector(), progress=False)
+    # make it look like an older run: filter in the settings, "kept" instead of "written", only kept pairs' files
+    settings = json.loads((out / "augment_settings.json").read_text(encoding="utf-8"))
+    (out / "augment_settings.json").write_text(json.dumps({**settings, "filter": {"max_pose_d_l2": 5.2}}))
+    kept = set(_ids(out))
+    for p in (out / "shards").glob("*.json"):
+        shard = json.loads(p.read_text(encoding="utf-8"))
+        for r in shard["records"]:
+            r.pop("written")
+            r["kept"] = r["id"] in kept
+        p.write_text(json.dumps(shard), encoding="utf-8")
+    loose = AugmentConfig(mode="random", conditions=8, seed=1, shard_size=2, filter=FilterConfig(max_pose_d_l2=11.0))
+    again = FakeProjector()
+    augment(corpus, out, loose, projector=again, progress=False)
+    assert again.calls == 0 and set(_ids(out)) == kept
+    assert all((out / "new_joint_vecs" / f"{i}.npy").is_file() for i in kept)
