@@ -104,13 +104,20 @@ def test_auto_threshold_when_the_target_is_unreachable() -> None:
     assert cal["earth_kept"] == 8 and cal["earth_keep_achieved"] == pytest.approx(0.8)
 
 
-def test_auto_needs_earth_pairs_and_a_valid_target() -> None:
+def test_auto_needs_earth_pairs_and_a_valid_target(tmp_path: Path) -> None:
     with pytest.raises(SimdiffError, match="Earth pairs"):
         calibrate_pose_threshold([_record(1, 1.0, env=[-3.0, 0.0, 0.0])], FilterConfig(max_pose_d_l2="auto"))
     with pytest.raises(SimdiffError, match="earth-keep"):
         calibrate_pose_threshold(_synthetic(), FilterConfig(max_pose_d_l2="auto", earth_keep=1.5))
     with pytest.raises(SimdiffError, match="calibrated first"):
         keep_pair(_record(1, 1.0)["info"], FilterConfig(max_pose_d_l2="auto"))
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=1, n_test=1, frames=48)
+    fake = FakeProjector()
+    with pytest.raises(SimdiffError, match="auto calibrates on Earth pairs"):  # refused before simulating
+        augment(corpus, tmp_path / "aug", AugmentConfig(mode="random", conditions=3,
+                                                        filter=FilterConfig(max_pose_d_l2="auto")),
+                projector=fake, progress=False)
+    assert fake.calls == 0
     assert _pose_bound("auto") == "auto" and _pose_bound("4.5") == 4.5
     with pytest.raises(argparse.ArgumentTypeError, match="'five'"):
         _pose_bound("five")

@@ -30,8 +30,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=0, help="parallel simulations (default: all cores)")
     p.add_argument("--backend", choices=["process", "ray", "serial"], default="process", help="parallel backend (default process)")
     p.add_argument("--seed", type=int, default=0, help="seed of the environment draw (default 0)")
-    p.add_argument("--max-pose-d-l2", type=_pose_bound, default="auto",
-                   help="largest pose d_L2 against the re-timed source (normalised units), or 'auto' (default): "
+    p.add_argument("--max-pose-d-l2", type=_pose_bound,
+                   help="largest pose d_L2 against the re-timed source (normalised units), or 'auto' (default in "
+                        "paired/binary mode; random/paper modes have no Earth pairs and default to 5.2): "
                         "the smallest bound at which this run's Earth keep rate reaches --earth-keep (when fewer "
                         "Earth pairs tracked with an acceptable residual: the largest pose d_L2 among those); the "
                         "report gives the calibrated value and the achieved rate")
@@ -66,14 +67,17 @@ def _pose_bound(text: str) -> float | str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from simdiff.data.augment.filter import FilterConfig
+    from simdiff.data.augment.filter import AUTO, FilterConfig
     from simdiff.data.augment.run import AugmentConfig, augment
 
     defaults = FilterConfig()
+    pose = args.max_pose_d_l2
+    if pose is None:
+        pose = AUTO if args.mode in ("paired", "binary") else defaults.max_pose_d_l2
     residual_n = defaults.max_residual_n if args.max_residual_n is None else args.max_residual_n
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
-                           filter=FilterConfig(max_pose_d_l2=args.max_pose_d_l2, earth_keep=args.earth_keep, max_residual_n=residual_n,
+                           filter=FilterConfig(max_pose_d_l2=pose, earth_keep=args.earth_keep, max_residual_n=residual_n,
                                                max_d_l2=args.max_d_l2, max_residual=args.max_residual),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip, share_mirrors=args.share_mirrors)

@@ -27,9 +27,9 @@ the 11th smallest pose d_L2 of the tracked, residual-ok Earth rollouts with the 
 point is 4.62), so the Earth keep rate is not lower (``benchmarks/bench_augment_sample.py``,
 ``reports/augment/README.md``).
 Like d_L2 it is in normalised units, so it depends on the normaliser: on the all-source corpus
-with its own Mean/Std, 5.2 keeps 18 % at Earth. ``max_pose_d_l2 = "auto"`` (the CLI default)
-calibrates it per run so that the Earth keep rate is ``earth_keep`` (0.66), see
-:mod:`simdiff.data.augment.decide`.
+with its own Mean/Std, 5.2 keeps 18 % at Earth. ``max_pose_d_l2 = "auto"`` (the CLI default in
+paired and binary mode) calibrates it per run so that the Earth keep rate is ``earth_keep``
+(0.66), see :mod:`simdiff.data.augment.decide`.
 """
 
 from __future__ import annotations

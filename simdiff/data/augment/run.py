@@ -47,7 +47,7 @@ import numpy as np
 from simdiff.fsio import write_text
 from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
 from simdiff.data.augment.decide import decide
-from simdiff.data.augment.filter import FilterConfig
+from simdiff.data.augment.filter import AUTO, FilterConfig
 from simdiff.data.augment.report import build_report, report_markdown
 from simdiff.data.augment.share import group_mirrors, mirror_condition, mirror_info, mirror_rollout, mirror_sources
 from simdiff.data.augment.projector import Projector, SimProjector
@@ -229,6 +229,9 @@ def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[AugmentEn
     if not clips:
         raise SimdiffError(f"{corpus / (config.split + '.txt')}: no clips to augment")
     conditions = make_conditions(config.mode, config.n_conditions, config.seed)
+    if config.filter.max_pose_d_l2 == AUTO and config.mode not in ("paired", "binary"):
+        raise SimdiffError(f"--max-pose-d-l2 auto calibrates on Earth pairs, which {config.mode!r} mode does not "
+                           "simulate; give a number")
     if config.share_mirrors:
         if config.mode not in ("paired", "binary"):
             raise SimdiffError(f"--share-mirrors needs paired or binary mode, got {config.mode!r} "
