@@ -63,11 +63,13 @@ def test_quick_pipeline_runs_skips_and_reruns_downstream(corpus, tmp_path) -> No
     assert (out / "backbone" / "model" / "model.safetensors").stat().st_mtime_ns == mtime
     assert json.loads((out / "stages" / "adapters.json").read_text())["summary"]["step"] == 5
 
-    set_option(config, "augment.filter.max_pose_d_l2=3.0")  # the simulation starts afresh, the backbone is kept
+    shards = {p.name: p.stat().st_mtime_ns for p in (out / "augmented" / "shards").glob("*.json")}
+    set_option(config, "augment.filter.max_pose_d_l2=3.0")  # re-finalised from the shards, the backbone is kept
     refiltered, _ = _run(config, out)
     assert refiltered["augment"] == "run" and refiltered["backbone"] == "current" and refiltered["adapters"] == "run"
-    settings = json.loads((out / "augmented" / "augment_settings.json").read_text())
-    assert settings["filter"]["max_pose_d_l2"] == 3.0
+    report = json.loads((out / "augmented" / "report.json").read_text())
+    assert report["filter"]["thresholds"]["max_pose_d_l2"] == 3.0
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "augmented" / "shards").glob("*.json")} == shards
 
     config.seed += 1
     dry, lines = _run(config, out, dry_run=True)

@@ -60,15 +60,16 @@ def format_plan(plans: list[StagePlan]) -> str:
 def _reset(ctx: PipelineContext, name: str, settings: dict[str, Any]) -> None:
     """Drop a stale stage's own outputs (never an input folder given by path).
 
-    The pipeline's own augmented corpus is kept when only ``limit`` changed (the augmentation
-    then resumes and extends it); any other change of its settings starts it afresh.
+    The pipeline's own augmented corpus is kept when only ``limit`` or the ``filter`` changed
+    (the augmentation then resumes and extends it, or only re-finalises: the keep decision is
+    made at finalize); any other change of its settings starts it afresh.
     """
     previous = (read_marker(ctx.out, name) or read_marker(ctx.out, name, started=True) or {}).get("settings")
     clear_marker(ctx.out, name)
     folder = OWN_FOLDER.get(name)
     if name == "augment" and not ctx.config.augment.path and previous is not None:
         def strip(d: dict[str, Any]) -> dict[str, Any]:
-            return {k: v for k, v in d.items() if k != "limit"}
+            return {k: v for k, v in d.items() if k not in ("limit", "filter")}
 
         if strip(previous) != strip(settings):
             folder = "augmented"
