@@ -21,7 +21,15 @@ from simdiff.sim.flight import FlightConfig, aligned_source
 from simdiff.sim.humanoid import HumanoidConfig, load_model, model_index, world_to_hml
 from simdiff.sim.residual import ResidualConfig
 from simdiff.sim.rollout import FallConfig, RolloutResult, rollout
+from simdiff.sim.strength import StrengthConfig
 from simdiff.sim.tracker import Tracker
+
+SIM_VERSION: int = 2
+"""Version of the physics behind :func:`project` with its defaults, recorded with augmented pairs.
+
+1: Earth-strength actuators at every gravity. 2 (issue 13): actuators and the tracker's balance
+layer scale with max(1, |g_z|/9.81) (:mod:`simdiff.sim.strength`); identical to 1 at
+|g_z| ≤ 9.81. A record without a version is version 1."""
 
 
 @dataclass
@@ -119,6 +127,7 @@ def project(
     force: bool = False,
     audit: bool = False,
     flight: FlightConfig | None = None,
+    strength: StrengthConfig | None = StrengthConfig(),
 ) -> tuple[np.ndarray, ProjectionInfo]:
     """P_φ,π(τ): replay ``joints`` in MuJoCo under ``env`` and return the rollout.
 
@@ -132,6 +141,8 @@ def project(
         audit: check the physics invariants at every step (slower).
         flight: follow the simulated flights (:class:`simdiff.sim.flight.FlightClock`);
             None: the reference's own clock (output at most as long as the input).
+        strength: actuator strength under |g_z| > 9.81 (:mod:`simdiff.sim.strength`; default
+            × max(1, |g_z|/9.81); None: Earth strength at every g).
     Returns:
         (rollout joints (T', 22, 3) float32, :class:`ProjectionInfo`).
     """
@@ -140,7 +151,7 @@ def project(
     model = model if model is not None else load_model(HumanoidConfig())
     joints = np.asarray(joints, dtype=np.float64)
     ref = make_reference(model, joints, retarget, gravity=env.gravity)
-    res = rollout(model, ref, env, tracker, residual, fall, audit=audit, flight=flight)
+    res = rollout(model, ref, env, tracker, residual, fall, audit=audit, flight=flight, strength=strength)
     out = rollout_joints(model, res, joints.shape[0] if flight is None else None, retarget.fps)
     if flight is None:
         source = joints[: len(out)]

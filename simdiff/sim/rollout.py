@@ -36,6 +36,7 @@ from simdiff.sim.env import Environment
 from simdiff.sim.flight import FlightClock, FlightConfig
 from simdiff.sim.humanoid import ModelIndex, model_index
 from simdiff.sim.residual import ResidualConfig, RootResidual
+from simdiff.sim.strength import StrengthConfig, apply_strength, scale_balance
 from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig, Tracker
 
 
@@ -161,6 +162,7 @@ def rollout(
     audit: bool = False,
     recovery: RecoveryConfig | None = None,
     flight: FlightConfig | None = None,
+    strength: StrengthConfig | None = StrengthConfig(),
 ) -> RolloutResult:
     """Simulate the reference under ``env`` with ``tracker`` and the gated residual.
 
@@ -176,12 +178,18 @@ def rollout(
         flight: follow the simulated flights with a :class:`FlightClock` (None: the reference's
             own clock). The default tracker then runs without its landing sync (the clock
             does that job); the rollout may be longer or shorter than the reference.
+        strength: actuator kp, kd and force limits × s = max(1, |g_z|/9.81) on the rollout's
+            copy of the model, and the balance layer of the default tracker and of the
+            recovery variants scaled for s (:mod:`simdiff.sim.strength`); a tracker passed
+            in is used as given. None: Earth strength at every g.
     Returns:
         A :class:`RolloutResult`.
     """
     import mujoco
 
     m = copy.copy(model)
+    apply_strength(m, env.gravity, strength)
+    s = strength.factor(env.gravity) if strength is not None and strength.balance else 1.0
     ix: ModelIndex = model_index(m)
     env.apply(m, ix.mass)
     d = mujoco.MjData(m)
@@ -189,7 +197,7 @@ def rollout(
     d.qvel[:] = reference.qvel[0]
     mujoco.mj_forward(m, d)
     clock = FlightClock(reference.contact, 1.0 / reference.dt, flight) if flight is not None else None
-    tracker = tracker or PDTracker(PDTrackerConfig(landing_sync=clock is None))
+    tracker = tracker or PDTracker(scale_balance(PDTrackerConfig(landing_sync=clock is None), s))
     tracker.reset(m, d, reference, ix)
     res = RootResidual(residual, m, reference, ix, env.gravity)
     n_sub = int(round(reference.dt / m.opt.timestep))
@@ -228,7 +236,7 @@ def rollout(
         if override is not None and override[0] <= n < override[1]:
             v = override[2]
             if v not in alternates:
-                cfg = rec.variants[v]
+                cfg = scale_balance(rec.variants[v], s)
                 if clock is not None:
                     cfg = replace(cfg, landing_sync=False)
                 alternates[v] = PDTracker(cfg)

@@ -52,6 +52,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="paired/binary: derive each mirrored clip M<id> from <id>'s rollouts under mirror(phi) "
                         "(w_x negated) instead of simulating it (the simulator is left-right symmetric: "
                         "reports/augment/mirror_check.md); M<id>'s conditions are then mirror(<id>'s)")
+    p.add_argument("--resimulate-gravity-below", type=float, metavar="G",
+                   help="in an existing run, re-simulate the pairs with g_z < G (m/s^2) made by an older simulator "
+                        "version (records' sim_version), re-derive their mirrors, rewrite their files and shards, "
+                        "then finalise; resumable. -9.81: exactly the pairs changed by the gravity-scaled "
+                        "actuators (issue 13)")
     p.add_argument("--limit", type=int, help="augment only the first N clips of the split")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(func=run)
@@ -80,7 +85,8 @@ def run(args: argparse.Namespace) -> int:
                            filter=FilterConfig(max_pose_d_l2=pose, earth_keep=args.earth_keep, max_residual_n=residual_n,
                                                max_d_l2=args.max_d_l2, max_residual=args.max_residual),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
-                           per_clip=args.per_clip, share_mirrors=args.share_mirrors)
+                           per_clip=args.per_clip, share_mirrors=args.share_mirrors,
+                           resimulate_gravity_below=args.resimulate_gravity_below)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)
     frac = report["kept_fraction"]
     cal = report["filter"].get("calibration")

@@ -54,6 +54,7 @@ from simdiff.data.augment.projector import Projector, SimProjector
 from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_npy
 from simdiff.errors import SimdiffError
 from simdiff.sim.env import Environment
+from simdiff.sim.project import SIM_VERSION
 
 BINARY_SIM_INDEX: int = 1
 """``env_index`` of simulated clips in binary mode (0 = source clips)."""
@@ -82,6 +83,10 @@ class AugmentConfig:
         share_mirrors: derive each mirrored clip ``M<id>`` (original in the split) from
             ``<id>``'s rollouts instead of simulating it (paired and binary modes); its
             conditions are then mirror(``<id>``'s), not independent draws.
+        resimulate_gravity_below: after the shards are done, re-project the pairs with g_z
+            below this (m/s²) that an older simulator version made, and their mirrors
+            (:mod:`simdiff.data.augment.resim`; −9.81: what issue 13 changed). Not a setting:
+            a resumed run may add it. None: off.
 
     Modes (:mod:`simdiff.data.augment.conditions`): ``paired`` (default; Earth + ``conditions``
     (default 6) draws per clip), ``paper`` (every clip under all ``conditions`` (30) random
@@ -100,6 +105,7 @@ class AugmentConfig:
     backend: str = "process"
     per_clip: int | None = None
     share_mirrors: bool = False
+    resimulate_gravity_below: float | None = None
 
     @property
     def n_conditions(self) -> int:
@@ -287,7 +293,8 @@ def _pair_record(corpus: Path, out: Path, clip: str, cond: AugmentEnv, rollout: 
         except SimdiffError:
             signal = None
     return {"clip": clip, "condition": cond.index, "id": aid, "written": written, "reason": reason, "info": info,
-            "env": list(cond.env.as_tuple()), "factor": cond.factor, "signal": signal, "content": content}
+            "env": list(cond.env.as_tuple()), "factor": cond.factor, "signal": signal, "content": content,
+            "sim_version": SIM_VERSION}
 
 
 def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[AugmentEnv]],
@@ -374,6 +381,12 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
         for i in todo:
             record = _run_shard(corpus, out, i, shards[i], assigned, config, proj, bar.update)
             write_json(_shard_path(out, i), record)
+        bar.close()
+        if config.resimulate_gravity_below is not None:
+            from simdiff.data.augment.resim import resimulate
+
+            resimulate(corpus, out, [_shard_path(out, i) for i in range(len(shards))], proj,
+                       config.resimulate_gravity_below, progress)
     finally:
         bar.close()
         if own:
