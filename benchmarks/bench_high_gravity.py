@@ -16,7 +16,8 @@ there) and at each high gravity under each strength variant (:mod:`simdiff.sim.s
 * ``gains_limits``: kp, kd and force limits × max(1, |g|/9.81);
 * ``limits``: force limits only × that factor;
 * ``balance``: only the tracker's balance layer scaled (:func:`simdiff.sim.strength.scale_balance`);
-* ``all``: kp, kd, force limits and the balance layer (the default :class:`StrengthConfig`).
+* ``actuators_balance``: kp, kd, force limits and the balance layer;
+* ``all``: those and the root residual's torque bound (the default :class:`StrengthConfig`).
 
 The log is resumable (one JSON line per projection); the summary (success rate, medians over
 the tracked rollouts of pose d_L2, residual N, local joint error mm, per g and variant, and
@@ -41,15 +42,16 @@ STRATA: dict[str, tuple[str, tuple[str, ...]]] = {
     "cmu_amc": ("cmu-amc", ("walk", "exercise", "dance", "other", "sports")),
     "aclstm": ("cmu-aclstm", ("dance", "sports")),
 }
-VARIANTS = ("earth", "gains_limits", "limits", "balance", "all")
+VARIANTS = ("earth", "gains_limits", "limits", "balance", "actuators_balance", "all")
 
 
 def strength_of(variant: str):
     from simdiff.sim.strength import NO_SCALING, StrengthConfig
 
-    return {"earth": NO_SCALING, "gains_limits": StrengthConfig(balance=False),
-            "limits": StrengthConfig(gains=False, balance=False), "balance": StrengthConfig(gains=False, limits=False),
-            "all": StrengthConfig()}[variant]
+    return {"earth": NO_SCALING, "gains_limits": StrengthConfig(balance=False, residual_torque=False),
+            "limits": StrengthConfig(gains=False, balance=False, residual_torque=False),
+            "balance": StrengthConfig(gains=False, limits=False, residual_torque=False),
+            "actuators_balance": StrengthConfig(residual_torque=False), "all": StrengthConfig()}[variant]
 
 
 def pick_clips(corpus: Path, shards: Path, per_stratum: int) -> dict[str, list[str]]:

@@ -14,7 +14,10 @@ from simdiff.sim import synthetic  # noqa: E402
 from simdiff.sim.env import Environment  # noqa: E402
 from simdiff.sim.humanoid import load_model  # noqa: E402
 from simdiff.sim.project import project  # noqa: E402
-from simdiff.sim.strength import NO_SCALING, StrengthConfig, apply_strength, scale_balance  # noqa: E402
+from simdiff.sim.residual import ResidualConfig  # noqa: E402
+from simdiff.sim.strength import (  # noqa: E402
+    NO_SCALING, StrengthConfig, apply_strength, scale_balance, scale_residual,
+)
 from simdiff.sim.tracker import PDTrackerConfig  # noqa: E402
 
 
@@ -46,6 +49,14 @@ def test_scale_balance_stiffens_by_s_and_damps_by_sqrt_s() -> None:
     assert scale_balance(PDTrackerConfig(balance=None), 2.0).balance is None
 
 
+def test_scale_residual_scales_the_torque_bound_only() -> None:
+    cfg = ResidualConfig(max_force=0.5)
+    assert scale_residual(cfg, 1.0) is cfg
+    r2 = scale_residual(cfg, 2.0)
+    assert r2.torque_bound == 2 * cfg.torque_bound == 600.0 and r2.max_force == cfg.max_force
+    assert scale_residual(ResidualConfig(max_torque=100.0), 1.5).torque_bound == 150.0
+
+
 @pytest.mark.parametrize("env", [Environment(), Environment(-3.0), Environment(-9.81, 6.0, -4.0)])
 def test_rollouts_at_or_below_earth_gravity_are_bit_identical(env: Environment) -> None:
     joints = synthetic.walk_in_place(24)
@@ -61,7 +72,7 @@ def test_rollouts_at_or_below_earth_gravity_are_bit_identical(env: Environment) 
 
 
 def test_high_gravity_walk_holds_its_pose_better_than_earth_strength() -> None:
-    """At g = −20 the Earth-strength body sags (local joint error 17.6 mm measured vs 13.2 mm scaled)."""
+    """At g = −20 the Earth-strength body sags: local joint error measured 17.6 mm; scaled 13.2 (Earth 13.9)."""
     joints = synthetic.walk_in_place(40)
     _, earth = project(joints, Environment(), strength=None)
     _, old = project(joints, Environment(-20.0), strength=NO_SCALING)

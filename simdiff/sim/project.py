@@ -27,9 +27,9 @@ from simdiff.sim.tracker import Tracker
 SIM_VERSION: int = 2
 """Version of the physics behind :func:`project` with its defaults, recorded with augmented pairs.
 
-1: Earth-strength actuators at every gravity. 2 (issue 13): actuators and the tracker's balance
-layer scale with max(1, |g_z|/9.81) (:mod:`simdiff.sim.strength`); identical to 1 at
-|g_z| ≤ 9.81. A record without a version is version 1."""
+1: Earth strength at every gravity. 2 (issue 13): actuators, the tracker's balance layer and
+the residual's torque bound scale with max(1, |g_z|/9.81) (:mod:`simdiff.sim.strength`);
+identical to 1 at |g_z| ≤ 9.81. A record without a version is version 1."""
 
 
 @dataclass

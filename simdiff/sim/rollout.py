@@ -36,7 +36,7 @@ from simdiff.sim.env import Environment
 from simdiff.sim.flight import FlightClock, FlightConfig
 from simdiff.sim.humanoid import ModelIndex, model_index
 from simdiff.sim.residual import ResidualConfig, RootResidual
-from simdiff.sim.strength import StrengthConfig, apply_strength, scale_balance
+from simdiff.sim.strength import StrengthConfig, apply_strength, scale_balance, scale_residual
 from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig, Tracker
 
 
@@ -179,9 +179,10 @@ def rollout(
             own clock). The default tracker then runs without its landing sync (the clock
             does that job); the rollout may be longer or shorter than the reference.
         strength: actuator kp, kd and force limits × s = max(1, |g_z|/9.81) on the rollout's
-            copy of the model, and the balance layer of the default tracker and of the
-            recovery variants scaled for s (:mod:`simdiff.sim.strength`); a tracker passed
-            in is used as given. None: Earth strength at every g.
+            copy of the model, the balance layer of the default tracker and of the
+            recovery variants and the residual's torque bound scaled for s
+            (:mod:`simdiff.sim.strength`); a tracker passed in is used as given. None: Earth
+            strength at every g.
     Returns:
         A :class:`RolloutResult`.
     """
@@ -189,7 +190,9 @@ def rollout(
 
     m = copy.copy(model)
     apply_strength(m, env.gravity, strength)
-    s = strength.factor(env.gravity) if strength is not None and strength.balance else 1.0
+    s = strength.factor(env.gravity) if strength is not None else 1.0
+    if strength is not None and strength.residual_torque:
+        residual = scale_residual(residual, s)
     ix: ModelIndex = model_index(m)
     env.apply(m, ix.mass)
     d = mujoco.MjData(m)
@@ -197,7 +200,8 @@ def rollout(
     d.qvel[:] = reference.qvel[0]
     mujoco.mj_forward(m, d)
     clock = FlightClock(reference.contact, 1.0 / reference.dt, flight) if flight is not None else None
-    tracker = tracker or PDTracker(scale_balance(PDTrackerConfig(landing_sync=clock is None), s))
+    s_bal = s if strength is not None and strength.balance else 1.0
+    tracker = tracker or PDTracker(scale_balance(PDTrackerConfig(landing_sync=clock is None), s_bal))
     tracker.reset(m, d, reference, ix)
     res = RootResidual(residual, m, reference, ix, env.gravity)
     n_sub = int(round(reference.dt / m.opt.timestep))
@@ -236,7 +240,7 @@ def rollout(
         if override is not None and override[0] <= n < override[1]:
             v = override[2]
             if v not in alternates:
-                cfg = scale_balance(rec.variants[v], s)
+                cfg = scale_balance(rec.variants[v], s_bal)
                 if clock is not None:
                     cfg = replace(cfg, landing_sync=False)
                 alternates[v] = PDTracker(cfg)

@@ -1,23 +1,32 @@
-"""Actuator strength under a gravity stronger than Earth's: s = max(1, |g_z| / 9.81).
+"""Body strength under a gravity stronger than Earth's: s = max(1, |g_z| / 9.81).
 
 Strength model: the simulated body is as strong *relative to its own weight* as on Earth.
-Under ``|g_z| > 9.81`` every actuator's stiffness ``kp``, damping ``kd`` and force limit are
-multiplied by ``s = |g_z| / 9.81``; at ``|g_z| ≤ 9.81`` nothing changes (s = 1, the model is
-not touched, so Earth, low-gravity and wind rollouts are bit-identical to unscaled ones).
+Under ``|g_z| > 9.81`` every gravity-sized quantity that was tuned at 9.81 is multiplied by s:
+the actuators' stiffness ``kp``, damping ``kd`` and force limits, the balance layer's gains
+(:func:`scale_balance`) and the root residual's torque bound (:func:`scale_residual`; its force
+bound is a fraction of m·|g_z| already). At ``|g_z| ≤ 9.81`` nothing changes (s = 1: the model
+and configs are not touched, so Earth, low-gravity and wind rollouts are bit-identical).
 
-Why: the PD gains and force limits (:data:`simdiff.sim.humanoid._GAINS`) were tuned at 9.81.
-The tracker's inverse-dynamics feed-forward already knows g (it is computed under φ's g_z) and
-asks for up to s times the Earth torques, but the servos stay Earth-strong: hips and knees
-saturate at 500 N·m, and the feed-forward offset τ_ff / kp grows with g until the target
-leaves the joint range (targets are clipped there), so the body sags under load and the
-root residual carries it. Scaling kp and kd together keeps the servo's natural frequency per
-unit load and the feed-forward offset τ_ff / kp as on Earth; scaling the limits keeps the
-torque headroom. Measured (``benchmarks/bench_high_gravity.py``,
-``reports/augment/high_gravity.json``): see :data:`StrengthConfig` defaults.
+Why: the gains and limits (:data:`simdiff.sim.humanoid._GAINS`) were tuned at 9.81. The
+tracker's inverse-dynamics feed-forward already knows g (computed under φ's g_z) and asks for up
+to s times the Earth torques, but the servos stayed Earth-strong (hips and knees saturate at
+500 N·m, and the feed-forward offset τ_ff / kp grows with g), the balance layer's COM gain
+(kp_xy = 20 1/s²) falls below the toppling rate g/h of the body (≈ 22 1/s² at −20), and the
+pelvis help was capped at Earth's 300 N·m, so the body sagged and tipped. Scaling kp and kd
+together keeps τ_ff / kp and the servo lag kd / kp as on Earth; scaling the limits keeps the
+torque headroom.
 
-The scaling is applied to a rollout's private copy of the model (``rollout`` copies it), by
-writing ``actuator_gainprm``, ``actuator_biasprm`` and ``actuator_forcerange``, so the cached
-compiled model is never modified and no XML is rebuilt.
+Measured (``benchmarks/bench_high_gravity.py`` → ``reports/augment/high_gravity.json``; 24
+corpus3 train clips without flight that track at Earth, augmentation settings): success at
+g = −15 / −18 / −20 went from 0.88 / 0.75 / 0.71 (Earth strength) to 1.0 / 1.0 / 1.0; on the
+clips both track, median pose d_L2 6.54 / 6.66 / 6.70 → 6.40 / 6.49 / 6.48 and local joint
+error 44 / 43 / 44 → 39 / 40 / 39 mm (Earth: 6.29, 41 mm); median residual 47 / 51 / 52 →
+48 / 51 / 54 N (Earth 41 N). Actuators alone (kp, kd, limits) reached 0.92 / 0.88 / 0.79,
+limits alone 0.88 / 0.75 / 0.67.
+
+The actuator scaling is applied to a rollout's private copy of the model (``rollout`` copies
+it) by writing ``actuator_gainprm``, ``actuator_biasprm`` and ``actuator_forcerange``: the
+cached compiled model is never modified and no XML is rebuilt.
 """
 
 from __future__ import annotations
@@ -26,6 +35,7 @@ import math
 from dataclasses import dataclass, replace
 
 from simdiff.sim.env import EARTH_GRAVITY
+from simdiff.sim.residual import ResidualConfig
 from simdiff.sim.tracker import PDTrackerConfig
 
 
@@ -38,22 +48,26 @@ class StrengthConfig:
         limits: multiply every actuator's force limit by s.
         balance: scale the default tracker's balance layer (:func:`scale_balance`): position
             gains (COM ``kp_xy``, pelvis ``kp_rot``) × s, damping (``kd_xy``, ``kd_rot``) × √s.
+        residual_torque: the root residual's torque bound × s (:func:`scale_residual`); its
+            force bound is already a fraction of m·|g_z|, the torque bound (600·max_force N·m
+            ≈ max_force·m·9.81·0.85 m) was not.
         reference_gravity: |g| (m/s²) at which the gains were tuned (9.81).
     """
 
     gains: bool = True
     limits: bool = True
     balance: bool = True
+    residual_torque: bool = True
     reference_gravity: float = abs(EARTH_GRAVITY)
 
     def factor(self, gravity: float) -> float:
         """s = max(1, |g_z| / reference_gravity) (1 when nothing is scaled)."""
-        if not (self.gains or self.limits or self.balance):
+        if not (self.gains or self.limits or self.balance or self.residual_torque):
             return 1.0
         return max(1.0, abs(float(gravity)) / self.reference_gravity)
 
 
-NO_SCALING = StrengthConfig(gains=False, limits=False, balance=False)
+NO_SCALING = StrengthConfig(gains=False, limits=False, balance=False, residual_torque=False)
 """Earth-strength actuators at every gravity (the behaviour before issue 13)."""
 
 
@@ -95,3 +109,15 @@ def scale_balance(config: PDTrackerConfig, s: float) -> PDTrackerConfig:
     r = math.sqrt(s)
     return replace(config, balance=replace(b, kp_xy=b.kp_xy * s, kd_xy=b.kd_xy * r, kp_rot=b.kp_rot * s,
                                            kd_rot=b.kd_rot * r))
+
+
+def scale_residual(config: ResidualConfig, s: float) -> ResidualConfig:
+    """The residual config with its torque bound × ``s`` (s = 1: unchanged).
+
+    The force bound is a fraction of m·|g_z| already; the torque bound is fixed in N·m
+    (600·max_force, i.e. max_force·m·9.81 at a 0.85 m lever on Earth). Scaling it keeps the
+    pelvis-orientation help the same fraction of the body's weight moment as on Earth.
+    """
+    if s == 1.0:
+        return config
+    return replace(config, max_torque=config.torque_bound * s)

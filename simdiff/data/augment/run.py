@@ -26,7 +26,9 @@ match leave out the filter thresholds, so re-running the same command with other
 clips, see :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`); random mode uses the
 condition index. ``--share-mirrors`` (:mod:`simdiff.data.augment.share`): a mirrored clip
 ``M<id>`` whose original is in the split is not simulated; its pairs are the mirrors of
-``<id>``'s under mirror(φ) (records carry ``mirrored_from``). Resuming: shards whose file exists with the same clips are skipped; files a
+``<id>``'s under mirror(φ) (records carry ``mirrored_from``). Every record carries the
+``sim_version`` of the physics that made it; ``--resimulate-gravity-below G`` re-projects, in a
+finished run, the pairs with g_z < G of an older version (:mod:`simdiff.data.augment.resim`). Resuming: shards whose file exists with the same clips are skipped; files a
 killed shard left behind are overwritten by its re-run, and files of no finished shard are
 deleted when the run finalises.
 """
