@@ -184,3 +184,17 @@ def test_older_run_refinalizes_and_never_keeps_a_pair_without_files(tmp_path: Pa
     augment(corpus, out, loose, projector=again, progress=False)
     assert again.calls == 0 and set(_ids(out)) == kept
     assert all((out / "new_joint_vecs" / f"{i}.npy").is_file() for i in kept)
+
+
+def test_residual_budget_follows_body_strength_only_above_earth_gravity() -> None:
+    def info(g: float, newtons: float) -> dict:
+        return {"success": True, "d_l2_pose": 1.0, "env": [g, 0.0, 0.0], "residual": {"force_mean_n": newtons}}
+
+    config = FilterConfig(max_pose_d_l2=5.0, max_residual_n=70.0)
+    assert keep_pair(info(-9.81, 69.0), config) == (True, "kept")
+    assert keep_pair(info(-9.81, 71.0), config) == (False, "residual")
+    assert keep_pair(info(-1.6, 71.0), config) == (False, "residual")  # absolute on the Moon, not 0.16 of it
+    assert keep_pair(info(-19.62, 139.0), config) == (True, "kept")  # s = 2: 140 N
+    assert keep_pair(info(-19.62, 141.0), config) == (False, "residual")
+    fixed = FilterConfig(max_pose_d_l2=5.0, max_residual_n=70.0, residual_follows_strength=False)
+    assert keep_pair(info(-19.62, 71.0), fixed) == (False, "residual")

@@ -39,7 +39,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--earth-keep", type=float, default=0.66,
                    help="auto: target Earth keep rate (default 0.66, the previous filter's on the old corpus)")
     p.add_argument("--max-residual-n", type=float,
-                   help="largest mean root residual force kept, newtons, at any gravity (default: FilterConfig's, 70.6)")
+                   help="largest mean root residual force kept, newtons (default: FilterConfig's, 70.6); above Earth "
+                        "gravity times s = |g_z|/9.81, the body-strength factor (simdiff.sim.strength)")
+    p.add_argument("--residual-fixed", action="store_true",
+                   help="keep --max-residual-n unchanged above Earth gravity too (no strength scaling)")
     p.add_argument("--max-d-l2", type=float, help="also require the paper's d_L2 <= this (e.g. 7.0; default off)")
     p.add_argument("--max-residual", type=float, help="also require the residual <= this fraction of m*|g_z| (default off)")
     p.add_argument("--residual-bound", type=float, default=0.5,
@@ -83,7 +86,8 @@ def run(args: argparse.Namespace) -> int:
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
                            filter=FilterConfig(max_pose_d_l2=pose, earth_keep=args.earth_keep, max_residual_n=residual_n,
-                                               max_d_l2=args.max_d_l2, max_residual=args.max_residual),
+                                               max_d_l2=args.max_d_l2, max_residual=args.max_residual,
+                                               residual_follows_strength=not args.residual_fixed),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip, share_mirrors=args.share_mirrors,
                            resimulate_gravity_below=args.resimulate_gravity_below)
