@@ -28,7 +28,7 @@ def main(argv: list[str] | None = None) -> int:
     from simdiff.errors import SimdiffError
     from simdiff.fsio import write_json
     from simdiff.motion.skeleton import MIN_FRAMES
-    from simdiff.train.curves import DESIGNS, design_config, design_factor, held_out, plot_curves, run_curve
+    from simdiff.train.curves import DESIGNS, design_config, design_factor, held_out, plot_curves, rescore, run_curve
     from simdiff.train.trainer import Trainer
 
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -39,7 +39,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--evaluator", type=Path, help="our trained evaluator folder (for R@3)")
     p.add_argument("--text-encoder", default="minilm", help="minilm, or hash (smoke tests: no text meaning)")
     p.add_argument("--out", type=Path, default=Path("reports/training"))
-    p.add_argument("--run-dir", type=Path, help="trainer folder (default: a temporary folder)")
+    p.add_argument("--run-dir", type=Path,
+                   help="trainer folder, checkpointed at every point; calling again with more --minutes continues it "
+                        "(default: a temporary folder, not kept)")
+    p.add_argument("--rescore", action="store_true",
+                   help="do not train: recompute the sample metrics of --run-dir's saved points (R@3 with --evaluator)")
     p.add_argument("--seed", type=int, default=10)
     p.add_argument("--heldout", type=int, default=32, help="held-out items evaluated")
     p.add_argument("--sample-steps", type=int, default=20, help="DDIM steps of the samples")
@@ -80,18 +84,29 @@ def main(argv: list[str] | None = None) -> int:
         config = design_config(args.design, args.text_encoder, encoder.dim, args.seed)
         import tempfile
 
-        run_dir = args.run_dir or Path(tempfile.mkdtemp(prefix=f"curve_{args.design}_"))
-        trainer = Trainer(run_dir, config, train, text_encoder=encoder, resume=False)
-        start = time.time()
-        points = run_curve(trainer, held, args.minutes, args.points, evaluator=evaluator, sample_steps=args.sample_steps,
-                           factor=factor)
         path = args.out / "curves.json"
         curves = json.loads(path.read_text()) if path.is_file() else {}
-        curves[args.design] = {"points": points, "ground_truth": held.gt, "corpus": str(corpus), "fps": 20 // factor, "heldout_split": split,
-                               "heldout_items": len(held.batch["lengths"]), "train_clips": len(train),
-                               "text_encoder": args.text_encoder, "evaluator": str(args.evaluator) if args.evaluator else None,
-                               "threads": torch.get_num_threads(), "machine": platform.processor() or platform.machine(),
-                               "minutes": args.minutes, "wall_s": round(time.time() - start, 1), "seed": args.seed}
+        start = time.time()
+        if args.rescore:
+            if args.run_dir is None or args.design not in curves:
+                raise SimdiffError("--rescore needs --run-dir and the design's entry in <out>/curves.json")
+            points = rescore(args.run_dir, held, evaluator, factor)
+        else:
+            run_dir = args.run_dir or Path(tempfile.mkdtemp(prefix=f"curve_{args.design}_"))
+            trainer = Trainer(run_dir, config, train, text_encoder=encoder, resume=args.run_dir is not None)
+            points = run_curve(trainer, held, args.minutes, args.points, evaluator=evaluator,
+                               sample_steps=args.sample_steps, factor=factor, save=args.run_dir is not None)
+        if args.rescore:
+            curves[args.design].update(points=points, ground_truth=held.gt,
+                                       evaluator=str(args.evaluator) if args.evaluator else None)
+        else:
+            curves[args.design] = {"points": points, "ground_truth": held.gt, "corpus": str(corpus), "fps": 20 // factor, "heldout_split": split,
+                                   "heldout_items": len(held.batch["lengths"]), "train_clips": len(train),
+                                   "text_encoder": args.text_encoder, "evaluator": str(args.evaluator) if args.evaluator else None,
+                                   "threads": torch.get_num_threads(), "machine": platform.processor() or platform.machine(),
+                                   "minutes": max(args.minutes, points[-1]["cpu_s"] / 60.0 if points else 0.0),
+                                   "wall_s": round(time.time() - start, 1), "seed": args.seed,
+                                   "run_dir": str(args.run_dir) if args.run_dir else None}
         write_json(path, curves)
         plot_curves(curves, args.out / "curves.png")
         print(f"wrote {path} and {args.out / 'curves.png'}")

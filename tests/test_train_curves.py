@@ -45,3 +45,27 @@ def test_designs_are_mdm_transformers_with_optional_geometric_losses() -> None:
     assert set(DESIGNS) >= {"small_plain", "small_geo_crop", "mdm_geo_crop"}
     with pytest.raises(SimdiffError, match="unknown design"):
         design_config("latent", "minilm", 384, 0)
+
+
+def test_curve_run_continues_from_its_folder_and_rescores_saved_samples(tmp_path) -> None:
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=8, n_val=4, n_test=4, frames=48)
+    spec = importlib.util.spec_from_file_location("train_curves", ROOT / "benchmarks" / "train_curves.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    out, run = tmp_path / "reports", tmp_path / "run"
+    base = ["--corpus", str(corpus), "--design", "tiny_plain", "--points", "1", "--text-encoder", "hash",
+            "--out", str(out), "--heldout", "4", "--sample-steps", "2", "--run-dir", str(run)]
+    assert module.main(base + ["--minutes", "0.01"]) == 0
+    first = json.loads((out / "curves.json").read_text())["tiny_plain"]["points"]
+    assert len(first) == 1 and (run / "checkpoints").is_dir()
+    assert module.main(base + ["--minutes", "0.02"]) == 0  # continues: one more point, later step, more CPU
+    pts = json.loads((out / "curves.json").read_text())["tiny_plain"]["points"]
+    assert len(pts) == 2 and pts[0] == first[0]
+    assert pts[1]["step"] > pts[0]["step"] and pts[1]["cpu_s"] >= 1.2 and pts[0]["cpu_s"] < pts[1]["cpu_s"]
+    assert len(list((run / "curve_samples").glob("step_*.npy"))) == 2
+    # rescoring the saved samples without training reproduces the sample metrics
+    assert module.main(base + ["--minutes", "0.02", "--rescore"]) == 0
+    again = json.loads((out / "curves.json").read_text())["tiny_plain"]["points"]
+    assert [r["step"] for r in again] == [r["step"] for r in pts]
+    for a, b in zip(again, pts):
+        assert abs(a["sliding"] - b["sliding"]) < 1e-6 and abs(a["skate_ratio"] - b["skate_ratio"]) < 1e-6

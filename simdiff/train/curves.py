@@ -132,9 +132,8 @@ def heldout_loss(trainer: Any, held: HeldOut, draws: int = 4) -> float:
     return total / draws
 
 
-def sample_metrics(trainer: Any, held: HeldOut, evaluator: Any, steps: int, guidance: float,
-                   factor: int = 1) -> dict[str, float]:
-    """Metrics of DDIM samples (the exported, EMA weights) for the held-out captions and lengths."""
+def draw_samples(trainer: Any, held: HeldOut, steps: int, guidance: float) -> torch.Tensor:
+    """DDIM samples (the exported, EMA weights) for the held-out captions at their lengths: (N, L, 263) raw features."""
     from simdiff.model.checkpoint import build_network
     from simdiff.model.generator import MotionGenerator
 
@@ -142,20 +141,80 @@ def sample_metrics(trainer: Any, held: HeldOut, evaluator: Any, steps: int, guid
     net.load_state_dict(trainer.export_state())
     gen = MotionGenerator(net, trainer.config.model, trainer.text, trainer.mean, trainer.std, trainer.device)
     lengths = [int(n) for n in held.batch["lengths"]]
-    feats = gen.generate(held.batch["captions"], lengths, steps=steps, guidance=guidance, seed=0).features.cpu()
-    return _sample_metrics(feats, {**held.batch, "lengths": torch.tensor(lengths)}, evaluator, factor)
+    return gen.generate(held.batch["captions"], lengths, steps=steps, guidance=guidance, seed=0).features.cpu()
+
+
+def sample_metrics(trainer: Any, held: HeldOut, evaluator: Any, steps: int, guidance: float,
+                   factor: int = 1) -> dict[str, float]:
+    """Metrics of DDIM samples (the exported, EMA weights) for the held-out captions and lengths."""
+    feats = draw_samples(trainer, held, steps, guidance)
+    return _sample_metrics(feats, held.batch, evaluator, factor)
+
+
+def score_samples(feats: torch.Tensor, held: HeldOut, evaluator: Any, factor: int = 1) -> dict[str, float]:
+    """The sample metrics of saved samples ``feats`` (N, L, 263) raw features (e.g. R@3 once an evaluator exists)."""
+    return _sample_metrics(feats, held.batch, evaluator, factor)
+
+
+POINTS_NAME = "curve_points.jsonl"
+"""Per-run log of the points (one JSON object per line), so a run continues where it stopped."""
+
+
+def _sample_path(run_dir: Path, step: int) -> Path:
+    return run_dir / "curve_samples" / f"step_{step:07d}.npy"
+
+
+def load_points(run_dir: Path | None) -> list[dict[str, Any]]:
+    """Points already measured in ``run_dir`` (empty without one)."""
+    import json
+
+    path = None if run_dir is None else Path(run_dir) / POINTS_NAME
+    if path is None or not path.is_file():
+        return []
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+def rescore(run_dir: Path, held: HeldOut, evaluator: Any, factor: int = 1) -> list[dict[str, Any]]:
+    """Recompute the sample metrics of every saved point of ``run_dir`` (R@3 with ``evaluator``); rewrites the log."""
+    import json
+
+    from simdiff.fsio import write_text
+
+    rows = load_points(run_dir)
+    for row in rows:
+        path = _sample_path(Path(run_dir), int(row["step"]))
+        if not path.is_file():
+            raise SimdiffError(f"{path}: no saved samples for step {row['step']}; cannot rescore")
+        row.update(score_samples(torch.from_numpy(np.load(path)), held, evaluator, factor))
+    write_text(Path(run_dir) / POINTS_NAME, "".join(json.dumps(r) + "\n" for r in rows))
+    return rows
 
 
 def run_curve(trainer: Any, held: HeldOut, minutes: float, points: int, *, evaluator: Any = None,
-              sample_steps: int = 20, guidance: float = 2.5, factor: int = 1,
+              sample_steps: int = 20, guidance: float = 2.5, factor: int = 1, save: bool = False,
               log: Callable[[str], None] = print) -> list[dict[str, Any]]:
-    """Train for ``minutes`` of CPU time (training only), evaluating ``points`` times evenly; returns the points."""
+    """Train until ``minutes`` of CPU time (training only), evaluating ``points`` times evenly; returns all points.
+
+    With ``save`` the trainer checkpoints at every point and the points and samples are logged
+    in its run folder: a later call with a larger ``minutes`` continues from the last point
+    (CPU time counted from there) and returns the earlier points too.
+    """
+    import json
+
+    from simdiff.fsio import atomic_path, write_text
+
     budget = 60.0 * minutes
-    rows: list[dict[str, Any]] = []
-    cpu = 0.0
-    wall = 0.0
+    rows = load_points(trainer.run_dir) if save else []
+    if rows and int(rows[-1]["step"]) != trainer.step:
+        raise SimdiffError(f"{trainer.run_dir}: last logged point is step {rows[-1]['step']} but the checkpoint is at "
+                           f"step {trainer.step}; use a new run folder")
+    cpu = float(rows[-1]["cpu_s"]) if rows else 0.0
+    wall = float(rows[-1]["wall_s"]) if rows else 0.0
+    start = cpu
     for p in range(1, points + 1):
-        target = budget * p / points
+        target = start + (budget - start) * p / points
+        if target <= cpu:
+            continue
         losses: list[float] = []
         while cpu < target:
             c0, w0 = time.process_time(), time.perf_counter()
@@ -164,8 +223,17 @@ def run_curve(trainer: Any, held: HeldOut, minutes: float, points: int, *, evalu
             wall += time.perf_counter() - w0
         row = {"step": trainer.step, "cpu_s": round(cpu, 2), "cpu_h": cpu / 3600.0, "wall_s": round(wall, 2),
                "train_loss": float(np.mean(losses)) if losses else None, "heldout_loss": heldout_loss(trainer, held)}
-        row.update(sample_metrics(trainer, held, evaluator, sample_steps, guidance, factor))
+        feats = draw_samples(trainer, held, sample_steps, guidance)
+        row.update(_sample_metrics(feats, held.batch, evaluator, factor))
         rows.append(row)
+        if save:
+            trainer.save()
+            path = _sample_path(trainer.run_dir, trainer.step)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_path(path) as tmp:
+                with open(tmp, "wb") as fh:
+                    np.save(fh, feats.numpy().astype(np.float32))
+            write_text(trainer.run_dir / POINTS_NAME, "".join(json.dumps(r) + "\n" for r in rows))
         log(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
     return rows
 
