@@ -66,6 +66,7 @@ def test_check_writes_every_field(checked: dict) -> None:
     split = report["test_split"]
     assert split["samples_per_replication"] == 16 and split["replications"] == 1 and split["seeds"] == [0]
     assert not split["r_precision_comparable"] and "resample" in split["fid_floor"]
+    assert any("replications=1" in p for p in split["claim_problems"])  # the quick preset carries no claim
     for key in ("sliding", "skate_ratio", "r_precision_top3", "fid"):
         assert key in split["generated"] and key in split["ground_truth"]
     assert set(split["ratios"]) == {"skate_ratio", "r_precision_top3", "fid_over_floor", "sliding_over_gt"}
@@ -80,7 +81,7 @@ def test_check_writes_every_field(checked: dict) -> None:
     assert {v["check"] for v in report["verdicts"]} == set(RULES)
     assert report["figures"]["generate_wall_s"] == 4.2
     md = (out / "check.md").read_text()
-    assert "## Verdicts" in md and "quick preset" in md and "| jumps |" in md
+    assert "## Verdicts" in md and "quick preset" in md and "| jumps |" in md and "cannot carry" in md
 
 
 def test_verdicts_follow_the_figures(checked: dict) -> None:

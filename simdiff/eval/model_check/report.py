@@ -25,6 +25,15 @@ def _ci(s: dict[str, Any] | None, digits: int = 3) -> str:
     return _f(s.get("mean"), digits) + ("" if half is None or half != half else f" ± {_f(half, digits)}")
 
 
+def _claim_line(report: dict[str, Any]) -> list[str]:
+    problems = (report.get("test_split") or {}).get("claim_problems")
+    if problems is None:
+        return []
+    if not problems:
+        return ["The test-split settings can carry the issue's claim (n ≥ 256 or the whole split, ≥ 5 replications).", ""]
+    return ["**These settings cannot carry the issue's claim:** " + "; ".join(problems) + ".", ""]
+
+
 def _verdict_lines(report: dict[str, Any]) -> list[str]:
     lines = ["| check | rule | value | threshold | verdict |", "|---|---|---|---|---|"]
     for v in report["verdicts"]:
@@ -60,7 +69,7 @@ def _jump_lines(j: dict[str, Any]) -> list[str]:
     r = j["rule"]
     lines = [f"{j['overall']['n']} samples of {j['frames']} frames at Earth φ. A sample jumps when a flight lasts "
              f"≥ {r['min_flight_s']} s and the pelvis rises ≥ {r['min_rise_m'] * 100:.0f} cm above its standing level "
-             f"({r['standing_level']}) during it. Interval: {r['interval']}.", "",
+             f"during it. Standing level: {r['standing_level']}. Interval: {r['interval']}.", "",
              "| prompt | n | jumps | fraction [95 %] | with flight ≥ 0.2 s | median flight s | median rise m |",
              "|---|---|---|---|---|---|---|"]
     for row in [*j["per_prompt"], j["overall"]]:
@@ -140,7 +149,7 @@ def markdown(report: dict[str, Any]) -> str:
              + ("; **quick preset (smoke run, not a claim)**" if c["quick"] else "") + ".",
              f"Command: `{p['command']}`; commit {p['git_commit']}{' (dirty tree)' if p['git_dirty'] else ''}; "
              f"{p['machine']['cpus']} CPUs, torch threads {p['machine']['torch_threads']}; finished {report['finished']}.",
-             "", "## Verdicts (issue 14, done when)", "", *_verdict_lines(report),
+             "", "## Verdicts (issue 14, done when)", "", *_claim_line(report), *_verdict_lines(report),
              "", "## 1. Test split at Earth φ", "", *_split_lines(report["test_split"]),
              "", "## 2. Jump and hop prompts", "", *_jump_lines(report["jumps"]),
              "", "## 3. Walk and run speeds", "", *_speed_lines(report["speeds"]),

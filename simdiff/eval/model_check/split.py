@@ -19,7 +19,7 @@ import numpy as np
 
 from simdiff.eval import metrics as M
 from simdiff.eval.model_check.config import SplitOptions
-from simdiff.eval.protocol import GenerateFn, ProtocolConfig, evaluate_t2m
+from simdiff.eval.protocol import GenerateFn, ProtocolConfig, claim_problems, evaluate_t2m
 from simdiff.eval.stats import t_interval
 
 FID_FLOOR: str = ("ground truth vs a resample: the protocol's second independent draw of n test motions "
@@ -65,8 +65,11 @@ def measure_split(evaluator: Any, dataset: Any, generate: GenerateFn, options: S
         "split": options.split, "split_size": len(dataset), "n_requested": options.n,
         "samples_per_replication": n_used[0], "whole_split": whole, "batch_size": batch,
         "r_precision_comparable": batch == 32, "replications": len(seeds), "seeds": list(seeds),
+        "data_draw_seeds": [[s, 0] for s in seeds],
         "generation_seeds": [[s * 1_000_003 + k for k in range(n_used[0] // batch)] for s in seeds],
         "env": "Earth (-9.81, 0, 0)", "fid_floor": FID_FLOOR,
+        "claim_problems": claim_problems(dataclasses.replace(protocol_config(options, seeds[0]), replications=len(seeds)),
+                                         len(dataset)) + ([] if batch == 32 else [f"R-precision batch {batch}, not 32"]),
         "generated": M.summarize(gen_rows), "ground_truth": M.summarize(gt_rows), "ratios": ratios,
         "per_seed": {"generated": gen_rows, "ground_truth": gt_rows}, "gen_s_per_sample": float(np.mean(seconds)),
         "protocol": dataclasses.asdict(protocol_config(options, seeds[0])) | {"seed": "per replication"},
