@@ -210,3 +210,15 @@ def test_config_refuses_bad_values(checked: dict) -> None:
         CheckConfig(**{**config.__dict__, "seeds": [1, 1]}).validate()
     with pytest.raises(SimdiffError, match="corpus"):
         CheckConfig(**{**config.__dict__, "corpus": str(checked["root"])}).validate()
+
+
+def test_backbone_has_no_response_section(checked: dict, tmp_path: Path) -> None:
+    config = _config(checked["paths"], tmp_path / "out")
+    config.model = str(checked["paths"]["backbone"])
+    config.prompts.jump_samples = config.prompts.speed_samples = 1
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert report["model"]["kind"] == "backbone" and "Sim Encoder" in report["response"]["skipped"]
+    by = {v["check"]: v for v in report["verdicts"]}
+    assert by["gravity_rise"]["passed"] is None and by["wind_downwind"]["passed"] is None
+    assert by["sliding"]["passed"] is not None and "skipped" in report["generation_speed"]
