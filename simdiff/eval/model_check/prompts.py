@@ -1,0 +1,109 @@
+"""Prompt figures: do jump/hop prompts jump, and do walk/run prompts move at the corpus's speeds?
+
+* Jumps (:func:`jump_summary`): per prompt and over all, the fraction of samples that jump
+  (:func:`simdiff.eval.model_check.detect.jump_stats`) with a Wilson 95 % interval over samples
+  (samples of one prompt are not fully independent; the per-prompt rows show the spread).
+* Speeds (:func:`speed_summary`): quartiles of the samples' mean horizontal root speed per motion
+  type against the quartiles of the corpus's *train* clips of that ``motion_type``
+  (``manifest.json``; mirrors left out: they have their original's speed). A type passes when
+  the samples' median lies within the corpus clips' interquartile range.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from simdiff.errors import SimdiffError
+from simdiff.eval.model_check.detect import MIN_FLIGHT_S, MIN_RISE_M, jump_stats, quartiles, root_speed, wilson
+from simdiff.eval.model_check.samples import PromptBatch
+
+STANDING_LEVEL: str = ("median pelvis height over the frames outside every flight (feet on the ground by the "
+                       "flight rule of simdiff/motion/flight.py)")
+
+
+def _per_sample(batches: Sequence[PromptBatch]) -> list[PromptBatch]:
+    return [b for b in batches for _ in range(b.count)]
+
+
+def jump_summary(joints: np.ndarray, batches: Sequence[PromptBatch]) -> dict[str, Any]:
+    """Jump fraction per prompt and overall over (N, T, 22, 3) samples generated from ``batches``."""
+    owners = _per_sample(batches)
+    if len(owners) != len(joints):
+        raise SimdiffError(f"{len(joints)} motions for {len(owners)} planned samples")
+    stats = [jump_stats(j) for j in joints]
+    per_prompt = []
+    for prompt in dict.fromkeys(b.prompt for b in batches):
+        mine = [s for s, b in zip(stats, owners) if b.prompt == prompt]
+        per_prompt.append(_row(prompt, mine))
+    return {"rule": {"min_flight_s": MIN_FLIGHT_S, "min_rise_m": MIN_RISE_M, "standing_level": STANDING_LEVEL,
+                     "interval": "Wilson 95 % over samples"},
+            "per_prompt": per_prompt, "overall": _row("all", stats), "frames": int(joints.shape[1])}
+
+
+def _row(prompt: str, stats: list[dict[str, Any]]) -> dict[str, Any]:
+    k = sum(bool(s["jump"]) for s in stats)
+    frac, lo, hi = wilson(k, len(stats))
+    return {"prompt": prompt, "n": len(stats), "jumps": k, "fraction": frac, "wilson95": [lo, hi],
+            "with_flight": sum(s["flight_s"] >= MIN_FLIGHT_S - 1e-9 for s in stats),
+            "median_flight_s": float(np.median([s["flight_s"] for s in stats])) if stats else float("nan"),
+            "median_rise_m": float(np.median([s["rise_m"] for s in stats])) if stats else float("nan")}
+
+
+def corpus_speeds(corpus: str | Path, types: Sequence[str], limit: int = 0, seed: int = 0) -> dict[str, list[float]]:
+    """Mean horizontal root speeds (m/s) of the corpus's train clips per ``motion_type`` (originals only).
+
+    Args:
+        corpus: a corpus folder with ``manifest.json`` (``clips`` with ``id``, ``split``, ``motion_type``,
+            ``mirror_of``) and ``new_joints/<id>.npy``.
+        limit: at most this many clips per type, a seeded random subset (0: all).
+    Raises:
+        SimdiffError: no manifest, or a manifest without motion types.
+    """
+    path = Path(corpus) / "manifest.json"
+    if not path.is_file():
+        raise SimdiffError(f"{path}: missing (the speed check needs the corpus manifest with motion_type)")
+    try:
+        clips = json.loads(path.read_text(encoding="utf-8")).get("clips")
+    except (json.JSONDecodeError, AttributeError) as exc:
+        raise SimdiffError(f"{path}: not a corpus manifest ({exc})") from None
+    if not isinstance(clips, list) or not all(isinstance(c, dict) and "motion_type" in c for c in clips):
+        raise SimdiffError(f"{path}: clips without 'motion_type' (build the corpus with `simdiff data build`)")
+    rng = np.random.default_rng(seed)
+    out: dict[str, list[float]] = {}
+    for kind in types:
+        ids = sorted(c["id"] for c in clips if c.get("split") == "train" and c["motion_type"] == kind
+                     and not c.get("mirror_of"))
+        if limit and len(ids) > limit:
+            ids = sorted(rng.choice(ids, limit, replace=False).tolist())
+        speeds = []
+        for clip_id in ids:
+            f = Path(corpus) / "new_joints" / f"{clip_id}.npy"
+            if not f.is_file():
+                raise SimdiffError(f"{f}: missing (listed in manifest.json)")
+            speeds.append(root_speed(np.load(f)))
+        out[kind] = speeds
+    return out
+
+
+def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dict[str, Sequence[str]],
+                  corpus: dict[str, list[float]]) -> dict[str, Any]:
+    """Per motion type: quartiles of the samples' speeds (and per prompt) against the corpus clips'."""
+    owners = _per_sample(batches)
+    speeds = [root_speed(j) for j in joints]
+    out: dict[str, Any] = {"speed": "mean horizontal pelvis speed over the motion (m/s)",
+                           "rule": "pass when the samples' median lies in the corpus train clips' [Q1, Q3]",
+                           "types": {}}
+    for kind, prompts in kinds.items():
+        mine = [v for v, b in zip(speeds, owners) if b.prompt in prompts]
+        ref = quartiles(corpus.get(kind, []))
+        gen = quartiles(mine)
+        out["types"][kind] = {
+            "prompts": list(prompts), "samples": gen, "corpus_train": ref,
+            "per_prompt": {p: quartiles([v for v, b in zip(speeds, owners) if b.prompt == p]) for p in prompts},
+            "median_in_iqr": bool(ref["n"] > 0 and ref["q1"] <= gen["median"] <= ref["q3"]) if gen["n"] else False}
+    return out

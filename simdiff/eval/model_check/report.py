@@ -1,0 +1,160 @@
+"""check.md: the model check as a readable report (every number from check.json)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+
+def _f(v: Any, digits: int = 3) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_f(x, digits) for x in v) + "]"
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return str(v)
+    return "NaN" if math.isnan(x) else f"{x:.{digits}g}" if abs(x) >= 1000 else f"{x:.{digits}f}"
+
+
+def _ci(s: dict[str, Any] | None, digits: int = 3) -> str:
+    if not s:
+        return "—"
+    half = s.get("ci95")
+    return _f(s.get("mean"), digits) + ("" if half is None or half != half else f" ± {_f(half, digits)}")
+
+
+def _claim_line(report: dict[str, Any]) -> list[str]:
+    problems = (report.get("test_split") or {}).get("claim_problems")
+    if problems is None:
+        return []
+    if not problems:
+        return ["The test-split settings can carry the issue's claim (n ≥ 256 or the whole split, ≥ 5 replications).", ""]
+    return ["**These settings cannot carry the issue's claim:** " + "; ".join(problems) + ".", ""]
+
+
+def _verdict_lines(report: dict[str, Any]) -> list[str]:
+    lines = ["| check | rule | value | threshold | verdict |", "|---|---|---|---|---|"]
+    for v in report["verdicts"]:
+        mark = {True: "**PASS**", False: "**FAIL**", None: "n/a"}[v["passed"]]
+        lines.append(f"| {v['check']} | {v['rule']} | {_f(v['value'])} | {_f(v['threshold'])} | {mark} |")
+    return lines
+
+
+def _split_lines(s: dict[str, Any]) -> list[str]:
+    if not s or "skipped" in s:
+        return [f"Not measured: {(s or {}).get('skipped', 'no result')}."]
+    n = s["samples_per_replication"]
+    size_note = (f"the whole split in batches of {s['batch_size']} ({n} of {s['split_size']}; fewer than the "
+                 f"{s['n_requested']} asked)") if s["whole_split"] else f"{n} of {s['split_size']} test motions"
+    lines = [f"Split `{s['split']}`, {size_note} per replication, {s['replications']} replications (seeds "
+             f"{', '.join(map(str, s['seeds']))}), samples at the GT lengths for the GT captions, {s['env']}. "
+             f"Mean ± Student-t 95 % half-width over replications. FID floor: {s['fid_floor']}."]
+    if not s["r_precision_comparable"]:
+        lines.append(f"R-precision batch {s['batch_size']} (not 32): not comparable with protocol numbers.")
+    lines += ["", "| metric | generated | ground truth | generated / GT (per replication) |", "|---|---|---|---|"]
+    ratio = {"skate_ratio": "skate_ratio", "r_precision_top3": "r_precision_top3", "fid": "fid_over_floor",
+             "sliding": "sliding_over_gt"}
+    for key in ("sliding", "skate_ratio", "penetration", "floating", "r_precision_top1", "r_precision_top3", "mm_dist",
+                "fid", "diversity"):
+        r = s["ratios"].get(ratio.get(key, ""))
+        lines.append(f"| {key}{' (FID floor for GT)' if key == 'fid' else ''} | {_ci(s['generated'].get(key))} | "
+                     f"{_ci(s['ground_truth'].get(key))} | {_ci(r) if r else ''} |")
+    lines.append(f"\nGeneration: {_f(s['gen_s_per_sample'])} s per sample (batched).")
+    return lines
+
+
+def _jump_lines(j: dict[str, Any]) -> list[str]:
+    r = j["rule"]
+    lines = [f"{j['overall']['n']} samples of {j['frames']} frames at Earth φ. A sample jumps when a flight lasts "
+             f"≥ {r['min_flight_s']} s and the pelvis rises ≥ {r['min_rise_m'] * 100:.0f} cm above its standing level "
+             f"during it. Standing level: {r['standing_level']}. Interval: {r['interval']}.", "",
+             "| prompt | n | jumps | fraction [95 %] | with flight ≥ 0.2 s | median flight s | median rise m |",
+             "|---|---|---|---|---|---|---|"]
+    for row in [*j["per_prompt"], j["overall"]]:
+        lines.append(f"| {row['prompt']} | {row['n']} | {row['jumps']} | {_f(row['fraction'], 2)} "
+                     f"{_f(row['wilson95'], 2)} | {row['with_flight']} | {_f(row['median_flight_s'], 2)} | "
+                     f"{_f(row['median_rise_m'], 3)} |")
+    return lines
+
+
+def _est(v: list[float]) -> str:
+    """``estimate [low, high]`` of a bootstrap triple; ``—`` when undefined."""
+    est, lo, hi = (_f(x, 2) for x in v)
+    return "—" if est == "NaN" else est if lo == "NaN" else f"{est} [{lo}, {hi}]"
+
+
+def _q(q: dict[str, Any]) -> str:
+    return f"{_f(q['q1'], 2)} / {_f(q['median'], 2)} / {_f(q['q3'], 2)} (n {q['n']})"
+
+
+def _speed_lines(s: dict[str, Any]) -> list[str]:
+    if "skipped" in s:
+        return [f"Not measured: {s['skipped']}."]
+    lines = [f"Speed: {s['speed']}; {s['rule']}. Quartiles Q1 / median / Q3.", "",
+             "| type | prompts | samples | corpus train clips | median in IQR |", "|---|---|---|---|---|"]
+    for kind, t in s["types"].items():
+        lines.append(f"| {kind} | {'; '.join(t['prompts'])} | {_q(t['samples'])} | {_q(t['corpus_train'])} | "
+                     f"{'yes' if t['median_in_iqr'] else 'no'} |")
+    return lines
+
+
+def _response_lines(r: dict[str, Any]) -> list[str]:
+    if "skipped" in r:
+        return [f"Not measured: {r['skipped']}."]
+    g, w = r["gravity"], r["wind"]
+    lines = [f"Simulator: {r['simulator']}. Same noise for every φ; simulated change = the Earth sample re-tracked "
+             "under φ minus it re-tracked under Earth.", "",
+             f"**Gravity {_f(g['env'][0], 2)} vs −9.81** on the jump prompts: {g['rise_both']} of {g['n']} samples raise "
+             f"both apex gain and flight time ({_f(g['rise_fraction'], 2)} {_f(g['wilson95'], 2)}; apex only "
+             f"{g['rise_apex_only']}, flight only {g['rise_flight_only']}). Rollouts: "
+             + ", ".join(f"{k} {v}" for k, v in sorted(g["rollouts"].items())) + ".", "",
+             "| quantity | generated change Q1/med/Q3 | simulated change Q1/med/Q3 | median gen/sim | samples in ratio |",
+             "|---|---|---|---|---|"]
+    for q, v in g["ratios"].items():
+        lines.append(f"| {q} | {_q(v['generated_change'])} | {_q(v['simulated_change'])} | {_f(v['median_ratio'], 2)} | "
+                     f"{v['n_ratio']} (|Δsim| > {v['tolerance']}) |")
+    lines += ["", f"**Wind ±10 N** (w_x, w_y) on the walk prompts: {w['downwind']} of {w['n']} (sample, φ) pairs drift "
+              f"downwind ({_f(w['downwind_fraction'], 2)} {_f(w['wilson95'], 2)}). Drift along the wind per 10 N, "
+              f"Q1/med/Q3: generated {_q(w['drift_per_10n_generated_m'])} m, simulated "
+              f"{_q(w['drift_per_10n_simulated_m'])} m; median ratio {_f(w['median_ratio_generated_to_simulated'], 2)}. "
+              "Rollouts: " + ", ".join(f"{k} {v}" for k, v in sorted(w["rollouts"].items())) + ".", "",
+              "| φ | downwind | generated m Q1/med/Q3 | simulated m Q1/med/Q3 |", "|---|---|---|---|"]
+    for env, v in w["per_env"].items():
+        lines.append(f"| {env} | {v['downwind']} / {v['n']} | {_q(v['generated_m'])} | {_q(v['simulated_m'])} |")
+    lines += ["", "Response scores (simdiff/eval/response.py; 95 % bootstrap over samples):", "",
+              "| factor | quantity | pairs / with effect | sign agreement | slope ratio |", "|---|---|---|---|---|"]
+    for s in [*g["scores"], *w["scores"]]:
+        lines.append(f"| {s['factor']} | {s['quantity']} | {s['n_pairs']} / {s['n_effect']} | "
+                     f"{_est(s['sign_agreement'])} | {_est(s['slope_ratio'])} |")
+    return lines
+
+
+def _speed_of_generate(s: dict[str, Any]) -> list[str]:
+    if "skipped" in s:
+        return [f"Not measured: {s['skipped']}."]
+    wall, cpu = s["summary"]["wall_s"], s["summary"]["cpu_s"]
+    return [f"`{s['command']}` ({len(s['runs'])} runs, threads {s['threads']}): wall median {wall['median']} s, "
+            f"CPU median {cpu['median']} s (benchmarks/bench_generate.py; load before/after "
+            f"{s['machine']['loadavg_1min_before_after']})."]
+
+
+def markdown(report: dict[str, Any]) -> str:
+    """The whole report as Markdown."""
+    c, p = report["settings"], report["provenance"]
+    lines = [f"# Model check: {report['model']['path']}", "",
+             f"Model kind: {report['model']['kind']}; corpus {report['corpus']}; evaluator {report['evaluator']['path']}; "
+             f"DDIM {c['steps']} steps, guidance {c['guidance']}, α {c['alpha']}; seeds {c['seeds']}"
+             + ("; **quick preset (smoke run, not a claim)**" if c["quick"] else "") + ".",
+             f"Command: `{p['command']}`; commit {p['git_commit']}{' (dirty tree)' if p['git_dirty'] else ''}; "
+             f"{p['machine']['cpus']} CPUs, torch threads {p['machine']['torch_threads']}; finished {report['finished']}.",
+             "", "## Verdicts (issue 14, done when)", "", *_claim_line(report), *_verdict_lines(report),
+             "", "## 1. Test split at Earth φ", "", *_split_lines(report["test_split"]),
+             "", "## 2. Jump and hop prompts", "", *_jump_lines(report["jumps"]),
+             "", "## 3. Walk and run speeds", "", *_speed_lines(report["speeds"]),
+             "", "## 4. Physics response", "", *_response_lines(report["response"]),
+             "", "## 5. Generation speed", "", *_speed_of_generate(report["generation_speed"]),
+             "", "Wall seconds per section (a stored section shows the time it took when measured): "
+             + ", ".join(f"{k} {float(v):.1f}" for k, v in report["timings_s"].items()) + "."]
+    return "\n".join(lines) + "\n"

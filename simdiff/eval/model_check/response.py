@@ -1,0 +1,114 @@
+"""Physics-response figures (models with a Sim Encoder): g = −1.6 vs −9.81 on jumps, ±10 N wind on walks.
+
+Every sample is generated under Earth and under φ with the same noise (:mod:`.samples`). The
+simulator's answer for that motion, as in the environment-response benchmark
+(:mod:`simdiff.eval.experiments.env_response`): the *Earth* sample re-tracked under φ minus the same
+sample re-tracked under Earth, flights following gravity (the projector's flight clock); pairs
+where either rollout fell have no simulated effect. Effects come from
+:func:`simdiff.eval.response.effects`, slope ratios and sign agreement from
+:func:`simdiff.eval.response.score` (bootstrap over samples).
+
+* Gravity: a sample *rises* when both its apex gain (pelvis over take-off in the longest flight)
+  and its longest flight time are larger at −1.6 than at Earth. Ratio per sample: generated change
+  ÷ simulated change, over samples whose simulated change exceeds the response tolerance; the
+  check takes the median per quantity.
+* Wind: a (sample, φ) pair drifts *downwind* when its root displacement along the wind grows
+  against Earth (Δ > 0). The drift per 10 N is that Δ (|w| = 10 N), generated and simulated.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from simdiff.eval.model_check.detect import quartiles, wilson
+from simdiff.eval.response import TOLERANCE, effects, quantities, score
+from simdiff.motion.flight import flight_stats
+
+GRAVITY_QUANTITIES: dict[str, float] = {"apex_gain_m": TOLERANCE["apex_m"], "flight_s": TOLERANCE["flight_s"]}
+"""Quantities of the gravity check with the |simulated change| a ratio needs."""
+
+
+def motion_quantities(joints: np.ndarray, env: Sequence[float]) -> dict[str, float]:
+    """:func:`simdiff.eval.response.quantities` plus ``apex_gain_m`` (:func:`simdiff.motion.flight.flight_stats`)."""
+    return {**quantities(joints, env), "apex_gain_m": flight_stats(joints)["apex_gain_m"]}
+
+
+def simulate(projector: Any, earth: np.ndarray, envs: Sequence[Sequence[float]]) -> tuple[dict, dict[str, int], list[str]]:
+    """Re-track every Earth sample under every φ; ({(i, φ): quantities | None}, statuses, first errors)."""
+    from simdiff.sim.env import Environment
+
+    jobs = [(i, tuple(float(v) for v in env)) for env in envs for i in range(len(earth))]
+    results = projector([earth[i] for i, _ in jobs], [Environment(*env) for _, env in jobs])
+    out: dict[tuple[int, tuple[float, ...]], dict[str, float] | None] = {}
+    statuses: dict[str, int] = {}
+    errors: list[str] = []
+    for (i, env), (rollout, info) in zip(jobs, results):
+        failed = isinstance(info, str)
+        ok = not failed and bool(_get(info, "success")) and rollout is not None and len(rollout) >= 2
+        status = "error" if failed else str(_get(info, "status", "ok" if ok else "fell"))
+        statuses[status] = statuses.get(status, 0) + 1
+        if failed and len(errors) < 3:
+            errors.append(str(info))
+        out[(i, env)] = motion_quantities(np.asarray(rollout), env) if ok else None
+    return out, statuses, errors
+
+
+def _get(info: Any, key: str, default: Any = None) -> Any:
+    return info.get(key, default) if isinstance(info, dict) else getattr(info, key, default)
+
+
+def _records(ids: Sequence[str], generated: dict[tuple[float, ...], np.ndarray], sims: dict) -> list[dict[str, Any]]:
+    return [{"unit": u, "env": list(env), "gen": motion_quantities(joints[i], env), "sim": sims.get((i, env))}
+            for env, joints in generated.items() for i, u in enumerate(ids)]
+
+
+def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low_g: float, projector: Any, *,
+                     resamples: int = 1000, seed: int = 0) -> dict[str, Any]:
+    """Apex-gain and flight-time response of jump samples to g = ``low_g`` (same noise as ``earth``)."""
+    e_env, l_env = (-9.81, 0.0, 0.0), (float(low_g), 0.0, 0.0)
+    sims, statuses, errors = simulate(projector, earth, [e_env, l_env])
+    effs = effects(_records(ids, {e_env: earth, l_env: low}, sims))
+    rises = [e["dgen"]["apex_gain_m"] > 0 and e["dgen"]["flight_s"] > 0 for e in effs]
+    frac, lo, hi = wilson(sum(rises), len(rises))
+    ratios: dict[str, Any] = {}
+    for q, tol in GRAVITY_QUANTITIES.items():
+        pairs = [(e["dgen"][q], e["dsim"][q]) for e in effs if e["dsim"] is not None]
+        use = [g / s for g, s in pairs if abs(s) > tol]
+        ratios[q] = {"median_ratio": float(np.median(use)) if use else float("nan"), "n_ratio": len(use),
+                     "n_tracked": len(pairs), "tolerance": tol,
+                     "generated_change": quartiles([e["dgen"][q] for e in effs]),
+                     "simulated_change": quartiles([s for _, s in pairs])}
+    return {"env": list(l_env), "n": len(effs), "rise_both": sum(rises), "rise_fraction": frac, "wilson95": [lo, hi],
+            "rise_apex_only": sum(e["dgen"]["apex_gain_m"] > 0 for e in effs),
+            "rise_flight_only": sum(e["dgen"]["flight_s"] > 0 for e in effs),
+            "ratios": ratios, "scores": score(effs, resamples=resamples, seed=seed), "rollouts": statuses,
+            "rollout_errors": errors}
+
+
+def wind_response(ids: Sequence[str], earth: np.ndarray, windy: dict[tuple[float, ...], np.ndarray], projector: Any, *,
+                  resamples: int = 1000, seed: int = 0) -> dict[str, Any]:
+    """Drift along the wind of walk samples under each windy φ (same noise as ``earth``)."""
+    e_env = (-9.81, 0.0, 0.0)
+    envs = [tuple(float(v) for v in env) for env in windy]
+    sims, statuses, errors = simulate(projector, earth, [e_env, *envs])
+    effs = effects(_records(ids, {e_env: earth, **{env: windy[key] for env, key in zip(envs, windy)}}, sims))
+    along = [e["dgen"]["drift_along_wind_m"] for e in effs]
+    sim_along = [e["dsim"]["drift_along_wind_m"] for e in effs if e["dsim"] is not None]
+    frac, lo, hi = wilson(sum(d > 0 for d in along), len(along))
+    per_env = {}
+    for env in envs:
+        g = [e["dgen"]["drift_along_wind_m"] for e in effs if tuple(e["env"]) == env]
+        s = [e["dsim"]["drift_along_wind_m"] for e in effs if tuple(e["env"]) == env and e["dsim"] is not None]
+        per_env[f"wx{env[1]:+g} wy{env[2]:+g}"] = {"downwind": sum(d > 0 for d in g), "n": len(g),
+                                                   "generated_m": quartiles(g), "simulated_m": quartiles(s)}
+    gen_q, sim_q = quartiles(along), quartiles(sim_along)
+    return {"envs": [list(e) for e in envs], "n": len(along), "downwind": sum(d > 0 for d in along),
+            "downwind_fraction": frac, "wilson95": [lo, hi],
+            "drift_per_10n_generated_m": gen_q, "drift_per_10n_simulated_m": sim_q,
+            "median_ratio_generated_to_simulated": gen_q["median"] / sim_q["median"] if sim_q["n"] and sim_q["median"]
+            else float("nan"),
+            "per_env": per_env, "scores": score(effs, resamples=resamples, seed=seed), "rollouts": statuses,
+            "rollout_errors": errors}

@@ -1,0 +1,252 @@
+"""Run a model check: load once, measure each section (cached in ``parts/``), write check.json + check.md.
+
+Sections (see the package docstring): ``test_split``, ``jumps``, ``speeds`` and, for continuous
+SimDiff models, ``response`` (gravity, wind). Each section's result is stored atomically in
+``<out>/parts/<section>.json`` with a fingerprint of everything that determines it (model file
+stamp, settings, corpus, evaluator); a rerun reuses a part whose fingerprint matches, so an
+interrupted check resumes after its last finished section.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from simdiff.errors import SimdiffError
+from simdiff.eval.model_check.config import EARTH, JUMP_PROMPTS, MOON_G, SPEED_PROMPTS, WIND_N, CheckConfig
+from simdiff.eval.model_check.samples import PromptBatch, generate_set, plan_batches, units
+
+SCHEMA: str = "simdiff.model_check/1"
+
+
+def _stamp(path: str | Path, weights: str = "model.safetensors") -> dict[str, Any]:
+    p = Path(path).expanduser().resolve()
+    out: dict[str, Any] = {"path": str(p)}
+    f = p / weights
+    if f.is_file():
+        st = f.stat()
+        out.update(size=st.st_size, mtime_ns=st.st_mtime_ns)
+    return out
+
+
+class ModelCheck:
+    """Measures one model folder (:class:`CheckConfig`).
+
+    Args:
+        config: validated settings.
+        text_encoder: factory ``name -> encoder`` replacing the models' own sentence encoders (tests).
+        projector: replaces the simulator pool (tests); ``(motions, envs) -> iterable of (rollout, info)``.
+        progress: tqdm bars; fresh: ignore stored parts.
+    """
+
+    def __init__(self, config: CheckConfig, *, text_encoder: Callable[[str], Any] | None = None, projector: Any = None,
+                 progress: bool = True, fresh: bool = False, command: list[str] | None = None) -> None:
+        self.config = config.validate()
+        self.out = Path(config.out)
+        self.progress = progress
+        self.fresh = fresh
+        self.command = command
+        self._text_factory = text_encoder
+        self._encoders: dict[str, Any] = {}
+        self._injected = projector
+        self._projector = projector
+        self._generator: Any = None
+        self._sets: dict[tuple[str, tuple[float, ...] | None], np.ndarray] = {}
+        self.timings: dict[str, float] = {}
+
+    # --- resources --------------------------------------------------------------------------
+    def text_encoder(self, name: str) -> Any:
+        if name not in self._encoders:
+            if self._text_factory is not None:
+                self._encoders[name] = self._text_factory(name)
+            else:
+                from simdiff.text.base import load_text_encoder
+
+                self._encoders[name] = load_text_encoder(name, self.config.device)
+        return self._encoders[name]
+
+    @property
+    def generator(self) -> Any:
+        if self._generator is None:
+            from simdiff.model import MotionGenerator
+
+            gen = MotionGenerator.load(self.config.model, self.config.device, load_text=False)
+            gen.text_encoder = self.text_encoder(gen.config.text_encoder)
+            self._generator = gen
+        return self._generator
+
+    @property
+    def kind(self) -> str:
+        """``backbone``, ``continuous`` or ``categorical`` (from config.json)."""
+        try:
+            sim = json.loads((Path(self.config.model) / "config.json").read_text(encoding="utf-8")).get("sim")
+        except (json.JSONDecodeError, AttributeError, OSError) as exc:
+            raise SimdiffError(f"{Path(self.config.model) / 'config.json'}: unreadable ({exc})") from None
+        return "backbone" if sim is None else str(sim.get("mode", "continuous"))
+
+    def env(self, phi: Sequence[float]) -> tuple[float, ...] | None:
+        """φ as the generator takes it: None for a backbone (it takes no φ)."""
+        return None if self.kind == "backbone" else tuple(float(v) for v in phi)
+
+    @property
+    def projector(self) -> Any:
+        if self._projector is None:
+            from simdiff.data.augment.projector import SimProjector
+
+            r = self.config.response
+            self._projector = SimProjector(None, r.workers, "process", r.residual_bound)
+        return self._projector
+
+    def close(self) -> None:
+        """Stop the simulator workers this check started."""
+        if self._projector is not None and self._injected is None:
+            getattr(self._projector, "close", lambda: None)()
+            self._projector = None
+
+    # --- parts ------------------------------------------------------------------------------
+    def base_inputs(self) -> dict[str, Any]:
+        c = self.config
+        return {"schema": SCHEMA, "model": _stamp(c.model), "seeds": c.seeds, "steps": c.steps, "guidance": c.guidance,
+                "alpha": c.alpha, "device": c.device}
+
+    def part(self, name: str, inputs: dict[str, Any], measure: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+        """The stored result of section ``name`` when its fingerprint matches, else measured and stored."""
+        from simdiff.fsio import write_json
+
+        inputs = {**self.base_inputs(), **inputs}
+        fingerprint = hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()[:16]
+        path = self.out / "parts" / f"{name}.json"
+        if path.is_file() and not self.fresh:
+            try:
+                stored = json.loads(path.read_text(encoding="utf-8"))
+            except json.JSONDecodeError:
+                stored = {}
+            if stored.get("fingerprint") == fingerprint:
+                self.timings[name] = stored.get("wall_s", 0.0)
+                return {**stored["result"], "cached": True}
+        start = time.perf_counter()
+        result = measure()
+        wall = round(time.perf_counter() - start, 2)
+        self.timings[name] = wall
+        write_json(path, {"fingerprint": fingerprint, "inputs": inputs, "wall_s": wall, "result": result})
+        return result
+
+    def samples(self, name: str, batches: list[PromptBatch], phi: Sequence[float]) -> np.ndarray:
+        """Joints of a prompt set under φ (memoised for this run)."""
+        key = (name, self.env(phi))
+        if key not in self._sets:
+            c = self.config
+            self._sets[key] = generate_set(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
+                                           steps=c.steps, guidance=c.guidance, progress=self.progress)
+        return self._sets[key]
+
+    # --- sections ---------------------------------------------------------------------------
+    def test_split(self) -> dict[str, Any]:
+        from simdiff.data.humanml3d import HumanML3D
+        from simdiff.eval.evaluator import OurEvaluator, load_evaluator
+        from simdiff.eval.model_check.split import measure_split
+        from simdiff.eval.protocol import generator_fn
+
+        c = self.config
+
+        def measure() -> dict[str, Any]:
+            model = load_evaluator(c.evaluator, c.device)
+            evaluator = OurEvaluator(model, self.text_encoder(model.config.text_encoder))
+            dataset = HumanML3D(c.corpus, c.split.split, seed=c.seeds[0])
+            env = self.env(EARTH)
+            fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
+                              steps=c.steps, guidance=c.guidance)
+            return measure_split(evaluator, dataset, fn, c.split, c.seeds, self.progress)
+
+        return self.part("test_split", {"corpus": _stamp(c.corpus, f"{c.split.split}.txt"), "evaluator": _stamp(c.evaluator),
+                                        "split": c.split.__dict__}, measure)
+
+    def jump_batches(self) -> list[PromptBatch]:
+        return plan_batches(JUMP_PROMPTS, self.config.prompts.jump_samples, self.config.seeds)
+
+    def speed_batches(self) -> list[PromptBatch]:
+        prompts = [p for ps in SPEED_PROMPTS.values() for p in ps]
+        return plan_batches(prompts, self.config.prompts.speed_samples, self.config.seeds)
+
+    def jumps(self) -> dict[str, Any]:
+        from simdiff.eval.model_check.prompts import jump_summary
+
+        batches = self.jump_batches()
+        return self.part("jumps", {"prompts": JUMP_PROMPTS, "options": self.config.prompts.__dict__},
+                         lambda: jump_summary(self.samples("jumps", batches, EARTH), batches))
+
+    def speeds(self) -> dict[str, Any]:
+        from simdiff.eval.model_check.prompts import corpus_speeds, speed_summary
+
+        c = self.config
+
+        def measure() -> dict[str, Any]:
+            try:
+                corpus = corpus_speeds(c.corpus, list(SPEED_PROMPTS), c.prompts.corpus_clips, c.seeds[0])
+            except SimdiffError as exc:
+                return {"skipped": str(exc)}
+            batches = self.speed_batches()
+            return speed_summary(self.samples("speeds", batches, EARTH), batches, SPEED_PROMPTS, corpus)
+
+        return self.part("speeds", {"prompts": SPEED_PROMPTS, "options": c.prompts.__dict__,
+                                    "corpus": _stamp(c.corpus, "manifest.json")}, measure)
+
+    def response(self) -> dict[str, Any]:
+        from simdiff.eval.model_check.response import gravity_response, wind_response
+
+        c = self.config
+        if self.kind != "continuous":
+            return {"skipped": f"the model is a {self.kind} model without a continuous Sim Encoder: no φ to respond to"}
+        if not c.response.enabled:
+            return {"skipped": "turned off (--no-response)"}
+        inputs = {"options": c.response.__dict__, "prompts": c.prompts.__dict__, "injected": self._injected is not None}
+        jumps = self.jump_batches()
+        grav = self.part("gravity", {**inputs, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: gravity_response(
+            units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, (MOON_G, 0.0, 0.0)), MOON_G,
+            self.projector, resamples=c.response.resamples, seed=c.seeds[0]))
+        walk = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["walk"]]
+        winds = [(EARTH[0], WIND_N, 0.0), (EARTH[0], -WIND_N, 0.0), (EARTH[0], 0.0, WIND_N), (EARTH[0], 0.0, -WIND_N)]
+        wind = self.part("wind", {**inputs, "wind": winds, "walk_prompts": SPEED_PROMPTS["walk"]}, lambda: wind_response(
+            units(walk), self.samples("walks", walk, EARTH), {w: self.samples("walks", walk, w) for w in winds},
+            self.projector, resamples=c.response.resamples, seed=c.seeds[0]))
+        return {"gravity": grav, "wind": wind, "simulator": "the projector's flight clock (flights follow gravity)"
+                if self._injected is None else "injected projector (tests)"}
+
+    # --- all --------------------------------------------------------------------------------
+    def run(self, generation_speed: dict[str, Any] | None = None) -> dict[str, Any]:
+        """Measure every section, write ``check.json`` and ``check.md``; returns the report."""
+        from simdiff.eval.experiments.provenance import now, provenance
+        from simdiff.eval.model_check.report import markdown
+        from simdiff.eval.model_check.verdict import figures, verdicts
+        from simdiff.fsio import check_writable, write_json, write_text
+
+        c = self.config
+        check_writable(self.out / "check.json")
+        kind = self.kind
+        if kind == "categorical":
+            raise SimdiffError(f"{c.model}: a categorical SimDiff model; the check needs a backbone or a continuous one")
+        report: dict[str, Any] = {"schema": SCHEMA, "model": {**_stamp(c.model), "kind": kind},
+                                  "corpus": str(Path(c.corpus).resolve()), "evaluator": _stamp(c.evaluator),
+                                  "settings": c.as_dict(), "provenance": provenance(c.seeds[0], c.device, self.command)}
+        start = time.perf_counter()
+        try:
+            report["test_split"] = self.test_split()
+            report["jumps"] = self.jumps()
+            report["speeds"] = self.speeds()
+            report["response"] = self.response()
+        finally:
+            self.close()
+        report["generation_speed"] = generation_speed or {"skipped": "run with --speed to measure it"}
+        report["figures"] = figures(report)
+        report["verdicts"] = verdicts(report["figures"])
+        report["timings_s"] = {**self.timings, "total": round(time.perf_counter() - start, 2)}
+        report["finished"] = now()
+        write_json(self.out / "check.json", report)
+        write_text(self.out / "check.md", markdown(report))
+        return report

@@ -1,0 +1,105 @@
+"""PASS/FAIL of issue 14's "done when" checks, computed from the measured numbers only.
+
+:func:`figures` pulls the numbers out of a check report; :func:`verdicts` applies the rules to
+them. A check whose numbers are missing (a section not run) or undefined (NaN) is ``n/a``
+(``passed`` None), never a pass.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+RULES: dict[str, str] = {
+    "sliding": "generated sliding ≤ 1.0 mm/frame",
+    "skate_ratio": "generated skate ratio ≤ 2 × ground truth's",
+    "r_precision_top3": "generated R@3 ≥ 0.8 × ground truth's",
+    "fid": "generated FID ≤ 3 × ground truth's FID floor (same n)",
+    "jumps": "≥ 70 % of jump/hop samples fly ≥ 0.2 s with the pelvis ≥ 15 cm above standing",
+    "walk_speed": "walk samples' median speed within the corpus train walks' [Q1, Q3]",
+    "run_speed": "run samples' median speed within the corpus train runs' [Q1, Q3]",
+    "gravity_rise": "g = −1.6 vs −9.81 (same seed): ≥ 80 % of jump samples raise apex gain and flight time",
+    "gravity_size": "median generated/simulated change ≥ 0.5 for apex gain and for flight time",
+    "wind_downwind": "±10 N wind (w_x, w_y): ≥ 80 % of walk samples drift downwind",
+    "generate_speed": "`simdiff generate` ≤ 10 s wall (benchmarks/bench_generate.py, median)",
+}
+
+
+def _num(value: Any) -> float | None:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def _verdict(check: str, value: Any, threshold: Any, ok: bool | None, detail: str = "") -> dict[str, Any]:
+    return {"check": check, "rule": RULES[check], "value": value, "threshold": threshold, "passed": ok, "detail": detail}
+
+
+def _at_most(check: str, value: Any, limit: Any, detail: str = "") -> dict[str, Any]:
+    v, lim = _num(value), _num(limit)
+    return _verdict(check, v, lim, None if v is None or lim is None else v <= lim, detail)
+
+
+def _at_least(check: str, value: Any, limit: Any, detail: str = "") -> dict[str, Any]:
+    v, lim = _num(value), _num(limit)
+    return _verdict(check, v, lim, None if v is None or lim is None else v >= lim, detail)
+
+
+def verdicts(f: dict[str, Any]) -> list[dict[str, Any]]:
+    """Apply every rule of :data:`RULES` to the flat figures ``f`` (see :func:`figures` for the keys).
+
+    Returns:
+        one dict per check: check, rule, value, threshold (the number ``value`` is compared with),
+        passed (True / False / None = n/a), detail.
+    """
+    def scaled(key: str, factor: float) -> float | None:
+        v = _num(f.get(key))
+        return None if v is None else v * factor
+
+    out = [
+        _at_most("sliding", f.get("sliding"), 1.0, "mm/frame"),
+        _at_most("skate_ratio", f.get("skate_ratio"), scaled("gt_skate_ratio", 2.0), f"GT {f.get('gt_skate_ratio')}"),
+        _at_least("r_precision_top3", f.get("r_precision_top3"), scaled("gt_r_precision_top3", 0.8),
+                  f"GT {f.get('gt_r_precision_top3')}"),
+        _at_most("fid", f.get("fid"), scaled("gt_fid", 3.0), f"GT floor {f.get('gt_fid')}"),
+        _at_least("jumps", f.get("jump_fraction"), 0.7),
+    ]
+    for kind in ("walk", "run"):
+        med, q1, q3 = (_num(f.get(f"{kind}_{k}")) for k in ("median", "corpus_q1", "corpus_q3"))
+        ok = None if med is None or q1 is None or q3 is None else q1 <= med <= q3
+        out.append(_verdict(f"{kind}_speed", med, [q1, q3], ok, "m/s"))
+    out.append(_at_least("gravity_rise", f.get("gravity_rise_fraction"), 0.8))
+    apex, flight = _num(f.get("gravity_ratio_apex")), _num(f.get("gravity_ratio_flight"))
+    size_ok = None if apex is None or flight is None else apex >= 0.5 and flight >= 0.5
+    out.append(_verdict("gravity_size", [apex, flight], 0.5, size_ok, "[apex gain, flight time]"))
+    out.append(_at_least("wind_downwind", f.get("wind_downwind_fraction"), 0.8))
+    out.append(_at_most("generate_speed", f.get("generate_wall_s"), 10.0, "s"))
+    return out
+
+
+def figures(report: dict[str, Any]) -> dict[str, Any]:
+    """The flat numbers :func:`verdicts` reads, from a check report (missing sections give None)."""
+    f: dict[str, Any] = {}
+    split = report.get("test_split") or {}
+    gen, gt = split.get("generated") or {}, split.get("ground_truth") or {}
+    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid"):
+        f[key] = (gen.get(key) or {}).get("mean")
+        f[f"gt_{key}"] = (gt.get(key) or {}).get("mean")
+    f["jump_fraction"] = ((report.get("jumps") or {}).get("overall") or {}).get("fraction")
+    types = (report.get("speeds") or {}).get("types") or {}
+    for kind in ("walk", "run"):
+        t = types.get(kind) or {}
+        f[f"{kind}_median"] = (t.get("samples") or {}).get("median")
+        f[f"{kind}_corpus_q1"] = (t.get("corpus_train") or {}).get("q1")
+        f[f"{kind}_corpus_q3"] = (t.get("corpus_train") or {}).get("q3")
+    grav = (report.get("response") or {}).get("gravity") or {}
+    f["gravity_rise_fraction"] = grav.get("rise_fraction")
+    ratios = grav.get("ratios") or {}
+    f["gravity_ratio_apex"] = (ratios.get("apex_gain_m") or {}).get("median_ratio")
+    f["gravity_ratio_flight"] = (ratios.get("flight_s") or {}).get("median_ratio")
+    f["wind_downwind_fraction"] = ((report.get("response") or {}).get("wind") or {}).get("downwind_fraction")
+    speed = ((report.get("generation_speed") or {}).get("summary") or {}).get("wall_s") or {}
+    f["generate_wall_s"] = speed.get("median")
+    return f

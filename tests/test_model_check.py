@@ -1,0 +1,224 @@
+"""The model check (benchmarks/model_check.py, simdiff/eval/model_check) on a tiny model the tests build."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from simdiff.errors import SimdiffError
+from simdiff.eval.experiments.testing import EchoProjector, write_tiny_setup
+from simdiff.eval.model_check import CheckConfig, ModelCheck, quick_preset, verdicts
+from simdiff.eval.model_check.detect import jump_stats, root_speed, standing_level, wilson
+from simdiff.eval.model_check.response import gravity_response, wind_response
+from simdiff.eval.model_check.samples import plan_batches
+from simdiff.eval.model_check.verdict import RULES, figures
+from simdiff.motion.synthetic import jump, walk
+from simdiff.train.testing import HashTextEncoder
+
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
+REPO = Path(__file__).resolve().parents[1]
+LENGTH, STEPS = 24, 2
+
+
+def _write_manifest(corpus: Path) -> None:
+    """A manifest naming the tiny corpus's train walks ``walk`` or ``run`` by their speed, its jumps ``jump``."""
+    clips = []
+    for clip_id in (corpus / "train.txt").read_text().split():
+        caption = (corpus / "texts" / f"{clip_id}.txt").read_text()
+        kind = "jump" if "jumps" in caption else "run" if "fast" in caption else "walk"
+        clips.append({"id": clip_id, "split": "train", "motion_type": kind, "mirror_of": None})
+    (corpus / "manifest.json").write_text(json.dumps({"clips": clips}))
+
+
+def _config(paths: dict, out: Path) -> CheckConfig:
+    config = quick_preset(CheckConfig(model=str(paths["adapters"]), corpus=str(paths["corpus"]),
+                                      evaluator=str(paths["evaluator"]), out=str(out), steps=STEPS))
+    config.prompts.length = LENGTH
+    config.prompts.jump_samples = 2
+    config.prompts.speed_samples = 2
+    return config
+
+
+@pytest.fixture(scope="module")
+def checked(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    root = tmp_path_factory.mktemp("model_check")
+    paths = write_tiny_setup(root, n_test=16, frames=44)
+    _write_manifest(paths["corpus"])
+    config = _config(paths, root / "out")
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run({"summary": {"wall_s": {"median": 4.2}, "cpu_s": {"median": 3.0}},
+                                             "command": "simdiff generate", "runs": [{}], "threads": 1,
+                                             "machine": {"loadavg_1min_before_after": [0, 0]}})
+    return {"root": root, "paths": paths, "config": config, "report": report}
+
+
+def test_check_writes_every_field(checked: dict) -> None:
+    out = checked["root"] / "out"
+    report = json.loads((out / "check.json").read_text())
+    for key in ("schema", "model", "corpus", "evaluator", "settings", "provenance", "test_split", "jumps", "speeds",
+                "response", "generation_speed", "figures", "verdicts", "timings_s", "finished"):
+        assert key in report, key
+    split = report["test_split"]
+    assert split["samples_per_replication"] == 16 and split["replications"] == 1 and split["seeds"] == [0]
+    assert not split["r_precision_comparable"] and "resample" in split["fid_floor"]
+    assert any("replications=1" in p for p in split["claim_problems"])  # the quick preset carries no claim
+    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid"):
+        assert key in split["generated"] and key in split["ground_truth"]
+    assert set(split["ratios"]) == {"skate_ratio", "r_precision_top3", "fid_over_floor", "sliding_over_gt"}
+    jumps = report["jumps"]
+    assert [r["n"] for r in jumps["per_prompt"]] == [2] * 6 and jumps["overall"]["n"] == 12
+    assert "outside every flight" in jumps["rule"]["standing_level"]
+    speeds = report["speeds"]["types"]
+    assert speeds["walk"]["samples"]["n"] == 4 and speeds["walk"]["corpus_train"]["n"] >= 1
+    grav, wind = report["response"]["gravity"], report["response"]["wind"]
+    assert grav["n"] == 12 and grav["rollouts"] == {"ok": 24}
+    assert wind["n"] == 4 * 4 and wind["rollouts"] == {"ok": 20}  # 4 walk samples × (Earth + 4 winds)
+    assert {v["check"] for v in report["verdicts"]} == set(RULES)
+    assert report["figures"]["generate_wall_s"] == 4.2
+    md = (out / "check.md").read_text()
+    assert "## Verdicts" in md and "quick preset" in md and "| jumps |" in md and "cannot carry" in md
+
+
+def test_verdicts_follow_the_figures(checked: dict) -> None:
+    report = checked["report"]
+    assert report["verdicts"] == verdicts(figures(report))
+    by = {v["check"]: v for v in report["verdicts"]}
+    f = report["figures"]
+    assert by["sliding"]["passed"] == (f["sliding"] <= 1.0)
+    assert by["fid"]["threshold"] == pytest.approx(3 * f["gt_fid"])
+    assert by["generate_speed"]["passed"] is True
+
+
+def test_verdict_rules_on_known_numbers() -> None:
+    good = {"sliding": 0.9, "skate_ratio": 0.13, "gt_skate_ratio": 0.07, "r_precision_top3": 0.40,
+            "gt_r_precision_top3": 0.47, "fid": 2.9, "gt_fid": 1.0, "jump_fraction": 0.7, "walk_median": 1.2,
+            "walk_corpus_q1": 1.0, "walk_corpus_q3": 1.4, "run_median": 2.5, "run_corpus_q1": 2.0,
+            "run_corpus_q3": 3.0, "gravity_rise_fraction": 0.8, "gravity_ratio_apex": 0.5, "gravity_ratio_flight": 0.9,
+            "wind_downwind_fraction": 0.85, "generate_wall_s": 9.0}
+    assert all(v["passed"] is True for v in verdicts(good))
+    bad = {**good, "sliding": 1.01, "skate_ratio": 0.15, "r_precision_top3": 0.37, "fid": 3.1, "jump_fraction": 0.69,
+           "walk_median": 1.5, "run_median": 1.9, "gravity_rise_fraction": 0.79, "gravity_ratio_flight": 0.49,
+           "wind_downwind_fraction": 0.2, "generate_wall_s": 10.5}
+    assert all(v["passed"] is False for v in verdicts(bad))
+    r3 = {v["check"]: v for v in verdicts(good)}["r_precision_top3"]
+    assert r3["threshold"] == pytest.approx(0.8 * 0.47)
+    missing = {**good, "gt_fid": None, "gravity_ratio_apex": float("nan")}
+    by = {v["check"]: v for v in verdicts(missing)}
+    assert by["fid"]["passed"] is None and by["gravity_size"]["passed"] is None  # n/a, never a pass
+
+
+def test_jump_detection_on_ballistic_pelvis() -> None:
+    high = jump_stats(jump(120, height=0.4, start=40, airtime=0.5))
+    assert high["jump"] and high["flight_s"] == pytest.approx(0.5, abs=0.1) and high["rise_m"] == pytest.approx(0.4, abs=0.02)
+    low = jump_stats(jump(120, height=0.1, start=40, airtime=0.5))  # flies long enough, rises 10 cm
+    assert not low["jump"] and low["flight_s"] >= 0.2 and low["rise_m"] == pytest.approx(0.1, abs=0.02)
+    short = jump_stats(jump(120, height=0.3, start=40, airtime=0.15))  # high enough, too short a flight
+    assert not short["jump"] and short["flight_s"] < 0.2
+    assert not jump_stats(walk(120))["jump"]
+    still = walk(60, speed=0.0, amplitude=0.0, bounce=0.0)
+    assert standing_level(still) == pytest.approx(float(still[0, 0, 1]))
+    assert root_speed(walk(80, speed=1.3)) == pytest.approx(1.3, rel=0.02)
+
+
+def test_wilson_and_batches() -> None:
+    frac, lo, hi = wilson(7, 10)
+    assert frac == 0.7 and 0.39 < lo < 0.40 and 0.89 < hi < 0.90  # the Wilson score interval of 7/10
+    assert math.isnan(wilson(0, 0)[0])
+    batches = plan_batches(["a", "b"], 5, [0, 1, 2])
+    assert [(b.prompt, b.seed, b.count) for b in batches] == [("a", 0, 2), ("a", 1, 2), ("a", 2, 1), ("b", 0, 2),
+                                                              ("b", 1, 2), ("b", 2, 1)]
+    assert len({b.noise_seed for b in batches}) == len(batches)
+
+
+class _Physics:
+    """A fake simulator with a known answer: at low g a jump flies higher (``apex``) and longer; wind pushes
+    the root ``drift`` m downwind over the motion."""
+
+    def __init__(self, apex: float, drift: float) -> None:
+        self.apex, self.drift = apex, drift
+
+    def __call__(self, motions, envs):
+        for m, env in zip(motions, envs):
+            g, wx, wy = env.as_tuple()
+            if g > -5:
+                yield jump(120, height=self.apex, start=40, airtime=1.0), {"success": True, "status": "ok"}
+                continue
+            out = np.array(m, dtype=np.float32)
+            ramp = np.linspace(0.0, self.drift, len(out))[:, None] / 10.0
+            out[..., 0] += ramp * wx
+            out[..., 2] += ramp * wy
+            yield out, {"success": True, "status": "ok"}
+
+
+def test_gravity_response_on_synthetic_jumps() -> None:
+    earth = np.stack([jump(120, height=0.3, start=40, airtime=0.5)] * 3)
+    low = np.stack([jump(120, height=0.45, start=40, airtime=0.75)] * 2 + [jump(120, height=0.2, start=40)])
+    out = gravity_response(["a", "b", "c"], earth, low, -1.6, _Physics(apex=0.6, drift=0.0), resamples=20)
+    assert out["rise_both"] == 2 and out["rise_fraction"] == pytest.approx(2 / 3)
+    apex = out["ratios"]["apex_gain_m"]
+    assert apex["n_ratio"] == 3  # simulated change 0.6 − 0.3 = 0.3; generated +0.15, +0.15, −0.1
+    assert apex["median_ratio"] == pytest.approx(0.5, abs=0.05)
+    assert out["ratios"]["flight_s"]["median_ratio"] > 0
+
+
+def test_wind_response_counts_downwind_drift() -> None:
+    earth = np.stack([walk(80, speed=1.0)] * 2)
+    winds = {}
+    for env in ((-9.81, 10.0, 0.0), (-9.81, 0.0, -10.0)):
+        moved = earth.copy()
+        moved[..., 0] += np.linspace(0, 0.05, 80)[None, :, None] * env[1] / 10  # downwind along w_x
+        moved[..., 2] -= np.linspace(0, 0.05, 80)[None, :, None] * env[2] / 10  # upwind along w_y
+        winds[env] = moved
+    out = wind_response(["u", "v"], earth, winds, _Physics(apex=0.0, drift=0.1), resamples=20)
+    assert out["n"] == 4 and out["downwind"] == 2
+    assert out["drift_per_10n_simulated_m"]["median"] == pytest.approx(0.1, abs=1e-4)
+    assert out["per_env"]["wx+10 wy+0"]["generated_m"]["median"] == pytest.approx(0.05, abs=1e-4)
+
+
+def test_script_reuses_parts_and_reports_bad_input(checked: dict, tmp_path: Path, monkeypatch, capsys) -> None:
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    try:
+        import model_check
+    finally:
+        sys.path.remove(str(REPO / "benchmarks"))
+    import simdiff.text.base
+
+    monkeypatch.setattr(simdiff.text.base, "load_text_encoder", lambda name, *a, **k: HashTextEncoder())
+    p = checked["paths"]
+    args = ["--model", str(p["adapters"]), "--corpus", str(p["corpus"]), "--evaluator", str(p["evaluator"]), "--quick",
+            "--steps", str(STEPS), "--length", str(LENGTH), "--jump-samples", "2", "--speed-samples", "2", "--no-response",
+            "--out", str(checked["root"] / "out"), "-q"]
+    assert model_check.main(args) == 0
+    report = json.loads((checked["root"] / "out" / "check.json").read_text())
+    assert report["test_split"].get("cached") and report["jumps"].get("cached")  # the fixture's parts, reused
+    assert report["response"] == {"skipped": "turned off (--no-response)"}
+    capsys.readouterr()
+    bad = ["--model", str(tmp_path / "nope"), *args[2:]]
+    assert model_check.main(bad) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nope" in err[0] and "model.safetensors" in err[0]
+
+
+def test_config_refuses_bad_values(checked: dict) -> None:
+    config = checked["config"]
+    with pytest.raises(SimdiffError, match="--seeds"):
+        CheckConfig(**{**config.__dict__, "seeds": [1, 1]}).validate()
+    with pytest.raises(SimdiffError, match="corpus"):
+        CheckConfig(**{**config.__dict__, "corpus": str(checked["root"])}).validate()
+
+
+def test_backbone_has_no_response_section(checked: dict, tmp_path: Path) -> None:
+    config = _config(checked["paths"], tmp_path / "out")
+    config.model = str(checked["paths"]["backbone"])
+    config.prompts.jump_samples = config.prompts.speed_samples = 1
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert report["model"]["kind"] == "backbone" and "Sim Encoder" in report["response"]["skipped"]
+    by = {v["check"]: v for v in report["verdicts"]}
+    assert by["gravity_rise"]["passed"] is None and by["wind_downwind"]["passed"] is None
+    assert by["sliding"]["passed"] is not None and "skipped" in report["generation_speed"]
