@@ -147,3 +147,31 @@ def test_bounds_are_the_issues() -> None:
     assert (cfg.plain_gravity_keep, cfg.flight_gravity_keep, cfg.wind_keep, cfg.earth_keep, cfg.confound_r) == (
         0.5, 0.25, 0.6, 0.66, 0.1)
     assert len(gravity_bins()) == len(GRAVITY_EDGES) - 1 and len(wind_bins()) == 2 * (len(WIND_EDGES) - 1)
+
+
+def test_cli_refinalises_with_auto_without_simulating_and_reads_the_manifest(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from simdiff.cli.main import main
+    from simdiff.data.humanml3d import read_split
+    from simdiff.eval.testing import write_tiny_corpus
+
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=2, n_test=1, frames=40)
+    clips = read_split(corpus / "train.txt")
+    (corpus / "manifest.json").write_text(json.dumps({"clips": [{"id": clips[0], "motion_type": "acrobatics"},
+                                                                {"id": clips[1], "motion_type": "walk"}]}))
+    out = tmp_path / "aug"
+    args = ["data", "augment", "--corpus", str(corpus), "--out", str(out), "--conditions", "1", "--backend", "serial",
+            "--no-progress"]
+    assert main(args + ["--max-pose-d-l2", "1e9", "--max-residual-n", "1e9"]) == 0
+    shards = {p.name: p.read_bytes() for p in (out / "shards").iterdir()}
+
+    def no_simulation(*a: object, **k: object) -> None:
+        raise AssertionError("re-finalising must not simulate")
+
+    monkeypatch.setattr("simdiff.sim.pool._run_one", no_simulation)
+    assert main(args + ["--max-pose-d-l2", "auto"]) == 0
+    assert {p.name: p.read_bytes() for p in (out / "shards").iterdir()} == shards
+    report = json.loads((out / "report.json").read_text())
+    assert report["filter"]["calibration"]["earth_keep_target"] == 0.66
+    assert report["by_class"]["all"]["clips"]["acrobatics"] == 1 and report["motion_types"] == "manifest"
+    assert "Issue 13 \"done when\"" in (out / "report.md").read_text()
