@@ -1,4 +1,6 @@
-"""The augmentation report: keep rates and rejections per condition bin, confound check, physics signal."""
+"""The augmentation report: keep rates and rejections per condition bin and per bin × content class
+(:mod:`simdiff.data.augment.classes`), issue 13's "done when" checklist
+(:mod:`simdiff.data.augment.checklist`), confound check, physics signal."""
 
 from __future__ import annotations
 
@@ -7,7 +9,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from simdiff.data.augment.checklist import checklist, checklist_markdown
-from simdiff.data.augment.classes import bin_key, class_markdown, class_view, clip_classes, close, count, earth_tracked, new_cell
+from simdiff.data.augment.classes import (bin_key, class_markdown, class_view, clip_classes, close, count,
+                                          earth_tracked, new_cell)
 from simdiff.data.augment.conditions import AugmentEnv
 from simdiff.data.augment.confound import confound_check
 from simdiff.data.augment.filter import REASONS, FilterConfig
