@@ -111,6 +111,8 @@ def test_checklist_passes_when_every_class_meets_its_bound() -> None:
     assert report["checklist"]["passes"] is True
     md = report_markdown(report)
     assert "Overall (all pairs): **PASS**" in md and "PASS 60.0 %" in md and "clips per class: plain 2, flight 1" in md
+    row = next(line for line in md.splitlines() if line.startswith("| confound"))
+    assert row.count(" | ") == 2 and "\\|r\\|" in row  # three cells: pipes in |r| are escaped
 
 
 def test_checklist_fails_with_the_measured_value_and_the_earth_tracked_view_separates_tracker_failures() -> None:

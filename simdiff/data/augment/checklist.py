@@ -172,6 +172,7 @@ def checklist_markdown(check: dict[str, Any], labels: dict[str, str]) -> list[st
     lines = [f"Overall (all pairs): **{verdict}**", "",
              "| criterion | " + " | ".join(labels[v] for v in views) + " |", "|---" * (len(views) + 1) + "|"]
     for item in check["items"]:
-        lines.append(f"| {item['criterion']} | " + " | ".join(_cell(item["views"][v]) for v in views) + " |")
+        cells = [item["criterion"]] + [_cell(item["views"][v]) for v in views]
+        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
     lines += ["", "Not evaluated from the run's records: " + "; ".join(check["not_evaluated"]) + ".", ""]
     return lines
