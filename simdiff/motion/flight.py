@@ -41,6 +41,8 @@ LIFT_EDGE: float = 0.01
 """m: a flight found with :data:`LIFT` extends to the frames where every foot joint is this far up."""
 MIN_FRAMES: int = 2
 """Shortest flight, in frames (0.1 s at 20 fps)."""
+MIN_FLIGHT_S: float = 0.2
+"""s: a clip whose longest flight lasts this long or longer has real flight (corpus report, augment report)."""
 
 
 def _check(joints: np.ndarray) -> np.ndarray:
@@ -77,6 +79,11 @@ def flights(joints: np.ndarray) -> list[tuple[int, int]]:
         if e - s >= MIN_FRAMES and s > 0 and (not out or s >= out[-1][1]):
             out.append((s, e))
     return out
+
+
+def has_flight(longest_flight_s: float) -> bool:
+    """True when a clip's longest flight (``flight_stats(...)["flight_s"]``, s) is real flight (≥ :data:`MIN_FLIGHT_S`)."""
+    return float(longest_flight_s) >= MIN_FLIGHT_S - 1e-9
 
 
 def airborne(joints: np.ndarray) -> np.ndarray:

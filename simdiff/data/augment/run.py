@@ -47,6 +47,7 @@ from typing import Any, Callable
 import numpy as np
 
 from simdiff.fsio import write_text
+from simdiff.data.augment.classes import load_motion_types
 from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
 from simdiff.data.augment.decide import decide
 from simdiff.data.augment.filter import AUTO, FilterConfig
@@ -441,7 +442,7 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
             folder.mkdir(exist_ok=True)
         else:
             folder.mkdir(parents=True)
-    report = build_report(records, conditions, config, summary)
+    report = build_report(records, conditions, config, summary, motion_types=load_motion_types(corpus))
     report["wall_s_this_run"] = round(wall_s, 3)
     write_json(out / "report.json", report)
     write_text(out / "report.md", report_markdown(report))

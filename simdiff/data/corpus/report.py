@@ -20,10 +20,7 @@ from simdiff.data.corpus.item import LICENCES
 from simdiff.data.report_blocks import (
     clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table, write_report_files,
 )
-from simdiff.motion.flight import GROUND_PERCENTILE, LIFT, LIFT_EDGE, MIN_FRAMES, flight_stats
-
-MIN_FLIGHT_S: float = 0.2
-"""A flight phase this long (s) or longer marks the clip as having real flight."""
+from simdiff.motion.flight import GROUND_PERCENTILE, LIFT, LIFT_EDGE, MIN_FLIGHT_S, MIN_FRAMES, flight_stats, has_flight
 SPLITS: tuple[str, ...] = ("train", "val", "test")
 METRICS: tuple[str, ...] = ("penetration", "floating", "sliding", "skate_ratio")
 
@@ -65,7 +62,7 @@ def _flight_section(originals: list[dict[str, Any]], flights: dict[str, dict[str
     for source, group in [("all", originals)] + list(group_by(originals, "source").items()):
         f = [flights[c["id"]] for c in group]
         rows.append([source, len(group), sum(x["flight_s"] for x in f) / 60,
-                     sum(1 for x in f if x["longest_flight_s"] >= MIN_FLIGHT_S - 1e-9),
+                     sum(1 for x in f if has_flight(x["longest_flight_s"])),
                      max((x["longest_flight_s"] for x in f), default=0.0)])
     md.append(table(["source", "clips", "flight time (min)", f"clips with a flight >= {MIN_FLIGHT_S} s",
                       "longest flight (s)"], rows))
