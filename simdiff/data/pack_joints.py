@@ -21,6 +21,8 @@ joints no longer have), measured at pack time by :func:`mirror_scale`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from simdiff.errors import SimdiffError
@@ -29,10 +31,10 @@ REL_STEP: float = 2.0**-14
 """Quantisation step (m) of the root-relative joint positions."""
 REL_LIMIT: float = 32767 * REL_STEP
 """Largest root-relative coordinate (m) the int16 code holds (~2 m)."""
-MIRROR_TOLERANCE: float = 0.1
-"""A clip ``M<id>`` is rebuilt from ``<id>`` only if every rebuilt feature (contacts aside,
-which are stored) is within this many standard deviations (``Std.npy``) of the corpus's;
-otherwise it is stored as its own clip."""
+TOLERANCE: float = 0.1
+"""A clip is stored as joints (a mirror as a root scale) only if every feature rebuilt at pack
+time (contacts aside, which are stored) is within this many standard deviations
+(``Std.npy``) of the corpus's; otherwise its features are stored as they are (float32)."""
 CONTACTS = slice(259, 263)
 
 
@@ -76,12 +78,6 @@ def delta_decode(deltas: np.ndarray) -> np.ndarray:
     return np.cumsum(deltas, axis=0, dtype=np.int16)
 
 
-def contact_bits(features_list: list[np.ndarray]) -> np.ndarray:
-    """Foot-contact channels of clips' (T, 263) features, concatenated, as packed bits (uint8)."""
-    rows = np.concatenate([np.asarray(f[:, CONTACTS]) > 0.5 for f in features_list]) if features_list else np.zeros((0, 4), bool)
-    return np.packbits(rows.reshape(-1))
-
-
 def unpack_contacts(bits: np.ndarray, offset: int, rows: int) -> np.ndarray:
     """(rows, 4) float32 0/1 contacts of the clip whose first contact row is ``offset``."""
     flat = np.unpackbits(bits, count=(offset + rows) * 4)[offset * 4:]
@@ -113,6 +109,26 @@ def rebuild_mirror(joints: np.ndarray, scale: float) -> np.ndarray:
     return rebuild_features(_mirrored_retarget(joints, scale))
 
 
+def rebuild_error(rebuilt: np.ndarray, features: np.ndarray, std: np.ndarray) -> float:
+    """Largest |rebuilt - features| / std over every channel but the contacts (inf if not finite)."""
+    diff = np.abs(np.asarray(rebuilt, dtype=np.float64) - features) / np.asarray(std, dtype=np.float64)
+    diff[:, CONTACTS] = 0.0
+    error = float(diff.max(initial=0.0))
+    return error if np.isfinite(error) else float("inf")
+
+
+def checked(rebuild: Callable[[], np.ndarray], features: np.ndarray, std: np.ndarray) -> float:
+    """:func:`rebuild_error` of ``rebuild()``; inf when it fails (degenerate IK on a frame)."""
+    try:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rebuilt = rebuild()
+    except SimdiffError:
+        return float("inf")
+    if rebuilt.shape != features.shape:
+        return float("inf")
+    return rebuild_error(rebuilt, features, std)
+
+
 def mirror_scale(joints: np.ndarray, mirror_features: np.ndarray, std: np.ndarray) -> tuple[float, float]:
     """Root scale that turns the mirror of ``joints`` into the clip of ``mirror_features``.
 
@@ -131,6 +147,4 @@ def mirror_scale(joints: np.ndarray, mirror_features: np.ndarray, std: np.ndarra
     scale = float(a @ b / (a @ a)) if a @ a > 1e-12 else 1.0
     if not np.isfinite(scale) or not 0.5 < scale < 2.0:
         return 1.0, float("inf")
-    diff = np.abs(rebuild_mirror(joints, scale) - mirror_features) / np.asarray(std, dtype=np.float64)
-    diff[:, CONTACTS] = 0.0
-    return scale, float(diff.max())
+    return scale, checked(lambda: rebuild_mirror(joints, scale), mirror_features, std)

@@ -3,12 +3,15 @@ mirrors and features rebuilt on unpack (codec: :mod:`simdiff.data.pack_joints`).
 
 A pack folder holds::
 
-    pack.json              format, version 2, content "joints", counts, rel_step, sha256 of the index
+    pack.json              format, version 2, content "joints", counts, rel_step, the largest
+                           rebuild error measured at pack time, sha256 of the index
     index.json.xz          clips [[id, joint offset, joint frames, contact offset]],
                            mirrors [[id, parent id, root scale, contact offset]],
+                           raw [[id, row offset, rows]],
                            texts {id: caption file}, splits {name: [ids]},
                            files {name: text} (env.json, conditions.json, manifest.json)
-    arrays/joints.npz      root (N, 3) float32 m; rel (N, 21, 3) int16 delta codes; contacts (bits)
+    arrays/joints.npz      root (N, 3) float32 m; rel (N, 21, 3) int16 delta codes; contacts (bits);
+                           raw (R, 263) float32 features of the few clips that do not rebuild
     arrays/Mean.npy, arrays/Std.npy   (263,) float32, copied exactly
 
 Unpacking writes the HumanML3D layout (features (T, 263), joints (T, 22, 3) from the
@@ -57,17 +60,30 @@ def _load_features(corpus: Path, clip: str) -> np.ndarray:
 
 
 def _encode(task: Task) -> dict[str, Any]:
-    """Worker: one clip (and its mirror candidate) → codes, contacts, mirror scale."""
+    """Worker: one clip (and its mirror candidate) → codes, contacts, mirror scale, each checked
+    by rebuilding its features; a clip that does not rebuild within tolerance keeps its features."""
     corpus, clip, mirror = Path(task[0]), task[1], task[2]
+    std = np.load(corpus / "Std.npy").astype(np.float64)
     features = _load_features(corpus, clip)
-    joints = codec.canonical_joints(features)
-    root, rel = codec.quantize(joints, clip)
-    out: dict[str, Any] = {"clip": clip, "root": root, "rel": rel, "contacts": features[:, codec.CONTACTS] > 0.5}
+    out: dict[str, Any] = {"clip": clip, "contacts": features[:, codec.CONTACTS] > 0.5}
+    try:
+        root, rel = codec.quantize(codec.canonical_joints(features), clip)
+    except SimdiffError:
+        root = rel = None
+    joints = None if root is None else codec.dequantize(root, rel)
+    error = float("inf") if joints is None else codec.checked(lambda: codec.rebuild_features(joints), features, std)
+    if error <= codec.TOLERANCE:
+        out.update(root=root, rel=rel, error=error)
+    else:
+        out.update(raw=features, error=error)
     if mirror is not None:
         mfeat = _load_features(corpus, mirror)
-        std = np.load(corpus / "Std.npy").astype(np.float64)
-        scale, error = codec.mirror_scale(codec.dequantize(root, rel), mfeat, std)
-        out["mirror"] = {"id": mirror, "scale": scale, "error": error, "contacts": mfeat[:, codec.CONTACTS] > 0.5}
+        m: dict[str, Any] = {"id": mirror, "contacts": mfeat[:, codec.CONTACTS] > 0.5, "scale": 1.0, "error": float("inf")}
+        if "raw" not in out:
+            m["scale"], m["error"] = codec.mirror_scale(joints, mfeat, std)
+        if not m["error"] <= codec.TOLERANCE:
+            m["raw"] = mfeat
+        out["mirror"] = m
     return out
 
 
@@ -95,43 +111,48 @@ def pack_joints_corpus(corpus: Path, out: Path, ids: list[str], splits: dict[str
                        workers: int = 1, progress: bool = False) -> dict[str, Any]:
     """Write a version-2 pack of ``ids`` of ``corpus`` into ``out`` (see module doc).
 
-    A clip ``M<x>`` with ``<x>`` in ``ids`` is stored as a mirror when its rebuilt joints are
-    within :data:`~simdiff.data.pack_joints.MIRROR_TOLERANCE` of the corpus's; otherwise as
-    its own clip. Returns ``{clips, mirrors, frames, bytes, content}``.
+    Every clip's features are rebuilt here and compared with the corpus's: a clip ``M<x>``
+    with ``<x>`` in ``ids`` is stored as a root scale (mirror of ``<x>``), any other as joints,
+    when within :data:`~simdiff.data.pack_joints.TOLERANCE`; otherwise its features are stored
+    as they are ("raw", float32). Returns ``{clips, mirrors, raw, frames, bytes, content,
+    max_rebuild_error}``.
     """
     id_set = set(ids)
     candidates = {c: f"M{c}" for c in ids if f"M{c}" in id_set}
     tasks = [(str(corpus), c, candidates.get(c)) for c in ids if not (c.startswith("M") and c[1:] in candidates)]
     encoded = list(_progress(_pool_map(_encode, tasks, workers), len(tasks), "pack", progress))
-    fallback = [e["mirror"]["id"] for e in encoded
-                if "mirror" in e and not e["mirror"]["error"] <= codec.MIRROR_TOLERANCE]
-    if fallback:
-        encoded += list(_pool_map(_encode, [(str(corpus), m, None) for m in fallback], workers))
-    clips, mirrors, roots, rels, contacts = [], [], [], [], []
-    offset = contact_offset = 0
+    retry = [e["mirror"]["id"] for e in encoded if "raw" in e.get("mirror", {})]  # not a mirror: its own clip
+    encoded = [{k: v for k, v in e.items() if not (k == "mirror" and "raw" in v)} for e in encoded]
+    encoded += list(_pool_map(_encode, [(str(corpus), m, None) for m in retry], workers))
+    clips, mirrors, raw_index, roots, rels, contacts, raws = [], [], [], [], [], [], []
+    offset = contact_offset = raw_offset = 0
+    errors = {"originals": 0.0, "mirrors": 0.0}
     for e in encoded:
-        rows = len(e["contacts"])
-        clips.append([e["clip"], offset, len(e["root"]), contact_offset])
-        roots.append(e["root"])
-        rels.append(e["rel"])
-        contacts.append(e["contacts"])
-        offset += len(e["root"])
-        contact_offset += rows
-    for e in encoded:
-        m = e.get("mirror")
-        if m is not None and m["error"] <= codec.MIRROR_TOLERANCE:
-            mirrors.append([m["id"], e["clip"], m["scale"], contact_offset])
-            contacts.append(m["contacts"])
-            contact_offset += len(m["contacts"])
-    mirror_error = max((e["mirror"]["error"] for e in encoded if "mirror" in e and e["mirror"]["id"] not in fallback),
-                       default=0.0)
+        for item, parent in [(e, None)] + ([(e["mirror"], e["clip"])] if "mirror" in e else []):
+            cid = item.get("clip", item.get("id"))
+            if "raw" in item:
+                raw_index.append([cid, raw_offset, len(item["raw"])])
+                raws.append(item["raw"])
+                raw_offset += len(item["raw"])
+                continue
+            kind = "originals" if parent is None else "mirrors"
+            errors[kind] = max(errors[kind], item["error"])
+            if parent is None:
+                clips.append([cid, offset, len(item["root"]), contact_offset])
+                roots.append(item["root"])
+                rels.append(item["rel"])
+                offset += len(item["root"])
+            else:
+                mirrors.append([cid, parent, item["scale"], contact_offset])
+            contacts.append(item["contacts"])
+            contact_offset += len(item["contacts"])
     texts = {}
     for clip in ids:
         path = corpus / "texts" / f"{clip}.txt"
         if path.is_file():
             texts[clip] = path.read_text(encoding="utf-8")
     side = {name: (corpus / name).read_text(encoding="utf-8") for name in SIDE_FILES if (corpus / name).is_file()}
-    index = {"clips": clips, "mirrors": mirrors, "texts": texts, "splits": splits, "files": side}
+    index = {"clips": clips, "mirrors": mirrors, "raw": raw_index, "texts": texts, "splits": splits, "files": side}
     blob = lzma.compress(json.dumps(index, separators=(",", ":"), ensure_ascii=False).encode("utf-8"), preset=9)
     frames = sum(c[2] for c in clips)
     tmp = out.with_name(f".{out.name}.tmp{os.getpid()}")
@@ -142,13 +163,15 @@ def pack_joints_corpus(corpus: Path, out: Path, ids: list[str], splits: dict[str
         bits = np.packbits(np.concatenate(contacts).reshape(-1)) if contacts else np.zeros(0, np.uint8)
         with open(tmp / "arrays" / ARRAYS_NAME, "wb") as handle:
             np.savez_compressed(handle, root=np.concatenate(roots) if roots else np.zeros((0, 3), np.float32),
-                                rel=codec.delta_encode(rel), contacts=bits)
+                                rel=codec.delta_encode(rel), contacts=bits,
+                                raw=np.concatenate(raws) if raws else np.zeros((0, 263), np.float32))
         for name in ("Mean.npy", "Std.npy"):
             save_npy(tmp / "arrays" / name, np.load(corpus / name).astype(np.float32))
         write_bytes(tmp / INDEX_NAME, blob)
         write_json(tmp / "pack.json", {"format": PACK_FORMAT, "version": VERSION, "content": "joints",
                                        "rel_step": codec.REL_STEP, "clips": len(clips), "mirrors": len(mirrors),
-                                       "joint_frames": frames, "mirror_max_error": mirror_error,
+                                       "raw": len(raw_index), "joint_frames": frames,
+                                       "max_rebuild_error": errors, "tolerance": codec.TOLERANCE,
                                        "index_sha256": hashlib.sha256(blob).hexdigest()})
         from simdiff.data.pack import folder_size
 
@@ -160,8 +183,9 @@ def pack_joints_corpus(corpus: Path, out: Path, ids: list[str], splits: dict[str
         os.replace(tmp, out)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    return {"clips": len(clips) + len(mirrors), "mirrors": len(mirrors), "frames": frames, "bytes": size,
-            "content": "joints", "dtype": "int16+float32"}
+    return {"clips": len(clips) + len(mirrors) + len(raw_index), "mirrors": len(mirrors), "raw": len(raw_index),
+            "frames": frames, "bytes": size, "content": "joints", "dtype": "int16+float32",
+            "max_rebuild_error": errors}
 
 
 def read_index(path: Path) -> dict[str, Any]:
@@ -200,7 +224,7 @@ def unpack_joints(path: Path, out: Path, workers: int = 1, progress: bool = Fals
     arrays_path = path / "arrays" / ARRAYS_NAME
     try:
         with np.load(arrays_path, allow_pickle=False) as data:
-            root, rel, bits = data["root"], codec.delta_decode(data["rel"]), data["contacts"]
+            root, rel, bits, raw = data["root"], codec.delta_decode(data["rel"]), data["contacts"], data["raw"]
     except (OSError, KeyError, ValueError) as exc:
         raise SimdiffError(f"{arrays_path}: cannot read pack arrays ({type(exc).__name__})") from None
     last = max((o + n for _, o, n, _ in index["clips"]), default=0)
@@ -221,6 +245,13 @@ def unpack_joints(path: Path, out: Path, workers: int = 1, progress: bool = Fals
             tasks.append((str(tmp), clip, joints, codec.unpack_contacts(bits, coff, rows),
                           [(mid, s, codec.unpack_contacts(bits, mc, rows)) for mid, s, mc in mirrors_of.get(clip, [])]))
         done = sum(len(ids) for ids in _progress(_pool_map(_rebuild, tasks, workers), len(tasks), "unpack", progress))
+        from simdiff.motion.features import features_to_joints
+
+        for clip, offset, rows in index.get("raw", []):
+            features = np.asarray(raw[offset: offset + rows], dtype=np.float32)
+            np.save(tmp / "new_joint_vecs" / f"{clip}.npy", features)
+            np.save(tmp / "new_joints" / f"{clip}.npy", np.asarray(features_to_joints(features), dtype=np.float32))
+            done += 1
         for clip, text in index["texts"].items():
             (tmp / "texts" / f"{clip}.txt").write_text(text, encoding="utf-8")
         for name in ("Mean.npy", "Std.npy"):

@@ -38,6 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     k.add_argument("--dtype", choices=["float16", "float32"], default="float16",
                    help="feature dtype of --content features (float32: exact)")
     k.add_argument("--workers", type=int, default=1, help="processes encoding clips (0: all cores)")
+    k.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     k.add_argument("--splits", nargs="+", help="pack only these split files' clips (default all)")
     k.add_argument("--budget-mib", type=float, default=64.0, help="refuse a pack larger than this (0: no check)")
     k.set_defaults(func=run_pack)
@@ -99,7 +100,7 @@ def run_pack(args: argparse.Namespace) -> int:
 
     workers = args.workers if args.workers > 0 else (os.cpu_count() or 1)
     info = pack(args.corpus, args.out, dtype=args.dtype, budget_mib=args.budget_mib, splits=args.splits,
-                content=args.content, workers=workers, progress=True)
+                content=args.content, workers=workers, progress=not args.no_progress)
     print(f"packed {info['clips']} clips ({info.get('mirrors', 0)} as mirrors), {info['frames']} frames "
           f"({info['dtype']}): "
           f"{info['bytes'] / 2**20:.2f} MiB in {args.out}")
