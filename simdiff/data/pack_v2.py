@@ -224,7 +224,8 @@ def unpack_joints(path: Path, out: Path, workers: int = 1, progress: bool = Fals
     arrays_path = path / "arrays" / ARRAYS_NAME
     try:
         with np.load(arrays_path, allow_pickle=False) as data:
-            root, rel, bits, raw = data["root"], codec.delta_decode(data["rel"]), data["contacts"], data["raw"]
+            root, rel, bits = data["root"], codec.delta_decode(data["rel"]), data["contacts"]
+            raw = data["raw"] if "raw" in data.files else np.zeros((0, 263), np.float32)
     except (OSError, KeyError, ValueError) as exc:
         raise SimdiffError(f"{arrays_path}: cannot read pack arrays ({type(exc).__name__})") from None
     last = max((o + n for _, o, n, _ in index["clips"]), default=0)
