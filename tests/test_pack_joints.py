@@ -8,6 +8,8 @@ left/right-unequal bone lengths, so the mirrors' root scale differs from 1.
 from __future__ import annotations
 
 import json
+import lzma
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +50,8 @@ def write_builder_corpus(root: Path) -> Path:
     records = []
     for i, (motion, text) in enumerate(zip(motions, captions)):
         base = {"trial": f"t:{i}", "source": "synthetic", "licence": "MIT"}
-        recs, pending = clip_variants(base, f"s{i:02d}_00", _odd_body(motion), [text, text + " again"], True, caption_line)
+        lines = [text, text + " again"]
+        recs, pending = clip_variants(base, f"s{i:02d}_00", _odd_body(motion), lines, True, caption_line)
         records += recs
         for cid, features, recovered, lines in pending:
             write_clip(root, cid, features, recovered, lines)
@@ -75,7 +78,8 @@ def test_joints_pack_round_trip_rebuilds_features_and_mirrors(built, tmp_path) -
     assert unpack(tmp_path / "pack", tmp_path / "back", workers=2) == 12
     back = tmp_path / "back"
     std = np.load(built / "Std.npy")
-    scales = [m[2] for m in json.loads(__import__("lzma").decompress((tmp_path / "pack" / "index.json.xz").read_bytes()))["mirrors"]]
+    index = json.loads(lzma.decompress((tmp_path / "pack" / "index.json.xz").read_bytes()))
+    scales = [m[2] for m in index["mirrors"]]
     assert max(abs(s - 1.0) for s in scales) > 0.01  # the odd body makes the mirrors' root scale matter
     for path in sorted((built / "new_joint_vecs").glob("*.npy")):
         clip = path.stem
@@ -108,8 +112,6 @@ def test_mirror_root_scale_is_needed(built) -> None:
 
 def test_clip_named_like_a_mirror_but_not_one_is_kept_whole(built, tmp_path) -> None:
     odd = tmp_path / "odd"
-    import shutil
-
     shutil.copytree(built, odd)
     for sub in ("new_joint_vecs", "new_joints"):  # M s00 now holds another motion
         shutil.copyfile(odd / sub / "s03_00.npy", odd / sub / "Ms00_00.npy")

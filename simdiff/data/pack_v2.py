@@ -78,7 +78,8 @@ def _encode(task: Task) -> dict[str, Any]:
         out.update(raw=features, error=error)
     if mirror is not None:
         mfeat = _load_features(corpus, mirror)
-        m: dict[str, Any] = {"id": mirror, "contacts": mfeat[:, codec.CONTACTS] > 0.5, "scale": 1.0, "error": float("inf")}
+        m: dict[str, Any] = {"id": mirror, "contacts": mfeat[:, codec.CONTACTS] > 0.5, "scale": 1.0,
+                             "error": float("inf")}
         if "raw" not in out:
             m["scale"], m["error"] = codec.mirror_scale(joints, mfeat, std)
         if not m["error"] <= codec.TOLERANCE:
