@@ -1,8 +1,8 @@
 """A corpus as a few compact arrays (``simdiff train pack``), and back to the HumanML3D layout.
 
 Two contents: ``joints`` (version 2, the default; :mod:`simdiff.data.pack_v2`: the original
-clips' joints, features and mirrors rebuilt on unpack, ~5x smaller) and ``features``
-(version 1, below). :func:`unpack` reads both.
+clips' joints, features and mirrors rebuilt on unpack; 10x smaller than float16 features on the
+all-source corpus) and ``features`` (version 1, below). :func:`unpack` reads both.
 
 A version-1 pack folder holds::
 
