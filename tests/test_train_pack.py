@@ -41,7 +41,8 @@ def _clips(folder: Path) -> dict[str, np.ndarray]:
 
 @pytest.mark.parametrize("dtype", ["float32", "float16"])
 def test_pack_unpack_round_trip(corpus, tmp_path, dtype) -> None:
-    info = pack(corpus, tmp_path / "pack", dtype=dtype)
+    """Version-1 (features) packs; version 2 (joints) is tests/test_pack_joints.py."""
+    info = pack(corpus, tmp_path / "pack", dtype=dtype, content="features")
     assert info["clips"] == 16 and info["bytes"] < 2**20
     n = unpack(tmp_path / "pack", tmp_path / "back")
     assert n == 16

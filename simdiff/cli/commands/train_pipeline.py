@@ -32,7 +32,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     k = group.add_parser("pack", help="write a corpus as compact arrays (for carrying to a GPU machine)")
     k.add_argument("corpus", type=Path, help="HumanML3D-layout corpus folder")
     k.add_argument("--out", type=Path, required=True, help="pack folder")
-    k.add_argument("--dtype", choices=["float16", "float32"], default="float16", help="feature dtype (float32: exact)")
+    k.add_argument("--content", choices=["joints", "features"], default="joints",
+                   help="joints (v2, default): original clips' joints, features and mirrors rebuilt on unpack; "
+                        "features (v1): every clip's features as --dtype")
+    k.add_argument("--dtype", choices=["float16", "float32"], default="float16",
+                   help="feature dtype of --content features (float32: exact)")
+    k.add_argument("--workers", type=int, default=1, help="processes encoding clips (0: all cores)")
+    k.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     k.add_argument("--splits", nargs="+", help="pack only these split files' clips (default all)")
     k.add_argument("--budget-mib", type=float, default=64.0, help="refuse a pack larger than this (0: no check)")
     k.set_defaults(func=run_pack)
@@ -40,6 +46,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     u = group.add_parser("unpack", help="restore a pack as a HumanML3D-layout corpus folder")
     u.add_argument("pack", type=Path, help="pack folder")
     u.add_argument("--out", type=Path, required=True, help="corpus folder to write")
+    u.add_argument("--workers", type=int, default=0, help="processes rebuilding features (0: all cores)")
+    u.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     u.set_defaults(func=run_unpack)
 
 
@@ -86,17 +94,25 @@ def run_pipeline_cmd(args: argparse.Namespace) -> int:
 
 
 def run_pack(args: argparse.Namespace) -> int:
+    import os
+
     from simdiff.data.pack import pack
 
-    info = pack(args.corpus, args.out, dtype=args.dtype, budget_mib=args.budget_mib, splits=args.splits)
-    print(f"packed {info['clips']} clips, {info['frames']} frames ({info['dtype']}): "
+    workers = args.workers if args.workers > 0 else (os.cpu_count() or 1)
+    info = pack(args.corpus, args.out, dtype=args.dtype, budget_mib=args.budget_mib, splits=args.splits,
+                content=args.content, workers=workers, progress=not args.no_progress)
+    print(f"packed {info['clips']} clips ({info.get('mirrors', 0)} as mirrors), {info['frames']} frames "
+          f"({info['dtype']}): "
           f"{info['bytes'] / 2**20:.2f} MiB in {args.out}")
     return 0
 
 
 def run_unpack(args: argparse.Namespace) -> int:
+    import os
+
     from simdiff.data.pack import unpack
 
-    n = unpack(args.pack, args.out)
+    workers = args.workers if args.workers > 0 else (os.cpu_count() or 1)
+    n = unpack(args.pack, args.out, workers=workers, progress=not args.no_progress)
     print(f"unpacked {n} clips into {args.out}")
     return 0
