@@ -143,7 +143,7 @@ def _quick() -> PipelineConfig:
 
 
 def _cpu() -> PipelineConfig:
-    # The backbone is the design small_geo_crop, ahead of the 10 fps design at 24 training CPU-minutes each on
+    # The backbone is the design small_geo_crop, ahead of the 10 fps design at 40 training CPU-minutes each on
     # corpus3 (benchmarks/train_curves.py; reports/training/README.md, "All-source corpus").
     geo = GeometricLossConfig(position=0.0, velocity=1.0, foot_contact=1.0)
     return PipelineConfig(
