@@ -165,6 +165,20 @@ def read_pack(path: str | Path) -> tuple[dict[str, Any], np.ndarray]:
     return index, features
 
 
+def finish_unpack(path: Path, index: dict[str, Any], tmp: Path, out: Path) -> None:
+    """Write a pack's Mean/Std, split files and side files into ``tmp``, then let ``tmp`` replace ``out``."""
+    for name in ("Mean.npy", "Std.npy"):
+        shutil.copyfile(path / "arrays" / name, tmp / name)
+    for name, members in index["splits"].items():
+        (tmp / f"{name}.txt").write_text("".join(f"{m}\n" for m in members), encoding="utf-8")
+    for name, text in index.get("files", {}).items():
+        (tmp / name).write_text(text, encoding="utf-8")
+    ensure_dir(out.parent)
+    if out.exists():
+        shutil.rmtree(out)
+    os.replace(tmp, out)
+
+
 def unpack(path: str | Path, out: str | Path, workers: int = 1, progress: bool = False) -> int:
     """Write pack ``path`` (version 1 or 2) as a HumanML3D-layout folder ``out`` (replaced as a
     whole); returns the clip count. ``workers``: processes rebuilding a version-2 pack's features."""
@@ -187,16 +201,7 @@ def unpack(path: str | Path, out: str | Path, workers: int = 1, progress: bool =
             np.save(tmp / "new_joints" / f"{clip}.npy", np.asarray(features_to_joints(f), dtype=np.float32))
             if clip in index["texts"]:
                 (tmp / "texts" / f"{clip}.txt").write_text(index["texts"][clip], encoding="utf-8")
-        for name in ("Mean.npy", "Std.npy"):
-            shutil.copyfile(path / "arrays" / name, tmp / name)
-        for name, members in index["splits"].items():
-            (tmp / f"{name}.txt").write_text("".join(f"{m}\n" for m in members), encoding="utf-8")
-        for name, text in index.get("files", {}).items():
-            (tmp / name).write_text(text, encoding="utf-8")
-        ensure_dir(out.parent)
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
+        finish_unpack(path, index, tmp, out)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return len(index["clips"])

@@ -256,16 +256,9 @@ def unpack_joints(path: Path, out: Path, workers: int = 1, progress: bool = Fals
             done += 1
         for clip, text in index["texts"].items():
             (tmp / "texts" / f"{clip}.txt").write_text(text, encoding="utf-8")
-        for name in ("Mean.npy", "Std.npy"):
-            shutil.copyfile(path / "arrays" / name, tmp / name)
-        for name, members in index["splits"].items():
-            (tmp / f"{name}.txt").write_text("".join(f"{m}\n" for m in members), encoding="utf-8")
-        for name, text in index.get("files", {}).items():
-            (tmp / name).write_text(text, encoding="utf-8")
-        ensure_dir(out.parent)
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
+        from simdiff.data.pack import finish_unpack
+
+        finish_unpack(path, index, tmp, out)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return done

@@ -45,7 +45,8 @@ MIN_FLIGHT_S: float = 0.2
 """s: a clip whose longest flight lasts this long or longer has real flight (corpus report, augment report)."""
 
 
-def _check(joints: np.ndarray) -> np.ndarray:
+def check_joints(joints: np.ndarray) -> np.ndarray:
+    """``joints`` as float64 (T, 22, 3), T ≥ 2; a one-line :class:`SimdiffError` otherwise."""
     j = np.asarray(joints, dtype=np.float64)
     if j.ndim != 3 or j.shape[1:] != (22, 3) or j.shape[0] < 2:
         raise SimdiffError(f"expected joints of shape (T>=2, 22, 3), got {j.shape}")
@@ -61,7 +62,7 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 def feet_up(joints: np.ndarray, lift: float = LIFT) -> np.ndarray:
     """(T, 4) bool: each foot joint of :data:`FEET` more than ``lift`` m above its own ground level."""
-    h = _check(joints)[:, FEET, 1]
+    h = check_joints(joints)[:, FEET, 1]
     return h > np.percentile(h, GROUND_PERCENTILE, axis=0) + lift
 
 
@@ -88,7 +89,7 @@ def has_flight(longest_flight_s: float) -> bool:
 
 def airborne(joints: np.ndarray) -> np.ndarray:
     """(T,) bool: the frames inside a flight of :func:`flights`."""
-    mask = np.zeros(_check(joints).shape[0], dtype=bool)
+    mask = np.zeros(check_joints(joints).shape[0], dtype=bool)
     for s, e in flights(joints):
         mask[s:e] = True
     return mask
@@ -104,7 +105,7 @@ def flight_stats(joints: np.ndarray, fps: float = FPS) -> dict[str, float]:
     Raises:
         SimdiffError: not (T, 22, 3) with T ≥ 2.
     """
-    j = _check(joints)
+    j = check_joints(joints)
     found = flights(j)
     out = {"flights": float(len(found)), "flight_s": 0.0,
            "flight_total_s": float(sum(e - s for s, e in found) / fps), "apex_gain_m": 0.0}

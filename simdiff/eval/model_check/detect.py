@@ -19,20 +19,12 @@ import numpy as np
 from scipy import stats as sps
 
 from simdiff.errors import SimdiffError
-from simdiff.motion.flight import airborne, flights
+from simdiff.motion.flight import MIN_FLIGHT_S, airborne, flights
+from simdiff.motion.flight import check_joints as _joints
 from simdiff.motion.skeleton import FPS
 
-MIN_FLIGHT_S: float = 0.2
-"""Shortest flight that counts for a jump (s)."""
 MIN_RISE_M: float = 0.15
 """Least pelvis rise above the standing level during that flight (m)."""
-
-
-def _joints(joints: np.ndarray) -> np.ndarray:
-    j = np.asarray(joints, dtype=np.float64)
-    if j.ndim != 3 or j.shape[1:] != (22, 3) or j.shape[0] < 2:
-        raise SimdiffError(f"expected joints of shape (T>=2, 22, 3), got {j.shape}")
-    return j
 
 
 def standing_level(joints: np.ndarray) -> float:
