@@ -42,16 +42,17 @@ STRATA: dict[str, tuple[str, tuple[str, ...]]] = {
     "cmu_amc": ("cmu-amc", ("walk", "exercise", "dance", "other", "sports")),
     "aclstm": ("cmu-aclstm", ("dance", "sports")),
 }
-VARIANTS = ("earth", "gains_limits", "limits", "balance", "actuators_balance", "all")
+VARIANTS = ("earth", "gains_limits", "limits", "balance", "actuators_balance", "v2", "all")
 
 
 def strength_of(variant: str):
     from simdiff.sim.strength import NO_SCALING, StrengthConfig
 
-    return {"earth": NO_SCALING, "gains_limits": StrengthConfig(balance=False, residual_torque=False),
-            "limits": StrengthConfig(gains=False, balance=False, residual_torque=False),
-            "balance": StrengthConfig(gains=False, limits=False, residual_torque=False),
-            "actuators_balance": StrengthConfig(residual_torque=False), "all": StrengthConfig()}[variant]
+    return {"earth": NO_SCALING, "gains_limits": StrengthConfig(balance=False, residual_torque=False, residual_gains=False),
+            "limits": StrengthConfig(gains=False, balance=False, residual_torque=False, residual_gains=False),
+            "balance": StrengthConfig(gains=False, limits=False, residual_torque=False, residual_gains=False),
+            "actuators_balance": StrengthConfig(residual_torque=False, residual_gains=False),
+            "v2": StrengthConfig(residual_gains=False), "all": StrengthConfig()}[variant]
 
 
 def pick_clips(corpus: Path, shards: Path, per_stratum: int) -> dict[str, list[str]]:

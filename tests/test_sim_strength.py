@@ -54,7 +54,19 @@ def test_scale_residual_scales_the_torque_bound_only() -> None:
     assert scale_residual(cfg, 1.0) is cfg
     r2 = scale_residual(cfg, 2.0)
     assert r2.torque_bound == 2 * cfg.torque_bound == 600.0 and r2.max_force == cfg.max_force
+    assert (r2.kp_rot, r2.kd_rot) == (cfg.kp_rot, cfg.kd_rot)
     assert scale_residual(ResidualConfig(max_torque=100.0), 1.5).torque_bound == 150.0
+
+
+def test_scale_residual_gains_stiffen_by_s_and_damp_by_sqrt_s() -> None:
+    cfg = ResidualConfig(max_force=0.5)
+    assert scale_residual(cfg, 1.0, gains=True) is cfg
+    assert scale_residual(cfg, 4.0, torque=False, gains=False) is cfg
+    r4 = scale_residual(cfg, 4.0, torque=False, gains=True)
+    assert (r4.kp_rot, r4.kd_rot) == (4 * cfg.kp_rot, 2 * cfg.kd_rot)
+    assert (r4.torque_bound, r4.max_force, r4.kv_xy, r4.kp_z) == (cfg.torque_bound, cfg.max_force, cfg.kv_xy, cfg.kp_z)
+    both = scale_residual(cfg, 4.0, gains=True)
+    assert both.torque_bound == 4 * cfg.torque_bound and both.kp_rot == 4 * cfg.kp_rot
 
 
 @pytest.mark.parametrize("env", [Environment(), Environment(-3.0), Environment(-9.81, 6.0, -4.0)])

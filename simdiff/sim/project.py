@@ -24,12 +24,13 @@ from simdiff.sim.rollout import FallConfig, RolloutResult, rollout
 from simdiff.sim.strength import StrengthConfig
 from simdiff.sim.tracker import Tracker
 
-SIM_VERSION: int = 2
+SIM_VERSION: int = 3
 """Version of the physics behind :func:`project` with its defaults, recorded with augmented pairs.
 
 1: Earth strength at every gravity. 2 (issue 13): actuators, the tracker's balance layer and
 the residual's torque bound scale with max(1, |g_z|/9.81) (:mod:`simdiff.sim.strength`);
-identical to 1 at |g_z| ≤ 9.81. A record without a version is version 1."""
+identical to 1 at |g_z| ≤ 9.81. 3: also the residual's pelvis-orientation gains (kp_rot × s,
+kd_rot × √s); identical to 2 at |g_z| ≤ 9.81. A record without a version is version 1."""
 
 
 @dataclass

@@ -191,8 +191,8 @@ def rollout(
     m = copy.copy(model)
     apply_strength(m, env.gravity, strength)
     s = strength.factor(env.gravity) if strength is not None else 1.0
-    if strength is not None and strength.residual_torque:
-        residual = scale_residual(residual, s)
+    if strength is not None:
+        residual = scale_residual(residual, s, torque=strength.residual_torque, gains=strength.residual_gains)
     ix: ModelIndex = model_index(m)
     env.apply(m, ix.mass)
     d = mujoco.MjData(m)
