@@ -65,6 +65,8 @@ def test_quick_pipeline_runs_skips_and_reruns_downstream(corpus, tmp_path) -> No
     assert provenance["trained_on"][0]["licences"] == {"CC-BY-NC-4.0": 0.0007, "CMU": 0.0047}  # 1 and 7 clips of 2.4 s
     assert "Weights licence: **non-commercial" in (export / "model" / "README.md").read_text()
     assert (export / "sharded" / "provenance.json").is_file()
+    evaluator = json.loads((out / "evaluator" / "provenance.json").read_text())
+    assert [p["what"] for p in evaluator["trained_on"]] == ["evaluator"] and "non-commercial" in evaluator["weights_licence"]
     mtime = (out / "backbone" / "model" / "model.safetensors").stat().st_mtime_ns
 
     again, lines = _run(config, out)
