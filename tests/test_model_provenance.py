@@ -163,3 +163,20 @@ def test_shipped_default_model_states_its_licence() -> None:
 
     pyproject = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())
     assert "assets/**/*.json" in pyproject["tool"]["setuptools"]["package-data"]["simdiff"]
+
+
+def test_cli_adapters_resumed_without_init_keep_the_backbone_entries(tmp_path: Path) -> None:
+    import argparse
+
+    from simdiff.cli.commands.train import _provenance
+
+    corpus = write_manifest(tmp_path / "corpus", [clip("a_0", "CMU", 36.0)])
+    aug = write_augmented(tmp_path / "aug", ["a_0"], corpus)
+    args = argparse.Namespace(mode="adapters", data=[aug], split="train", source=None, synthetic=None, init=None,
+                              out=tmp_path / "run")
+    assert _provenance(args).trained_on[0].note == "licence unknown: resumed without --init"
+    earlier = Provenance([part("MIT", data="cmu_corpus"), part("CMU", data="old_aug", what="adapters")])
+    write_provenance(tmp_path / "run" / "model", earlier)
+    resumed = _provenance(args)
+    assert [(p.what, p.data) for p in resumed.trained_on] == [("backbone", "cmu_corpus"), ("adapters", "aug")]
+    assert resumed.weights_licence == "permissive (CMU, MIT)"
