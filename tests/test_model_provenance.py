@@ -60,6 +60,8 @@ def test_corpus_counts_the_split_and_originals_once(tmp_path: Path) -> None:
     assert provenance_from_corpus(corpus).weights_licence.startswith("share-alike")
     val = provenance_from_corpus(corpus, "evaluator", split="val")
     assert val.trained_on[0].licences == {"CC-BY-NC-4.0": 0.1} and val.weights_licence.startswith("non-commercial")
+    (corpus / "train.txt").write_text("a_0\nMa_0\n")  # the split file (what the trainer reads) wins
+    assert provenance_from_corpus(corpus).trained_on[0].licences == {"CMU": 0.01}
 
 
 def test_cmu_only_corpus_is_cmu(tmp_path: Path) -> None:

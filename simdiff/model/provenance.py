@@ -247,7 +247,8 @@ def source_record(corpus: str | Path, used: set[str]) -> dict[str, Any]:
 
 def provenance_from_corpus(corpus_dir: str | Path, what: str = "backbone", split: str = "train",
                            source: str | Path | None = None) -> Provenance:
-    """Provenance of training on ``corpus_dir`` (its ``split``), read from its ``manifest.json``.
+    """Provenance of training on ``corpus_dir`` (the clips of its ``<split>.txt``, else those whose
+    manifest ``split`` is ``split``), read from its ``manifest.json``.
 
     An augmented folder (``env.json``) is followed to its source corpus: the one its
     ``source_corpus.json`` names, else ``source`` (the corpus the caller says it came from), else
@@ -264,8 +265,9 @@ def provenance_from_corpus(corpus_dir: str | Path, what: str = "backbone", split
     if not folder.is_dir():
         raise SimdiffError(f"{folder}: not a data folder")
     if (folder / "manifest.json").is_file():
-        manifest_path = folder / "manifest.json"
-        return Provenance([summarize_manifest(_read_json(manifest_path), what, name, split=split, where=str(manifest_path))])
+        manifest_path = folder / "manifest.json"  # the split file is what the trainer reads; else the clips' split
+        return Provenance([summarize_manifest(_read_json(manifest_path), what, name, _split_ids(folder, split), split,
+                                              where=str(manifest_path))])
     if not (folder / "env.json").is_file():
         return Provenance([unknown_data(what, folder, f"{folder} has no manifest.json")])
     used = augmented_sources(folder)
