@@ -93,6 +93,8 @@ def test_augmented_folder_without_record(tmp_path: Path) -> None:
     assert prov.weights_licence == "unknown (no licence record for old_aug)"
     assert "records no source corpus" in prov.trained_on[0].note
     assert provenance_from_corpus(aug, "adapters", source=corpus).weights_licence == "permissive (MIT)"
+    (aug / SOURCE_CORPUS_NAME).write_text(json.dumps({"path": str(corpus)}))  # written by hand for an older run
+    assert provenance_from_corpus(aug, "adapters").weights_licence == "permissive (MIT)"
 
 
 def test_folder_without_manifest_is_unknown_said_plainly(tmp_path: Path) -> None:
