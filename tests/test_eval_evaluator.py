@@ -57,6 +57,11 @@ def test_training_learns_and_resumes(tmp_path: Path) -> None:
     out = tmp_path / "ev"
     first = train_evaluator(corpus, out, cfg, text_encoder=HashTextEncoder(), progress=False)
     assert len(first["history"]) == 2 and "val" in first["history"][0]
+    from simdiff.model.provenance import read_provenance
+
+    provenance = read_provenance(out)  # the tiny corpus has no manifest.json: licence unknown, said so
+    assert provenance is not None and provenance.trained_on[0].what == "evaluator"
+    assert provenance.weights_licence == "unknown (no licence record for c)"
     # resume to 4 epochs == a straight 4-epoch run (deterministic)
     cfg4 = EvaluatorTrainConfig(evaluator=SMALL, epochs=4, batch_size=8, seed=1)
     with pytest.raises(SimdiffError, match="different config"):

@@ -54,6 +54,27 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     assert (meta["alpha"], meta["alpha_source"], meta["steps"], meta["frames"]) == (0.5, "sampling.json", 2, 10)
     assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
     assert meta["threads"] == 1
+    assert (meta["model"]["trained_on"], meta["model"]["weights_licence"]) == ("unknown", "unknown")  # no provenance.json
+
+
+def test_generate_reports_the_models_provenance(tmp_path: Path, capsys) -> None:
+    from simdiff.model.provenance import Provenance, TrainingData, write_provenance
+
+    model = save_tiny(tmp_path / "m")
+    write_provenance(model, Provenance([TrainingData("backbone", "corpus", ["bandai"], 0.5, {"CC-BY-NC-4.0": 0.5}),
+                                        TrainingData("adapters", "aug", ["cmu-amc"], 0.1, {"CMU": 0.1})]))
+    argv = ["generate", "a person waves", "--frames", "8", "--steps", "2", "--model", str(model), "--threads", "1",
+            "--format", "npy", "--no-video", "-q"]
+    assert main([*argv, "--out", str(tmp_path / "o")]) == 0, capsys.readouterr().err
+    meta = json.loads((tmp_path / "o" / "generation.json").read_text())["model"]
+    assert meta["weights_licence"] == "non-commercial (CC-BY-NC-4.0 motion in the training data)"
+    assert [(p["what"], p["data"], p["licences"]) for p in meta["trained_on"]] == [
+        ("backbone", "corpus", {"CC-BY-NC-4.0": 0.5}), ("adapters", "aug", {"CMU": 0.1})]
+    (model / "provenance.json").write_text("{oops")  # malformed: one line, before any sampling
+    assert main([*argv, "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "provenance.json: cannot read JSON" in err and err.count("\n") == 1
+    assert not (tmp_path / "bad" / "generation.json").exists()
 
 
 def test_backbone_model_warns_once_and_ignores_phi(tmp_path: Path, capsys) -> None:

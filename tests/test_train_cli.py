@@ -39,6 +39,18 @@ def test_train_writes_model_and_resumes(runs, capsys) -> None:
     assert "already holds checkpoints" in capsys.readouterr().err
 
 
+def test_trained_models_record_provenance(runs) -> None:
+    from simdiff.model.provenance import read_provenance
+
+    backbone = read_provenance(runs / "bb" / "model")
+    assert backbone is not None and [(p.what, p.data) for p in backbone.trained_on] == [("backbone", "synthetic")]
+    assert "synthetic clips" in backbone.trained_on[0].note
+    adapters = read_provenance(runs / "ad" / "model")  # the backbone's record (from --init) joined with its own
+    assert adapters is not None
+    assert [(p.what, p.data) for p in adapters.trained_on] == [("backbone", "synthetic"), ("adapters", "synthetic")]
+    assert adapters.weights_licence == "permissive (synthetic data only)"
+
+
 def test_sample_backbone_and_simdiff(runs, tmp_path) -> None:
     out = tmp_path / "s"
     assert main(["sample", "--model", str(runs / "bb" / "model"), "--text", "a person walks", "--text", "jump",

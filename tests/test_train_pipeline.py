@@ -21,6 +21,14 @@ pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 @pytest.fixture(scope="module")
 def corpus(tiny_corpus):
+    """The tiny corpus with a made-up manifest: CMU clips, and one non-commercial clip in the train split."""
+    from provenance_fixtures import clip, write_manifest
+
+    splits = {s: (tiny_corpus / f"{s}.txt").read_text().split() for s in ("train", "val", "test")}
+    clips = [clip(cid, "CC-BY-NC-4.0" if cid == splits["train"][-1] else "CMU", 2.4, split, "bandai" if
+                  cid == splits["train"][-1] else "cmu-amc") | {"motion_type": "walk"}
+             for split, ids in splits.items() for cid in ids]
+    write_manifest(tiny_corpus, clips)
     return tiny_corpus
 
 
@@ -50,6 +58,15 @@ def test_quick_pipeline_runs_skips_and_reruns_downstream(corpus, tmp_path) -> No
     assert len(shards) > 1 and all((export / "sharded" / s).stat().st_size <= 0.25 * 2**20 for s in shards)
     gen = MotionGenerator.load(export / "sharded", load_text=False)
     assert gen.is_simdiff
+    assert json.loads((out / "augmented" / "source_corpus.json").read_text())["path"] == str(corpus.resolve())
+    provenance = json.loads((export / "model" / "provenance.json").read_text())  # the backbone saw the NC clip
+    assert provenance["weights_licence"] == "non-commercial (CC-BY-NC-4.0 motion in the training data)"
+    assert [p["what"] for p in provenance["trained_on"]] == ["backbone", "adapters"]
+    assert provenance["trained_on"][0]["licences"] == {"CC-BY-NC-4.0": 0.0007, "CMU": 0.0047}  # 1 and 7 clips of 2.4 s
+    assert "Weights licence: **non-commercial" in (export / "model" / "README.md").read_text()
+    assert (export / "sharded" / "provenance.json").is_file()
+    evaluator = json.loads((out / "evaluator" / "provenance.json").read_text())
+    assert [p["what"] for p in evaluator["trained_on"]] == ["evaluator"] and "non-commercial" in evaluator["weights_licence"]
     mtime = (out / "backbone" / "model" / "model.safetensors").stat().st_mtime_ns
 
     again, lines = _run(config, out)

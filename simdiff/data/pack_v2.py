@@ -9,7 +9,7 @@ A pack folder holds::
                            mirrors [[id, parent id, root scale, contact offset]],
                            raw [[id, row offset, rows]],
                            texts {id: caption file}, splits {name: [ids]},
-                           files {name: text} (env.json, conditions.json, manifest.json)
+                           files {name: text} (env.json, conditions.json, manifest.json, source_corpus.json)
     arrays/joints.npz      root (N, 3) float32 m; rel (N, 21, 3) int16 delta codes; contacts (bits);
                            raw (R, 263) float32 features of the few clips that do not rebuild
     arrays/Mean.npy, arrays/Std.npy   (263,) float32, copied exactly
@@ -41,7 +41,7 @@ PACK_FORMAT = "simdiff-pack"
 VERSION = 2
 INDEX_NAME = "index.json.xz"
 ARRAYS_NAME = "joints.npz"
-SIDE_FILES = ("env.json", "conditions.json", "manifest.json")
+SIDE_FILES = ("env.json", "conditions.json", "manifest.json", "source_corpus.json")
 
 Task = tuple[str, str, str | None]
 """(corpus folder, clip id, id of its mirror or None)."""

@@ -146,6 +146,9 @@ def train_evaluator(corpus: str | os.PathLike[str], out: str | os.PathLike[str],
 
         text_encoder = load_text_encoder(config.evaluator.text_encoder, device)
     text = CachedTextEncoder(text_encoder, device)
+    from simdiff.model.provenance import provenance_from_corpus, write_provenance
+
+    provenance = provenance_from_corpus(corpus, "evaluator", split=config.split)  # out/provenance.json
     ckpt = out / "checkpoint"
     meta = _load_checkpoint(ckpt, model, optim)
     if meta is not None and meta.get("config") != json.loads(json.dumps(dataclasses.asdict(config))):
@@ -184,6 +187,7 @@ def train_evaluator(corpus: str | os.PathLike[str], out: str | os.PathLike[str],
             best = score
             save_evaluator(out, model, {"training": {"corpus": str(corpus), "epoch": epoch + 1, "seed": config.seed,
                                                      "split": config.split, "val": row.get("val")}})
+            write_provenance(out, provenance)
         _save_checkpoint(ckpt, model, optim, {"epoch": epoch + 1, "best": best, "history": history,
                                               "config": dataclasses.asdict(config)})
         bar.set_postfix(loss=f"{row['loss']:.3f}", **({"val_top1": f"{row['val']['top1']:.3f}"} if "val" in row else {}))

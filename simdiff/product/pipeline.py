@@ -191,6 +191,16 @@ def _env_dict(env: Environment) -> dict:
     return {"gravity": env.gravity, "wind": [env.wind_x, env.wind_y]}
 
 
+def model_provenance(model_dir: Path) -> dict:
+    """``trained_on`` and ``weights_licence`` from the model's ``provenance.json`` ("unknown" without one)."""
+    from simdiff.model.provenance import UNKNOWN, read_provenance
+
+    prov = read_provenance(model_dir)
+    if prov is None:
+        return {"trained_on": UNKNOWN, "weights_licence": UNKNOWN}
+    return {"trained_on": [p.to_dict() for p in prov.trained_on], "weights_licence": prov.weights_licence}
+
+
 def metadata(request: GenerationRequest, generator, model_dir: Path, samples: list[Sample],
              files: list[dict[str, Path]], videos: list[Path], timer: Timer, alpha_source: str = "default") -> dict:
     """The ``generation.json`` record of one run (file names relative to the output folder)."""
@@ -212,6 +222,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
             "latent_dim": cfg.backbone.latent_dim,
             "num_layers": cfg.backbone.num_layers,
             "text_encoder": cfg.text_encoder,
+            **model_provenance(model_dir),
         },
         "environment": _env_dict(request.envs[0]) if simdiff_model and request.compare is None else None,
         "compare": ({"component": request.compare,

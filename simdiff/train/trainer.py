@@ -25,6 +25,7 @@ from simdiff.diffusion.losses import diffusion_prediction, masked_mse
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import build_network, load_pretrained, save_pretrained
 from simdiff.model.condition import Condition
+from simdiff.model.provenance import Provenance, write_provenance
 from simdiff.model.simdiff_net import SimDiffNet
 from simdiff.text.cache import CachedTextEncoder
 from simdiff.train.config import RunConfig
@@ -58,13 +59,16 @@ class Trainer:
         mean, std: (263,) normaliser saved with the model (default: ``dataset.normalizer`` or init model's).
         resume: continue from ``run_dir``'s latest checkpoint when there is one.
         rank, world_size: DDP process (``torch.distributed`` must already be initialised when > 1).
+        provenance: what the run trains on (:mod:`simdiff.model.provenance`); written as
+            ``model/provenance.json`` with every export when given.
     """
 
     def __init__(self, run_dir: str | Path, config: RunConfig, dataset: MotionDataset, *, text_encoder: Any = None,
                  device: torch.device | str = "cpu", init_model: str | Path | None = None,
                  mean: Tensor | None = None, std: Tensor | None = None, resume: bool = True,
-                 rank: int = 0, world_size: int = 1) -> None:
+                 rank: int = 0, world_size: int = 1, provenance: Provenance | None = None) -> None:
         self.run_dir = Path(run_dir)
+        self.provenance = provenance
         self.config = config
         self.dataset = dataset
         self.device = torch.device(device)
@@ -269,6 +273,8 @@ class Trainer:
             exported = build_network(self.config.model)
             exported.load_state_dict(self.export_state())
             save_pretrained(self.run_dir / "model", exported, self.config.model, self.extra_tensors())
+            if self.provenance is not None:
+                write_provenance(self.run_dir / "model", self.provenance)
             from simdiff.model.checkpoint import atomic_write_json
 
             atomic_write_json(run, self.run_dir / "train_config.json")

@@ -112,6 +112,9 @@ def run(args: argparse.Namespace) -> int:
 
     folder = check_model_dir(args.model)
     stored = sampling_defaults(args.model)
+    from simdiff.model.provenance import read_provenance
+
+    read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
     given = {name for name in ("sampler", "steps", "guidance", "alpha") if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")

@@ -128,6 +128,21 @@ def _dataset(args: argparse.Namespace, seed: int):
     return open_training_dataset(list(args.data), args.split, seed, source=getattr(args, "source", None))
 
 
+def _provenance(args: argparse.Namespace):
+    """What this run trains on (``model/provenance.json``); adapters add their backbone's record."""
+    from simdiff.model.provenance import Provenance, read_provenance, training_provenance, unknown_data
+
+    init = getattr(args, "init", None)
+    prov = training_provenance(args.mode, args.data or (), args.split, init=init, source=getattr(args, "source", None),
+                               synthetic=args.synthetic)
+    if args.mode == "adapters" and init is None:  # resuming: keep the backbone entries written before
+        earlier = read_provenance(args.out / "model")
+        backbone = [p for p in earlier.trained_on if p.what == "backbone"] if earlier is not None else []
+        prov = Provenance((backbone or [unknown_data("backbone", args.out / "model", "resumed without --init")])
+                          + prov.trained_on)
+    return prov
+
+
 def run(args: argparse.Namespace) -> int:
     import torch
 
@@ -151,12 +166,15 @@ def run(args: argparse.Namespace) -> int:
         encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
         dataset = _dataset(args, config.train.seed)
         trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
-                          init_model=getattr(args, "init", None), rank=dist.rank, world_size=dist.world_size)
+                          init_model=getattr(args, "init", None), rank=dist.rank, world_size=dist.world_size,
+                          provenance=_provenance(args))
         losses = trainer.train(progress=not args.no_progress)
         if dist.is_main:
             tail = losses[-10:]
             final = f", final loss {sum(tail) / len(tail):.4f}" if tail else ""
-            print(f"trained {config.train.mode} to step {trainer.step}{final}; model: {args.out / 'model'}")
+            licence = trainer.provenance.weights_licence if trainer.provenance is not None else "unknown"
+            print(f"trained {config.train.mode} to step {trainer.step}{final}; model: {args.out / 'model'} "
+                  f"(weights licence: {licence})")
     finally:
         shutdown()
     return 0

@@ -13,6 +13,8 @@ Output (``out``), in the HumanML3D layout plus φ::
     conditions.json           the condition list
     report.json, report.md    kept fraction per condition, reasons, CPU time
     augment_settings.json     what a resumed run must match
+    source_corpus.json        the source corpus's path and a licence summary of the clips behind
+                              the kept pairs (:mod:`simdiff.model.provenance`)
     shards/shard_NNNNN.json   one per group of ``shard_size`` source clips: every pair's projection
                               info and whether its files were written; written last (temp +
                               os.replace), so a shard either exists whole or is redone
@@ -430,6 +432,9 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
     write_lines(out / "all.txt", ids)
     write_json(out / "env.json", env)
     write_json(out / "conditions.json", [c.to_dict() for c in conditions])
+    from simdiff.model.provenance import SOURCE_CORPUS_NAME, source_record
+
+    write_json(out / SOURCE_CORPUS_NAME, source_record(corpus, {r["clip"] for r in kept}))
     for name in ("Mean.npy", "Std.npy"):
         write_bytes(out / name, (corpus / name).read_bytes())
     keep_set = set(ids) | protected

@@ -118,6 +118,7 @@ def _train(ctx: PipelineContext, trainer: Any, max_minutes: float) -> dict[str, 
 def run_backbone(ctx: PipelineContext) -> dict[str, Any]:
     from simdiff.data.humanml3d import HumanML3D
     from simdiff.model.config import ModelConfig, backbone_preset
+    from simdiff.model.provenance import provenance_from_corpus
     from simdiff.train.config import OptimConfig, RunConfig, TrainConfig
     from simdiff.train.trainer import Trainer
 
@@ -130,7 +131,7 @@ def run_backbone(ctx: PipelineContext) -> dict[str, Any]:
                         losses=dataclasses.replace(b.losses), crop=dataclasses.replace(b.crop))
     dataset = HumanML3D(ctx.corpus_dir(), "train", seed=seed)
     trainer = Trainer(ctx.out / "backbone", RunConfig(model=model, train=train), dataset, text_encoder=encoder,
-                      device=ctx.device)
+                      device=ctx.device, provenance=provenance_from_corpus(ctx.corpus_dir(), "backbone"))
     return _train(ctx, trainer, b.max_minutes)
 
 
@@ -138,6 +139,7 @@ def run_adapters(ctx: PipelineContext) -> dict[str, Any]:
     from simdiff.data.augment import open_training_dataset
     from simdiff.model.checkpoint import read_config
     from simdiff.model.config import SimConfig
+    from simdiff.model.provenance import provenance_from_corpus, training_provenance
     from simdiff.train.config import OptimConfig, RunConfig, TrainConfig
     from simdiff.train.trainer import Trainer
 
@@ -151,8 +153,10 @@ def run_adapters(ctx: PipelineContext) -> dict[str, Any]:
     if len(dataset) == 0:
         raise SimdiffError(f"{ctx.augmented_dir()}: the augmented corpus kept no training clip "
                            f"(see its report.md; loosen the filter or augment more clips, e.g. --set augment.limit=64)")
+    provenance = training_provenance("adapters", init=init).merged(  # an augmented folder without a record: our corpus
+        provenance_from_corpus(ctx.augmented_dir(), "adapters", source=ctx.corpus_dir()))
     trainer = Trainer(ctx.out / "adapters", RunConfig(model=model, train=train), dataset, text_encoder=ctx.text(),
-                      device=ctx.device, init_model=init)
+                      device=ctx.device, init_model=init, provenance=provenance)
     return _train(ctx, trainer, a.max_minutes)
 
 
@@ -209,6 +213,7 @@ def export_settings(ctx: PipelineContext) -> dict[str, Any]:
 def run_export(ctx: PipelineContext) -> dict[str, Any]:
     import json
 
+    from simdiff.model.provenance import PROVENANCE_NAME, read_provenance
     from simdiff.model.shards import shard_model_folder
 
     out = ctx.out / "export"
@@ -217,7 +222,9 @@ def run_export(ctx: PipelineContext) -> dict[str, Any]:
         shutil.rmtree(out)
     src = ctx.out / "adapters" / "model"
     model.mkdir(parents=True)
-    for name in ("config.json", "model.safetensors"):
+    for name in ("config.json", "model.safetensors", PROVENANCE_NAME):
+        if name == PROVENANCE_NAME and not (src / name).is_file():
+            continue  # a model trained before provenance was recorded: the README says "unknown"
         shutil.copyfile(src / name, model / name)
     write_json(model / "sampling.json", {"alpha": ctx.config.export.alpha, "guidance": ctx.config.evaluation.guidance,
                                          "steps": ctx.config.evaluation.steps, "sampler": ctx.config.evaluation.sampler})
@@ -231,17 +238,35 @@ def run_export(ctx: PipelineContext) -> dict[str, Any]:
     write_json(out / "training.json", {"budget": ctx.config.budget, "seed": ctx.config.seed, "keys": ctx.keys,
                                        "config": dataclasses.asdict(ctx.config), "training": markers,
                                        "evaluation": evaluation})
-    write_text(model / "README.md", _readme(ctx, markers, evaluation))
-    return {"model": str(model), "shards": shards}
+    provenance = read_provenance(model)
+    write_text(model / "README.md", _readme(ctx, markers, evaluation, provenance))
+    return {"model": str(model), "shards": shards,
+            "weights_licence": provenance.weights_licence if provenance is not None else "unknown"}
 
 
-def _readme(ctx: PipelineContext, markers: dict[str, Any], evaluation: dict[str, Any]) -> str:
+def _provenance_lines(provenance: Any) -> list[str]:
+    """README lines: the weights' licence and what each part was trained on."""
+    if provenance is None:
+        return ["Weights licence: **unknown** (the trained model folder has no provenance.json).", ""]
+    lines = [f"Weights licence: **{provenance.weights_licence}** (the most restrictive licence among the "
+             "training data decides; details in `provenance.json`).", "", "Trained on:", ""]
+    for part in provenance.trained_on:
+        hours = f"{part.hours:.2f} h of original motion" if part.hours is not None else "hours unknown"
+        codes = ", ".join(f"{code} {h:.2f} h" for code, h in part.licences.items()) or "licences unknown"
+        note = f"; {part.note}" if part.note else ""
+        lines.append(f"* {part.what}: `{part.data}` ({', '.join(part.sources) or 'sources unknown'}; {hours}; "
+                     f"{codes}{note})")
+    return lines + [""]
+
+
+def _readme(ctx: PipelineContext, markers: dict[str, Any], evaluation: dict[str, Any], provenance: Any = None) -> str:
     cfg = ctx.config
     lines = [f"# simdiff model (pipeline budget `{cfg.budget}`, seed {cfg.seed})", "",
              f"Backbone `{cfg.backbone.size}` ({markers.get('backbone', {}).get('step', '?')} steps of batch "
              f"{cfg.backbone.batch_size}); adapters {markers.get('adapters', {}).get('step', '?')} steps of batch "
              f"{cfg.adapters.batch_size}; text encoder `{cfg.text_encoder}`.",
              f"Corpus: `{ctx.corpus_dir()}`; augmented: `{ctx.augmented_dir()}`.", "",
+             *_provenance_lines(provenance),
              "Evaluation (our evaluator, test split, Earth φ; mean over replications):", ""]
     for side in ("generated", "ground_truth"):
         row = evaluation.get(side, {})
