@@ -112,6 +112,16 @@ def test_verdict_rules_on_known_numbers() -> None:
     assert by["fid"]["passed"] is None and by["gravity_size"]["passed"] is None  # n/a, never a pass
 
 
+def test_sliding_is_na_when_the_samples_hover() -> None:
+    """Low sliding from feet that never reach the floor is not a pass (the metric's 5 mm slack)."""
+    base = {"sliding": 0.0, "floating": 23.7, "gt_floating": 12.7}
+    hover = {v["check"]: v for v in verdicts(base)}["sliding"]
+    assert hover["passed"] is None and "hover" in hover["detail"]
+    near = {v["check"]: v for v in verdicts({**base, "floating": 17.0})}["sliding"]
+    assert near["passed"] is True
+    assert {v["check"]: v for v in verdicts({**base, "sliding": 2.0})}["sliding"]["passed"] is False
+
+
 def test_jump_detection_on_ballistic_pelvis() -> None:
     high = jump_stats(jump(120, height=0.4, start=40, airtime=0.5))
     assert high["jump"] and high["flight_s"] == pytest.approx(0.5, abs=0.1) and high["rise_m"] == pytest.approx(0.4, abs=0.02)

@@ -38,6 +38,8 @@ def _verdict_lines(report: dict[str, Any]) -> list[str]:
     lines = ["| check | rule | value | threshold | verdict |", "|---|---|---|---|---|"]
     for v in report["verdicts"]:
         mark = {True: "**PASS**", False: "**FAIL**", None: "n/a"}[v["passed"]]
+        if v["passed"] is None and "n/a:" in (v.get("detail") or ""):
+            mark += " (" + v["detail"].split("n/a:", 1)[1].strip() + ")"
         lines.append(f"| {v['check']} | {v['rule']} | {_f(v['value'])} | {_f(v['threshold'])} | {mark} |")
     return lines
 

@@ -25,6 +25,11 @@ RULES: dict[str, str] = {
 }
 
 
+HOVER_MM = 5.0
+"""Mean floating (mm) above the ground truth's beyond which the sliding figure is n/a (the metric's
+5 mm contact slack)."""
+
+
 def _num(value: Any) -> float | None:
     try:
         v = float(value)
@@ -47,6 +52,20 @@ def _at_least(check: str, value: Any, limit: Any, detail: str = "") -> dict[str,
     return _verdict(check, v, lim, None if v is None or lim is None else v >= lim, detail)
 
 
+def _sliding(f: dict[str, Any]) -> dict[str, Any]:
+    """Sliding ≤ 1.0 mm/frame, n/a when the samples hover: sliding only counts frame pairs whose
+    lowest joint is within the metric's 5 mm slack of the floor, so a motion whose lowest joint
+    floats higher than the ground truth's by more than that slack (mean floating, mm) scores low
+    sliding without touching the floor; the figure then says nothing about foot skating."""
+    v = _at_most("sliding", f.get("sliding"), 1.0, "mm/frame")
+    fl, gt_fl = _num(f.get("floating")), _num(f.get("gt_floating"))
+    if v["passed"] and fl is not None and gt_fl is not None and fl - gt_fl > HOVER_MM:
+        v["passed"] = None
+        v["detail"] = (f"mm/frame; n/a: the samples hover (floating {fl:.1f} mm vs ground truth {gt_fl:.1f} mm), "
+                       "so few frames are within 5 mm of the floor")
+    return v
+
+
 def verdicts(f: dict[str, Any]) -> list[dict[str, Any]]:
     """Apply every rule of :data:`RULES` to the flat figures ``f`` (see :func:`figures` for the keys).
 
@@ -59,7 +78,7 @@ def verdicts(f: dict[str, Any]) -> list[dict[str, Any]]:
         return None if v is None else v * factor
 
     out = [
-        _at_most("sliding", f.get("sliding"), 1.0, "mm/frame"),
+        _sliding(f),
         _at_most("skate_ratio", f.get("skate_ratio"), scaled("gt_skate_ratio", 2.0), f"GT {f.get('gt_skate_ratio')}"),
         _at_least("r_precision_top3", f.get("r_precision_top3"), scaled("gt_r_precision_top3", 0.8),
                   f"GT {f.get('gt_r_precision_top3')}"),
@@ -84,7 +103,7 @@ def figures(report: dict[str, Any]) -> dict[str, Any]:
     f: dict[str, Any] = {}
     split = report.get("test_split") or {}
     gen, gt = split.get("generated") or {}, split.get("ground_truth") or {}
-    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid"):
+    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid", "floating"):
         f[key] = (gen.get(key) or {}).get("mean")
         f[f"gt_{key}"] = (gt.get(key) or {}).get("mean")
     f["jump_fraction"] = ((report.get("jumps") or {}).get("overall") or {}).get("fraction")
