@@ -55,6 +55,27 @@ def folder_size(folder: str | Path) -> int:
     return sum(p.stat().st_size for p in Path(folder).rglob("*") if p.is_file())
 
 
+def finish_pack(tmp: Path, out: Path, budget_mib: float) -> int:
+    """Check the finished pack folder ``tmp`` against ``budget_mib`` (0: no check), then let it replace
+    ``out``; returns its size in bytes.
+
+    Raises:
+        SimdiffError: the pack is over budget (``out`` is left as it was).
+    """
+    size = folder_size(tmp)
+    if budget_mib > 0 and size > budget_mib * 2**20:
+        raise SimdiffError(f"{out}: pack is {size / 2**20:.1f} MiB, over the {budget_mib:g} MiB budget")
+    if out.exists():
+        shutil.rmtree(out)
+    os.replace(tmp, out)
+    return size
+
+
+def resolve_workers(workers: int) -> int:
+    """Processes for packing/unpacking: ``workers``, or every core when it is 0 or less."""
+    return workers if workers > 0 else (os.cpu_count() or 1)
+
+
 def pack(corpus: str | Path, out: str | Path, dtype: str = "float16", budget_mib: float = DEFAULT_BUDGET_MIB,
          splits: list[str] | None = None, content: str = "joints", workers: int = 1,
          progress: bool = False) -> dict[str, Any]:
@@ -64,7 +85,7 @@ def pack(corpus: str | Path, out: str | Path, dtype: str = "float16", budget_mib
         splits: pack only the clips of these split files (and those files); default every split.
         budget_mib: refuse (one-line error, nothing written) when the pack would exceed it; 0 = no check.
         content: "joints" (version 2) or "features" (version 1, stored as ``dtype``).
-        workers: processes encoding clips (joints content).
+        workers: processes encoding clips (joints content; 0: every core).
     Raises:
         SimdiffError: missing files, a clip with the wrong shape, or the pack over budget.
     """
@@ -88,7 +109,8 @@ def pack(corpus: str | Path, out: str | Path, dtype: str = "float16", budget_mib
     if content == "joints":
         from simdiff.data.pack_v2 import pack_joints_corpus
 
-        return pack_joints_corpus(corpus, out, ids, all_splits, budget_mib, workers=workers, progress=progress)
+        return pack_joints_corpus(corpus, out, ids, all_splits, budget_mib, workers=resolve_workers(workers),
+                                  progress=progress)
     shapes = {}
     for clip in ids:
         path = corpus / "new_joint_vecs" / f"{clip}.npy"
@@ -123,12 +145,7 @@ def pack(corpus: str | Path, out: str | Path, dtype: str = "float16", budget_mib
             save_npy(tmp / "arrays" / name, np.load(corpus / name).astype(np.float32))
         write_json(tmp / PACK_NAME, {"format": PACK_FORMAT, "version": PACK_VERSION, "dtype": dtype, "clips": clips,
                                      "texts": texts, "splits": all_splits, "files": side}, indent=None)
-        size = folder_size(tmp)
-        if budget_mib > 0 and size > budget_mib * 2**20:
-            raise SimdiffError(f"{out}: pack is {size / 2**20:.1f} MiB, over the {budget_mib:g} MiB budget")
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
+        size = finish_pack(tmp, out, budget_mib)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return {"clips": len(ids), "frames": frames, "bytes": size, "dtype": dtype}
@@ -181,14 +198,14 @@ def finish_unpack(path: Path, index: dict[str, Any], tmp: Path, out: Path) -> No
 
 def unpack(path: str | Path, out: str | Path, workers: int = 1, progress: bool = False) -> int:
     """Write pack ``path`` (version 1 or 2) as a HumanML3D-layout folder ``out`` (replaced as a
-    whole); returns the clip count. ``workers``: processes rebuilding a version-2 pack's features."""
+    whole); returns the clip count. ``workers``: processes rebuilding a version-2 pack's features (0: every core)."""
     from simdiff.motion.features import features_to_joints
 
     path, out = Path(path), Path(out)
     if pack_version(path) == 2:
         from simdiff.data.pack_v2 import unpack_joints
 
-        return unpack_joints(path, out, workers=workers, progress=progress)
+        return unpack_joints(path, out, workers=resolve_workers(workers), progress=progress)
     index, features = read_pack(path)
     tmp = out.with_name(f".{out.name}.tmp{os.getpid()}")
     shutil.rmtree(tmp, ignore_errors=True)

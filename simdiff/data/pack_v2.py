@@ -174,14 +174,9 @@ def pack_joints_corpus(corpus: Path, out: Path, ids: list[str], splits: dict[str
                                        "raw": len(raw_index), "joint_frames": frames,
                                        "max_rebuild_error": errors, "tolerance": codec.TOLERANCE,
                                        "index_sha256": hashlib.sha256(blob).hexdigest()})
-        from simdiff.data.pack import folder_size
+        from simdiff.data.pack import finish_pack
 
-        size = folder_size(tmp)
-        if budget_mib > 0 and size > budget_mib * 2**20:
-            raise SimdiffError(f"{out}: pack is {size / 2**20:.1f} MiB, over the {budget_mib:g} MiB budget")
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
+        size = finish_pack(tmp, out, budget_mib)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return {"clips": len(clips) + len(mirrors) + len(raw_index), "mirrors": len(mirrors), "raw": len(raw_index),

@@ -94,13 +94,10 @@ def run_pipeline_cmd(args: argparse.Namespace) -> int:
 
 
 def run_pack(args: argparse.Namespace) -> int:
-    import os
-
     from simdiff.data.pack import pack
 
-    workers = args.workers if args.workers > 0 else (os.cpu_count() or 1)
     info = pack(args.corpus, args.out, dtype=args.dtype, budget_mib=args.budget_mib, splits=args.splits,
-                content=args.content, workers=workers, progress=not args.no_progress)
+                content=args.content, workers=args.workers, progress=not args.no_progress)
     print(f"packed {info['clips']} clips ({info.get('mirrors', 0)} as mirrors), {info['frames']} frames "
           f"({info['dtype']}): "
           f"{info['bytes'] / 2**20:.2f} MiB in {args.out}")
@@ -108,11 +105,8 @@ def run_pack(args: argparse.Namespace) -> int:
 
 
 def run_unpack(args: argparse.Namespace) -> int:
-    import os
-
     from simdiff.data.pack import unpack
 
-    workers = args.workers if args.workers > 0 else (os.cpu_count() or 1)
-    n = unpack(args.pack, args.out, workers=workers, progress=not args.no_progress)
+    n = unpack(args.pack, args.out, workers=args.workers, progress=not args.no_progress)
     print(f"unpacked {n} clips into {args.out}")
     return 0

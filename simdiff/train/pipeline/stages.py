@@ -36,20 +36,13 @@ def corpus_settings(ctx: PipelineContext) -> dict[str, Any]:
             "seed": ctx.config.seed, "version": PIPELINE_VERSION}
 
 
-def _workers(n: int) -> int:
-    """Processes for unpacking a pack: ``n``, or every core when ``n`` is 0."""
-    import os
-
-    return n if n > 0 else (os.cpu_count() or 1)
-
-
 def run_corpus(ctx: PipelineContext) -> dict[str, Any]:
     c = ctx.config.corpus
     if c.path:
         from simdiff.data.pack import is_pack, unpack
 
         if is_pack(Path(c.path)):
-            return {"unpacked": unpack(c.path, ctx.corpus_dir(), workers=_workers(c.workers), progress=ctx.progress)}
+            return {"unpacked": unpack(c.path, ctx.corpus_dir(), workers=c.workers, progress=ctx.progress)}
         return {"corpus": str(ctx.corpus_dir())}
     from simdiff.data.corpus.build import CorpusConfig, build
 
@@ -73,7 +66,7 @@ def run_augment(ctx: PipelineContext) -> dict[str, Any]:
         from simdiff.data.pack import is_pack, unpack
 
         if is_pack(Path(a.path)):
-            return {"unpacked": unpack(a.path, ctx.augmented_dir(), workers=_workers(a.workers), progress=ctx.progress)}
+            return {"unpacked": unpack(a.path, ctx.augmented_dir(), workers=a.workers, progress=ctx.progress)}
         return {"augmented": str(ctx.augmented_dir())}
     from simdiff.data.augment import AugmentConfig, augment
 
