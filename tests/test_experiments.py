@@ -86,7 +86,7 @@ def test_shipped_configs_are_the_five_experiments_with_relative_paths() -> None:
     t1, t2 = load_config(CONFIGS / "eval_table1.json", "quick"), load_config(CONFIGS / "eval_table2.json", "quick")
     assert t1.protocol == t2.protocol  # so table1 reuses table2's SimDiff rows
     assert t1.samplers == ["ddpm", "ddim"] and t1.alphas == [0.1, "best"] and t1.ddpm_samples == 4
-    assert t2.alphas == [0.01, 0.05, 0.1, 0.2, 0.5, 1.0]
+    assert t2.alphas == [0.1, 0.5, 1.0]
     assert [m.physdiff["project_at"] for m in t1.models if m.physdiff] == [[60, 40, 20, 0]]
 
 
@@ -315,15 +315,20 @@ def test_env_response_scores_methods_against_the_simulator(setup: dict[str, Path
     sim = PhysicsStandIn()
     control = {"prompts": ["a person jumps", "a person walks"], "seeds": 2, "length": 24, "gravity": [-3.0],
                "wind": [5.0], "combos": [[-3.0, 5.0, 0.0]], "resamples": 50}
-    models = [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}]
+    models = [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST},
+              {"name": "SimDiff binary", "model": "adapters_binary", "env_index": 1, **FAST}]
     report = run_experiment(write(setup, "env_response", env_control=control, models=models), projector=sim,
                             progress=False, text_encoder=hash_text)
     rows = {r["method"]: r for r in report["rows"]}
     grid = [(-9.81, 0.0, 0.0), (-3.0, 0.0, 0.0), (-9.81, 5.0, 0.0), (-9.81, 0.0, 5.0), (-3.0, 5.0, 0.0)]
     assert [tuple(e) for e in rows["MDM"]["envs"]] == grid
-    assert set(sim.envs) == set(grid) and len(sim.envs) == 2 * 4 * len(grid)  # 2 methods × 4 units × every φ
+    assert set(sim.envs) == set(grid) and len(sim.envs) == 3 * 4 * len(grid)  # 3 methods × 4 units × every φ
     mdm = {(s["factor"], s["quantity"]): s for s in rows["MDM"]["scores"]}
     assert not rows["MDM"]["env_aware"] and rows["SimDiff"]["env_aware"]
+    # binary adapters take a class, not φ: one generation for every φ, so no response, as MDM
+    assert not rows["SimDiff binary"]["env_aware"]
+    binary = {(s["factor"], s["quantity"]): s for s in rows["SimDiff binary"]["scores"]}
+    assert binary[("wind", "drift_along_wind_m")]["slope_ratio"][0] == pytest.approx(0.0, abs=1e-9)
     # the simulator's answer is known: +0.2 m along the wind over 1.15 s at 5 N... and MDM does not respond at all
     drift = mdm[("wind", "drift_along_wind_m")]
     assert drift["mean_dsim"] == pytest.approx(0.02 * 5 * 23 / 20, abs=1e-3) and drift["n_units"] == 4

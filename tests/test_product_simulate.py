@@ -43,3 +43,35 @@ def test_backbone_motion_is_simulated_under_earth_and_bad_shapes_fail() -> None:
     assert sim.tracking["env"] == [-9.81, 0.0, 0.0] and sim.tracking["env_assumed"]
     with pytest.raises(SimdiffError, match=r"\(T>=2, 22, 3\)"):
         simulate_finish(np.zeros((1, 22, 3)), None)
+
+
+def test_simulated_motion_shares_the_floor_of_humanml3d() -> None:
+    """A flat planted foot's toe joint is on y = 0 (within the metrics' 5 mm contact slack), as in
+    HumanML3D, so the simulated motion's sliding is measured on real contacts, not vacuously 0."""
+    from simdiff.motion.metrics import GROUND_TOLERANCE
+
+    from simdiff.sim.synthetic import standing
+
+    still = standing(30)
+    still[..., 1] -= still[..., 1].min()  # HumanML3D's floor: the lowest joint on y = 0
+    sim = simulate_finish(still, Environment())
+    assert sim.tracking["status"] == "ok"
+    lowest = sim.joints[..., 1].min(axis=1)
+    assert np.all(np.abs(lowest) <= GROUND_TOLERANCE), lowest
+    assert sim.tracking["physics_simulated"]["floating"] <= 1.0
+
+
+def test_toe_joint_height_is_the_models_own() -> None:
+    """TOE_JOINT_HEIGHT is what the MuJoCo body has: toe joint above the lowest corner of its sole, flat."""
+    import mujoco
+
+    from simdiff.sim.humanoid import TOE_JOINT_HEIGHT, HumanoidConfig, load_model
+    from simdiff.sim.retarget.kinematics import box_bottom_corners, foot_geoms
+
+    model = load_model(HumanoidConfig())
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    for name, geom in zip(("L_Toe", "R_Toe"), foot_geoms(model)[1::2]):
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+        height = data.xpos[body][2] - box_bottom_corners(model, data, geom)[:, 2].min()
+        assert height == pytest.approx(TOE_JOINT_HEIGHT, abs=1e-6)

@@ -110,3 +110,17 @@ def test_jump_under_low_gravity_flies_higher_and_is_not_a_fall(jump):
         air[g] = res.airborne.sum()
     assert apex[-3.0] > apex[-9.81] + 0.05
     assert air[-3.0] > air[-9.81]
+
+
+def test_second_derivative5_is_scipys_quadratic_savgol_and_exact_for_free_fall():
+    from scipy.signal import savgol_filter
+
+    from simdiff.sim.retarget.contacts import second_derivative5
+
+    rng = np.random.default_rng(0)
+    for n in (5, 6, 41):
+        x = rng.normal(size=n)
+        want = savgol_filter(x, 5, 2, deriv=2, delta=1.0 / 20.0, mode="interp")
+        np.testing.assert_allclose(second_derivative5(x, 20.0), want, rtol=1e-9, atol=1e-9)
+    t = np.arange(30) / 20.0
+    np.testing.assert_allclose(second_derivative5(1.0 + 2.0 * t - 0.5 * 9.81 * t**2, 20.0), -9.81, atol=1e-9)

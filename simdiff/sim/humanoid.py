@@ -64,6 +64,14 @@ HML_TO_WORLD: np.ndarray = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0
 """World = HML_TO_WORLD @ hml: HumanML3D (x, y, z) Y-up → MuJoCo (z, x, y) Z-up (det +1)."""
 
 
+TOE_JOINT_HEIGHT: float = 0.012
+"""Metres of the toe joint (HumanML3D joints 10/11) above its box sole when the foot is flat.
+
+The simulated body stands on its soles, so its planted toe joints are this high; HumanML3D's
+convention puts the lowest joint (a planted toe) on the floor. :func:`simdiff.sim.project.project`
+lowers its rollout by this much so simulated and kinematic motions share one floor."""
+
+
 def hml_to_world(p: np.ndarray) -> np.ndarray:
     """HumanML3D Y-up points (..., 3) → MuJoCo Z-up world points (..., 3)."""
     return np.asarray(p)[..., [2, 0, 1]]
@@ -190,7 +198,7 @@ def _rest_offsets(cfg: HumanoidConfig) -> dict[str, np.ndarray]:
             offs[body] = np.zeros(3)
         elif g == "Toe":  # toe joint lower than the ankle so that zero angle = flat foot
             length = _bone_length(body)
-            drop = cfg.ankle_height - 0.012
+            drop = cfg.ankle_height - TOE_JOINT_HEIGHT
             offs[body] = np.array([np.sqrt(length**2 - drop**2), 0.0, -drop])
         elif g == "Hand":
             offs[body] = np.array([0.0, 0.0, -HAND_LENGTH])
@@ -250,8 +258,8 @@ def _geoms(body: str, offs: dict[str, np.ndarray], cfg: HumanoidConfig) -> list[
             f'size="{_fmt([(x1 - x0) / 2, half_w, half_h])}" mass="{m:.4g}"/>'
         ]
     if g == "Toe":  # toe: a short box in front of the toe joint, sole at the same level
-        sole = -0.012
-        half_h = 0.012
+        sole = -TOE_JOINT_HEIGHT
+        half_h = TOE_JOINT_HEIGHT
         return [
             f'<geom class="foot" type="box" pos="{_fmt([0.035, 0.0, sole + half_h])}" '
             f'size="{_fmt([0.035, 0.043, half_h])}" mass="{m:.4g}"/>'

@@ -1,7 +1,9 @@
 """The projection operator P_φ,π(τ): track a kinematic motion under φ, return the rollout.
 
 ``project(joints, env) -> (rollout_joints, info)``; ``rollout_joints`` is (T', 22, 3)
-float32 HumanML3D joints (Y-up, metres, 20 fps, same frame as the input) with T' = T on
+float32 HumanML3D joints (Y-up, metres, 20 fps, same horizontal frame as the input; floor at
+y = 0 with HumanML3D's convention: a flat planted foot's toe joint on it, see
+:data:`simdiff.sim.humanoid.TOE_JOINT_HEIGHT`) with T' = T on
 success and the frames up to the fall otherwise. With a flight clock (``flight``) T' is what
 the simulation needed: longer when a low-g flight outlasted the mocap's, shorter when a
 high-g flight landed early; distances are then taken against the re-timed source. ``info`` is a :class:`ProjectionInfo`.
@@ -18,19 +20,21 @@ from simdiff.sim.retarget import RetargetConfig, make_reference, qpos_to_world
 from simdiff.sim.env import Environment
 from simdiff.sim.faithfulness import pose_d_l2
 from simdiff.sim.flight import FlightConfig, aligned_source
-from simdiff.sim.humanoid import HumanoidConfig, load_model, model_index, world_to_hml
+from simdiff.sim.humanoid import TOE_JOINT_HEIGHT, HumanoidConfig, load_model, model_index, world_to_hml
 from simdiff.sim.residual import ResidualConfig
 from simdiff.sim.rollout import FallConfig, RolloutResult, rollout
 from simdiff.sim.strength import StrengthConfig
 from simdiff.sim.tracker import Tracker
 
-SIM_VERSION: int = 3
+SIM_VERSION: int = 4
 """Version of the physics behind :func:`project` with its defaults, recorded with augmented pairs.
 
 1: Earth strength at every gravity. 2 (issue 13): actuators, the tracker's balance layer and
 the residual's torque bound scale with max(1, |g_z|/9.81) (:mod:`simdiff.sim.strength`);
 identical to 1 at |g_z| ≤ 9.81. 3: also the residual's pelvis-orientation gains (kp_rot × s,
-kd_rot × √s); identical to 2 at |g_z| ≤ 9.81. A record without a version is version 1."""
+kd_rot × √s); identical to 2 at |g_z| ≤ 9.81. 4: the same physics; the rollout is returned
+:data:`simdiff.sim.humanoid.TOE_JOINT_HEIGHT` (12 mm) lower, on HumanML3D's floor (a flat planted
+toe joint at y = 0) instead of the soles'. A record without a version is version 1."""
 
 
 @dataclass
@@ -174,4 +178,8 @@ def project(
         duration_s=ref.duration, env=env.as_tuple(), violations=res.violations, d_l2_pose=dl2_pose,
         time_warp=float(len(out) / max(joints.shape[0], 1)),
     )
+    # The distances above are taken in the simulator's frame (soles on the floor), as the augmented
+    # corpus was filtered; the rollout returned is in HumanML3D's (planted toe joint on the floor).
+    out = out.copy()
+    out[..., 1] -= TOE_JOINT_HEIGHT
     return out, info

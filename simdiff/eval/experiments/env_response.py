@@ -9,7 +9,8 @@ for that motion. :mod:`simdiff.eval.response` turns the pairs into sign agreemen
 the additivity error against the single-factor effects.
 
 The same script scores MDM (env-blind: one generation reused for every φ, so it must score no
-response), SimDiff (continuous φ adapters) and PhysDiff (projection under φ).
+response), SimDiff with binary adapters (φ does not reach them either: one generation of the
+'simulated' class for every φ), SimDiff (continuous φ adapters) and PhysDiff (projection under φ).
 """
 
 from __future__ import annotations
@@ -103,8 +104,8 @@ def plan(runner: Runner) -> list[RowPlan]:
     plans = []
     for spec in c.models:
         mode = runner.sim_mode(spec)
-        if mode == "categorical":
-            raise SimdiffError(f"env_response needs continuous adapters (φ); {spec.name!r} is categorical")
+        if mode == "categorical" and spec.env_index is None:
+            raise SimdiffError(f"env_response: {spec.name!r} has categorical adapters; give its 'env_index'")
         alpha = spec.alpha if mode else None
         inputs = {"row": "env_response", **runner.method_inputs(spec, "ddim", alpha), "seed": c.seed, "envs": envs,
                   "prompts": o.prompts, "seeds": o.seeds, "length": o.length, "resamples": o.resamples,
