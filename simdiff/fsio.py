@@ -147,6 +147,15 @@ def write_json(path: str | Path, data: Any, indent: int | None = 2, allow_nan: b
     return write_text(path, text + "\n")
 
 
+def read_json(path: str | Path) -> Any:
+    """Parse a JSON file; an unreadable or malformed file is one :class:`SimdiffError` line naming it."""
+    try:
+        return json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise SimdiffError(f"{path}: cannot read JSON: {first}") from None
+
+
 def save_npy(path: str | Path, array: np.ndarray) -> Path:
     """Save ``array`` as ``.npy`` at exactly ``path`` (no suffix added) atomically."""
     with atomic_path(path) as tmp:

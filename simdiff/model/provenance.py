@@ -25,12 +25,12 @@ For a folder augmented before this record existed, ``{"path": "<its corpus>"}`` 
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable
 
 from simdiff.errors import SimdiffError
+from simdiff.fsio import read_json as _read_json
 
 PROVENANCE_NAME = "provenance.json"
 SOURCE_CORPUS_NAME = "source_corpus.json"
@@ -168,13 +168,6 @@ def synthetic_data(what: str, clips: int) -> TrainingData:
     """An entry for the trainer's ``--synthetic`` clips (random sinusoids: no third-party motion)."""
     return TrainingData(what=what, data=SYNTHETIC, hours=0.0,
                         note=f"{clips} synthetic clips (random sinusoids, no recorded motion)")
-
-
-def _read_json(path: Path) -> Any:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise SimdiffError(f"{path}: cannot read JSON: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
 
 
 def _split_ids(folder: Path, split: str) -> set[str] | None:

@@ -48,7 +48,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from simdiff.fsio import write_text
+from simdiff.fsio import read_json as _read_json, write_text
 from simdiff.data.augment.classes import load_motion_types
 from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
 from simdiff.data.augment.decide import decide
@@ -210,13 +210,6 @@ def _info_dict(info: Any) -> Any:
 
 def _shard_path(out: Path, index: int) -> Path:
     return out / SHARD_DIR / f"shard_{index:05d}.json"
-
-
-def _read_json(path: Path) -> Any:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as exc:
-        raise SimdiffError(f"cannot read {path}: {exc}") from None
 
 
 def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[AugmentEnv], list[list[str]]]:
