@@ -148,3 +148,26 @@ def test_adapters_train_on_a_simulator_augmented_corpus(runs, tmp_path) -> None:
     # Adapters refuse a corpus without φ.
     assert main(["train", "adapters", "--data", str(corpus), "--init", str(runs / "bb" / "model"),
                  "--steps", "1", "--out", str(tmp_path / "ad2"), "--no-progress"]) == 2
+
+
+def test_export_backbone_writes_the_frozen_backbone_bit_identical(runs, tmp_path, capsys) -> None:
+    from safetensors.torch import load_file
+
+    from simdiff.model import MotionGenerator
+    from simdiff.model.provenance import read_provenance
+
+    src, out = runs / "ad" / "model", tmp_path / "bb_only"
+    assert main(["train", "export-backbone", "--model", str(src), "--out", str(out)]) == 0
+    whole, alone = load_file(str(src / "model.safetensors")), load_file(str(out / "model.safetensors"))
+    backbone = {k[len("backbone."):]: v for k, v in whole.items() if k.startswith("backbone.")}
+    assert set(alone) == set(backbone) | {"normalizer.mean", "normalizer.std"}
+    assert all(torch.equal(alone[k], v) for k, v in backbone.items())
+    assert torch.equal(alone["normalizer.mean"], whole["normalizer.mean"])
+    gen = MotionGenerator.load(out, load_text=False)
+    assert not gen.is_simdiff and json.loads((out / "config.json").read_text())["sim"] is None
+    prov = read_provenance(out)
+    assert prov is not None and [p.what for p in prov.trained_on] == ["backbone"]
+    capsys.readouterr()
+    assert main(["train", "export-backbone", "--model", str(out), "--out", str(tmp_path / "again")]) == 2
+    err = capsys.readouterr().err
+    assert "already a backbone-only model" in err and err.count("\n") == 1

@@ -105,6 +105,27 @@ def load_pretrained(folder: str | os.PathLike[str], device: torch.device | str =
     return network.to(device), config, extra
 
 
+def export_backbone(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> Path:
+    """Write the frozen backbone of SimDiff model folder ``src`` as a backbone-only model folder ``dst``.
+
+    The weights are the backbone's own (bit-identical), with the feature Mean/Std; the config is
+    ``src``'s without its ``sim`` part; ``provenance.json`` keeps the backbone's records. The MDM rows
+    of an evaluation then run the very backbone the shipped SimDiff model was trained on.
+    """
+    from simdiff.model.provenance import Provenance, read_provenance, write_provenance
+
+    network, config, extra = load_pretrained(src)
+    if not isinstance(network, SimDiffNet):
+        raise SimdiffError(f"{src}: already a backbone-only model (config.json has no 'sim' part)")
+    out = Path(dst)
+    save_pretrained(out, network.backbone, dataclasses.replace(config, sim=None),
+                    {k: v for k, v in extra.items() if k.startswith("normalizer.")})
+    prov = read_provenance(src)
+    if prov is not None:
+        write_provenance(out, Provenance([p for p in prov.trained_on if p.what == "backbone"]))
+    return out
+
+
 # --- the official MDM checkpoint -------------------------------------------------------------
 
 _IGNORED_PREFIXES = ("clip_model.",)

@@ -1,4 +1,5 @@
-"""``simdiff train backbone|adapters``: train the MDM backbone, or SimDiff's adapters on a frozen one.
+"""``simdiff train backbone|adapters|export-backbone``: train the MDM backbone, or SimDiff's adapters on a
+frozen one; export a SimDiff model's backbone on its own.
 
 Multi-process: ``torchrun --nproc_per_node N -m simdiff train backbone ...`` (gloo on CPU,
 nccl on CUDA); ``--batch-size`` is the global batch.
@@ -54,6 +55,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--sim-mode", choices=["continuous", "categorical"], help="φ as (g_z, w_x, w_y) floats or a category")
     a.add_argument("--num-categories", type=int, help="number of environment categories (categorical)")
     a.set_defaults(func=run, mode="adapters")
+    e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
+                         description="Write the backbone of a SimDiff model folder (weights bit-identical, "
+                                     "Mean/Std, provenance) as its own model folder: the MDM rows of an evaluation.")
+    e.add_argument("--model", type=Path, required=True, help="SimDiff model folder (model.safetensors + config.json)")
+    e.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
+    e.set_defaults(func=run_export)
+
+
+def run_export(args: argparse.Namespace) -> int:
+    from simdiff.model.checkpoint import export_backbone
+
+    print(f"wrote {export_backbone(args.model, args.out)}")
+    return 0
 
 
 def _run_config(args: argparse.Namespace):
