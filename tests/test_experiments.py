@@ -287,6 +287,19 @@ def test_table1_uses_the_best_alpha_known_when_it_started(setup: dict[str, Path]
     assert [p.key for p in table1.plan(Runner(config, progress=False))][-1] == "SimDiff_ddim_alpha0.5"
 
 
+def test_a_method_may_list_its_own_alphas_in_table1(setup: dict[str, Path], tmp_path: Path) -> None:
+    """The simulated finish at the shipped α only, while the plain SimDiff rows take the table's α list."""
+    from simdiff.eval.experiments import table1
+
+    finish = {"name": "SimDiff + simulated finish", "model": "adapters_binary", "env_index": 1, "simulate": True,
+              "alphas": [1.0]}
+    plain = {"name": "SimDiff", "model": "adapters_binary", "env_index": 1}
+    config = load_config(write(setup, "table1", name="t1_own", alphas=[0.1, "best"], models=[finish, plain]), None,
+                         [("out_dir", str(tmp_path)), ("samplers", ["ddim"]), ("best_alpha", 0.5)])
+    keys = [p.key for p in table1.plan(Runner(config, progress=False))]
+    assert keys == ["ground_truth", "SimDiff___simulated_finish_ddim_alpha1", "SimDiff_ddim_alpha0.1", "SimDiff_ddim_alpha0.5"]
+
+
 def test_config_refuses_a_text_encoder_stand_in(setup: dict[str, Path]) -> None:
     with pytest.raises(SimdiffError, match="text_encoder 'hash' must be \"auto\""):
         load_config(write(setup, "fig4", name="hash_encoder", text_encoder="hash"))

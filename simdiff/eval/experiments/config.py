@@ -46,6 +46,9 @@ class ModelSpec:
         simulate: simulated finish: each final sample is re-tracked under its φ (Earth for
             categorical models) and the simulator's motion replaces it where tracked
             (``simdiff generate --simulate``); rows named e.g. ``SimDiff + simulated finish``.
+        alphas: this method's own α list in a table that lists α (table1: numbers and
+            ``"best"``), instead of the table's ``alphas`` (None: the table's); e.g. the simulated
+            finish at the shipped α only, where a best-α row of it would double the CPU time.
     """
 
     name: str
@@ -59,6 +62,7 @@ class ModelSpec:
     guidance: float = 2.5
     physdiff: dict[str, Any] | None = None
     simulate: bool = False
+    alphas: list[float | str] | None = None
 
     def sampler_steps(self, sampler: str) -> int | None:
         """Steps of ``sampler`` for this method."""

@@ -44,10 +44,10 @@ def _read_best_alpha(runner: Runner) -> tuple[float | None, str]:
                   "run table2 first (simdiff evaluate all does) and run table1 again")
 
 
-def alphas(runner: Runner) -> list[tuple[float, str]]:
-    """(α, why) for SimDiff rows, duplicates merged (``0.1 (paper, best)``)."""
+def alphas(runner: Runner, values: list[float | str] | None = None) -> list[tuple[float, str]]:
+    """(α, why) for SimDiff rows of ``values`` (None: the table's ``alphas``), duplicates merged (``0.1 (paper, best)``)."""
     out: dict[float, list[str]] = {}
-    for a in runner.config.alphas or [None]:
+    for a in (runner.config.alphas if values is None else values) or [None]:
         if a == "best":
             value, _ = best_alpha(runner)
             if value is not None:
@@ -66,7 +66,7 @@ def plan(runner: Runner) -> list[RowPlan]:
     for spec in c.models:
         for sampler in c.samplers:
             if runner.is_simdiff(spec):
-                pairs = sim_alphas or [(spec.alpha, "model")]
+                pairs = (sim_alphas if spec.alphas is None else alphas(runner, spec.alphas)) or [(spec.alpha, "model")]
                 plans += [method_plan(runner, spec, sampler, a, alpha_choice=why) for a, why in pairs]
             else:
                 plans.append(method_plan(runner, spec, sampler, None))
