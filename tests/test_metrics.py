@@ -139,3 +139,29 @@ def test_bad_input_errors() -> None:
         physics_metrics(np.zeros((3, 40, 22, 3)), lengths=[40, 40])
     with pytest.raises(SimdiffError, match=r"lengths\[0\]=1"):
         physics_metrics(np.zeros((1, 40, 22, 3)), lengths=[1])
+
+
+def test_own_floor_sliding_sees_the_skating_of_a_hovering_motion() -> None:
+    from simdiff.motion.metrics import own_floor_metrics
+
+    skating = standing(40, 0.0)
+    skating[:, :, 0] += 0.004 * np.arange(40)[:, None]  # the whole body slides 4 mm per frame
+    hovering = skating.copy()
+    hovering[..., 1] += 0.02  # the same, 2 cm up: CLoSD sees no contact
+    assert physics_metrics(hovering)["sliding"] == 0.0
+    own = own_floor_metrics(hovering)
+    assert own["sliding_own_floor"] == pytest.approx(4.0, rel=1e-5)
+    assert own["own_floor"] == pytest.approx(20.0, abs=1e-3)
+    # on y = 0 the two slidings agree, and the own floor is 0
+    on_floor = own_floor_metrics(skating)
+    assert on_floor["sliding_own_floor"] == pytest.approx(physics_metrics(skating)["sliding"])
+    assert on_floor["own_floor"] == pytest.approx(0.0, abs=1e-6)
+    # per motion and pooled over valid pairs: a batch of one hovering and one on the floor, second cut short
+    batch = np.stack([hovering, skating])
+    both = own_floor_metrics(batch, [40, 11])
+    assert both["sliding_own_floor"] == pytest.approx(4.0, rel=1e-5)
+    assert both["own_floor"] == pytest.approx(10.0, abs=1e-3)
+    # a motion that jumps keeps its stance as its floor (the 5th percentile, not the mean)
+    jump = hovering.copy()
+    jump[15:25, :, 1] += 0.3
+    assert own_floor_metrics(jump)["own_floor"] == pytest.approx(20.0, abs=1e-3)

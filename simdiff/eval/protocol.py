@@ -105,11 +105,11 @@ def _draw(dataset: Any, rng: np.random.Generator, config: ProtocolConfig) -> lis
 
 def _physics(features: Tensor, lengths: Tensor) -> dict[str, float]:
     from simdiff.motion.features import features_to_joints
-    from simdiff.motion.metrics import physics_metrics
+    from simdiff.motion.metrics import own_floor_metrics, physics_metrics
 
     joints = features_to_joints(features.detach().cpu().double())
     lens = lengths.clamp(min=2, max=joints.shape[1])
-    return physics_metrics(joints.numpy(), lens.numpy())
+    return {**physics_metrics(joints.numpy(), lens.numpy()), **own_floor_metrics(joints.numpy(), lens.numpy())}
 
 
 def _scores(text: np.ndarray, motion: np.ndarray, ref_motion: np.ndarray, config: ProtocolConfig,

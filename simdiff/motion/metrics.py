@@ -175,6 +175,40 @@ def physics_metrics(
     }
 
 
+OWN_FLOOR_PERCENTILE: float = 5.0
+"""Percentile of a motion's per-frame lowest-joint height taken as its own floor (see :func:`own_floor_metrics`)."""
+
+
+def own_floor_metrics(
+    joints: np.ndarray | torch.Tensor,
+    lengths: Sequence[int] | np.ndarray | torch.Tensor | None = None,
+) -> dict[str, float]:
+    """Sliding measured on each motion's own floor, and how far that floor is from y = 0.
+
+    CLoSD's sliding counts a lowest joint as in contact only within 5 mm of y = 0, so a motion
+    that hovers (its stance feet 2 cm up) scores 0 sliding however much its feet skate: the
+    metric is vacuous there, and Phys-Err rewards hovering as floating-to-GT once rewarded
+    sinking. Here every motion is first shifted so that its own floor, the
+    :data:`OWN_FLOOR_PERCENTILE`-th percentile of its lowest-joint height over its valid frames,
+    is at y = 0; then the same sliding is taken. On motion that stands on y = 0 the two agree.
+
+    Args:
+        joints: (B, T, 22, 3) or (T, 22, 3) metres, Y-up; lengths: (B,) valid frames (None: all).
+    Returns:
+        {"sliding_own_floor": mm/frame pooled over all valid frame pairs as :func:`physics_metrics`,
+         "own_floor": mean over samples of the own floor's height above y = 0 (mm; negative below)}.
+    """
+    arr, lens = _prepare(joints, lengths)
+    lowest = arr[..., 1].min(axis=-1).astype(np.float64)  # (B, T)
+    floor = np.array([np.percentile(lowest[b, : lens[b]], OWN_FLOOR_PERCENTILE) for b in range(len(lens))])
+    shifted = arr.astype(np.float64, copy=True)
+    shifted[..., 1] -= floor[:, None, None]
+    per = _per_sample(shifted, lens)
+    n_pairs = lens.astype(np.float64) - 1.0
+    return {"sliding_own_floor": float((per["sliding"] * n_pairs).sum() / n_pairs.sum()),
+            "own_floor": float(floor.mean() * 1000.0)}
+
+
 def floating_to_gt(
     joints: np.ndarray | torch.Tensor,
     gt_joints: np.ndarray | torch.Tensor,

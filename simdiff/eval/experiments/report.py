@@ -12,11 +12,17 @@ T2M_METRICS: tuple[tuple[str, str], ...] = (
     ("mm_dist", "MM-Dist↓"), ("diversity", "Diversity→"), ("multimodality", "MModality↑"))
 PHYSICS_METRICS: tuple[tuple[str, str], ...] = (
     ("penetration", "Penetrate (mm)↓"), ("floating", "Float (mm)→GT"), ("floating_to_gt", "|Float−GT| (mm)↓"),
-    ("sliding", "Slide (mm/frame)↓"), ("skate_ratio", "Skate ratio↓"))
+    ("sliding", "Slide (mm/frame)↓"), ("skate_ratio", "Skate ratio↓"), ("own_floor", "Own floor (mm)→0"),
+    ("sliding_own_floor", "Slide on own floor (mm/frame)↓"))
 PHYS_ERR_NOTE: str = ("Phys-Err = penetration + sliding + |floating − ground truth's floating| (mm). PhysDiff adds raw "
                       "floating, so a motion that sinks into the floor scores better than the ground truth; floating is "
                       "'→' (closer to ground truth is better), so it enters as its distance to the ground truth's "
                       "floating on the same captions.")
+OWN_FLOOR_NOTE: str = ("Slide counts a lowest joint as in contact only within 5 mm of y = 0, so motion that hovers "
+                       "scores 0 however its feet skate (and Phys-Err, which adds Slide, rewards hovering). 'Own floor' is "
+                       "the 5th percentile of each motion's lowest-joint height (mm above y = 0, mean over motions); 'Slide "
+                       "on own floor' is the same sliding after moving each motion's own floor to y = 0 "
+                       "(simdiff.motion.metrics.own_floor_metrics).")
 INTERVAL_NOTE: str = ("± is the Student-t 95 % half-width over the R replications (t_{0.975,R−1}·s/√R, sample std); "
                       "n × R: motions per replication × replications.")
 FID_NOTE: str = ("FID is biased upwards at small n (covariance rank ≤ n − 1 in a D-dimensional embedding): read a "

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from simdiff.eval.experiments.report import FID_NOTE, INTERVAL_NOTE, PHYS_ERR_NOTE, PHYSICS_METRICS, T2M_METRICS, mean_ci, save_figure, value
+from simdiff.eval.experiments.report import FID_NOTE, INTERVAL_NOTE, OWN_FLOOR_NOTE, PHYS_ERR_NOTE, PHYSICS_METRICS, T2M_METRICS, mean_ci, save_figure, value
 from simdiff.eval.experiments.rows import phys_err, phys_err_ci
 
 
@@ -33,7 +33,7 @@ def metrics_table(rows: list[dict[str, Any]], first: str = "Method") -> list[str
                      f" | {value(phys_err(r), 2)} | {sps} |")
     if any("summary" not in r for r in rows):
         lines += ["", "† physics metrics and time only: too few motions for R-precision (batches of 32), FID or Diversity."]
-    lines += ["", f"* {INTERVAL_NOTE}", f"* {PHYS_ERR_NOTE}", f"* {FID_NOTE}"]
+    lines += ["", f"* {INTERVAL_NOTE}", f"* {PHYS_ERR_NOTE}", f"* {OWN_FLOOR_NOTE}", f"* {FID_NOTE}"]
     seeds = next((r["seeds"] for r in rows if r.get("seeds")), None)
     if seeds:
         lines.append(f"* seeds: protocol base seed {seeds.get('base', seeds)}; replication r draws its data with "
