@@ -203,10 +203,7 @@ def own_floor_metrics(
     floor = np.array([np.percentile(lowest[b, : lens[b]], OWN_FLOOR_PERCENTILE) for b in range(len(lens))])
     shifted = arr.astype(np.float64, copy=True)
     shifted[..., 1] -= floor[:, None, None]
-    per = _per_sample(shifted, lens)
-    n_pairs = lens.astype(np.float64) - 1.0
-    return {"sliding_own_floor": float((per["sliding"] * n_pairs).sum() / n_pairs.sum()),
-            "own_floor": float(floor.mean() * 1000.0)}
+    return {"sliding_own_floor": physics_metrics(shifted, lens)["sliding"], "own_floor": float(floor.mean() * 1000.0)}
 
 
 def floating_to_gt(
