@@ -124,3 +124,44 @@ def test_second_derivative5_is_scipys_quadratic_savgol_and_exact_for_free_fall()
         np.testing.assert_allclose(second_derivative5(x, 20.0), want, rtol=1e-9, atol=1e-9)
     t = np.arange(30) / 20.0
     np.testing.assert_allclose(second_derivative5(1.0 + 2.0 * t - 0.5 * 9.81 * t**2, 20.0), -9.81, atol=1e-9)
+
+
+def test_stance_anchor_shift_cancels_planted_drift_and_keeps_steps():
+    from simdiff.sim.retarget.contacts import stance_anchor_shift
+
+    T = 11
+    xy = np.zeros((T, 4, 2))
+    xy[:, :, 0] = 0.01 * np.arange(T)[:, None]  # every box drifts +1 cm/frame
+    contact = np.ones((T, 4), dtype=bool)
+    shift = stance_anchor_shift(contact, xy)
+    assert shift.shape == (T, 2) and np.all(shift[0] == 0)
+    np.testing.assert_allclose(xy[:, :, 0] + shift[:, :1], 0.0, atol=1e-12)  # planted: held where it landed
+    # no contact: nothing moves; one planted foot drifting while the other swings: only the planted one counts
+    np.testing.assert_array_equal(stance_anchor_shift(np.zeros((T, 4), dtype=bool), xy), 0.0)
+    step = xy.copy()
+    step[:, 2:, 0] = 0.05 * np.arange(T)[:, None]  # right foot swings forward 5 cm/frame
+    half = np.zeros((T, 4), dtype=bool)
+    half[:, :2] = True
+    np.testing.assert_allclose(stance_anchor_shift(half, step)[:, 0], -0.01 * np.arange(T), atol=1e-12)
+    # a contact that lasts one frame has no displacement to cancel
+    blink = np.zeros((T, 4), dtype=bool)
+    blink[5] = True
+    np.testing.assert_array_equal(stance_anchor_shift(blink, xy), 0.0)
+
+
+def test_anchored_reference_keeps_a_skating_stand_in_place():
+    """A stand whose whole body glides 1 cm/frame on planted feet (what a generated 'jump in place'
+    does): anchored, the reference's pelvis and feet stay put; unanchored it glides."""
+    from simdiff.sim.retarget import RetargetConfig
+
+    still = synthetic.standing(40)
+    glide = still.copy()
+    glide[..., 0] += 0.01 * np.arange(40)[:, None]
+    model = load_model()
+    plain = make_reference(model, glide)
+    anchored = make_reference(model, glide, RetargetConfig(anchor_stance=True))
+    travel = lambda ref: float(np.linalg.norm(ref.qpos[-1, :2] - ref.qpos[0, :2]))  # noqa: E731
+    assert travel(plain) > 0.3
+    assert travel(anchored) < 0.02
+    feet = anchored.body_pos[:, [7, 8, 10, 11], :2]
+    assert np.abs(feet - feet[:1]).max() < 0.02

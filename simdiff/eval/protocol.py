@@ -214,12 +214,14 @@ def _multimodality(evaluator: Evaluator, batches: list[dict[str, Any]], generate
 
 def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_index: int | None = None, alpha: float = 1.0,
                  sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5,
-                 physdiff: Any = None, projector: Any = None, simulate: bool = False) -> GenerateFn:
+                 physdiff: Any = None, projector: Any = None, simulate: bool = False,
+                 finish_projector: Any = None) -> GenerateFn:
     """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
 
-    ``simulate``: the simulated finish: every final sample is re-tracked by ``projector`` under φ
-    (``env``, Earth when None) and its features are replaced by the rollout's where it tracked
-    (frames after a fall keep the generated ones, as a PhysDiff projection does).
+    ``simulate``: the simulated finish: every final sample is re-tracked by ``finish_projector``
+    (default ``projector``) under φ (``env``, Earth when None) and its features are replaced by the
+    rollout's where it tracked (frames after a fall keep the generated ones, as a PhysDiff
+    projection does).
     """
 
     def generate(captions: list[str], lengths: list[int], seed: int) -> Tensor:
@@ -234,7 +236,7 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
             out = generator.generate(captions, lengths, sampler=sampler, steps=steps, guidance=guidance, seed=seed, **kwargs)
         feats = out.features.detach().cpu()
         if simulate:
-            feats = simulated_finish(generator, feats, lengths, env, projector)
+            feats = simulated_finish(generator, feats, lengths, env, finish_projector or projector)
         return feats
 
     return generate

@@ -55,7 +55,7 @@ def _finite(value: Any) -> Any:
 
 
 def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: Any = None, max_force: float = 0.5,
-                    follow_flights: bool = True, force: bool = False) -> SimulatedMotion:
+                    follow_flights: bool = True, force: bool = False, anchor_stance: bool = True) -> SimulatedMotion:
     """Re-track ``joints`` under ``env`` (Earth when None) and return the rollout with its tracking result.
 
     Args:
@@ -65,11 +65,15 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
         max_force: tracker root-residual bound (fraction of m·|g_z|), as in the augmentation.
         follow_flights: flights last as long as φ makes them (the rollout may change length).
         force: allow φ outside the validated range.
+        anchor_stance: planted feet stay where they touched down; the body's skating drift is
+            taken out of the reference before tracking (see
+            :attr:`simdiff.sim.retarget.RetargetConfig.anchor_stance`).
     """
     from simdiff.motion.metrics import physics_metrics
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
     from simdiff.sim.residual import ResidualConfig
+    from simdiff.sim.retarget import RetargetConfig
 
     arr = np.asarray(joints, dtype=np.float64)
     if arr.ndim != 3 or arr.shape[1:] != (22, 3) or arr.shape[0] < 2:
@@ -77,11 +81,13 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     phi = env if env is not None else EARTH
     start = time.perf_counter()
     out, info = project(arr, phi, residual=ResidualConfig(max_force=max_force), normalizer=normalizer, force=force,
-                        flight=FlightConfig() if follow_flights else None)
+                        flight=FlightConfig() if follow_flights else None,
+                        retarget=RetargetConfig(anchor_stance=anchor_stance))
     wall = time.perf_counter() - start
     out = np.asarray(out, dtype=np.float32)
     tracking = info.to_dict()
     tracking.update(wall_s=wall, env_assumed=env is None, follow_flights=follow_flights, max_force=max_force,
+                    anchor_stance=anchor_stance,
                     physics_generated=physics_metrics(arr), physics_simulated=physics_metrics(out) if len(out) >= 2 else None)
     return SimulatedMotion(out, _finite(tracking))
 

@@ -56,7 +56,7 @@ def measure(runner: Runner, spec: ModelSpec, sampler: str) -> dict[str, Any]:
                 begin = time.perf_counter()
                 joints = np.asarray(features_to_joints(out.clips()[0].detach().cpu().double()))
                 env = Environment(*kwargs["env"]) if kwargs.get("env") else Environment()
-                list(runner.serial_projector()([joints], [env]))
+                list(runner.serial_projector(anchor_stance=True)([joints], [env]))
                 proj.append(time.perf_counter() - begin)
         times.append(time.perf_counter() - start)
     return {"times_s": times, "median_s": statistics.median(times),

@@ -86,6 +86,7 @@ class Runner:
             self.provenance["machine"]["torch_threads"] = config.threads
         self._injected = projector
         self._projector: Any = projector
+        self._finish_projector: Any = None
         self._models: dict[str, Any] = {}
         self._encoders: dict[str, Any] = {}
         self._evaluator: Any = None
@@ -167,31 +168,47 @@ class Runner:
             self._dataset = HumanML3D(corpus, self.config.split, seed=self.config.seed)
         return self._dataset
 
+    def _pool_projector(self, anchor_stance: bool) -> Any:
+        """A persistent simulator pool with the config's parallelism and residual bound."""
+        from simdiff.data.augment.projector import SimProjector
+
+        p = self.config.projector
+        corpus = Path(self.config.corpus).expanduser()
+        stats = str(corpus) if (corpus / "Mean.npy").is_file() else None  # d_L2 needs them; tracking does not
+        return SimProjector(stats, p.workers, p.backend, p.residual_bound, anchor_stance=anchor_stance)
+
     @property
     def sim(self) -> Any:
         """The projector PhysDiff and re-tracking use (injected, or a persistent simulator pool)."""
         if self._projector is None:
-            from simdiff.data.augment.projector import SimProjector
-
-            p = self.config.projector
-            corpus = Path(self.config.corpus).expanduser()
-            stats = str(corpus) if (corpus / "Mean.npy").is_file() else None  # d_L2 needs them; tracking does not
-            self._projector = SimProjector(stats, p.workers, p.backend, p.residual_bound)
+            self._projector = self._pool_projector(anchor_stance=False)
         return self._projector
 
-    def serial_projector(self) -> Any:
+    @property
+    def finish_sim(self) -> Any:
+        """The projector of the simulated finish: :attr:`sim`'s tracker with the planted feet anchored
+        (``simdiff generate --simulate``'s setting, :func:`simdiff.product.simulate.simulate_finish`)."""
+        if self._injected is not None:
+            return self._injected
+        if self._finish_projector is None:
+            self._finish_projector = self._pool_projector(anchor_stance=True)
+        return self._finish_projector
+
+    def serial_projector(self, anchor_stance: bool = False) -> Any:
         """An in-process simulator (batch-1 timing), or the injected projector."""
         if self._injected is not None:
             return self._injected
         from simdiff.data.augment.projector import SimProjector
 
-        return SimProjector(None, 1, "serial", self.config.projector.residual_bound)
+        return SimProjector(None, 1, "serial", self.config.projector.residual_bound, anchor_stance=anchor_stance)
 
     def close(self) -> None:
         """Stop the simulator workers this runner started."""
-        if self._projector is not None and self._injected is None:
-            getattr(self._projector, "close", lambda: None)()
-            self._projector = None
+        if self._injected is None:
+            for p in (self._projector, self._finish_projector):
+                if p is not None:
+                    getattr(p, "close", lambda: None)()
+            self._projector = self._finish_projector = None
 
     def preflight(self, needs_evaluator: bool, needs_corpus: bool = True) -> None:
         """Check that the corpus, the evaluator and every model folder exist before measuring anything."""
@@ -254,7 +271,8 @@ class Runner:
         return generator_fn(gen, env=use_env, env_index=spec.env_index if gen.is_simdiff else None,
                             alpha=spec.alpha if alpha is None else float(alpha), sampler=sampler,
                             steps=spec.sampler_steps(sampler), guidance=spec.guidance, physdiff=phys,
-                            projector=self.sim if phys is not None or spec.simulate else None, simulate=spec.simulate)
+                            projector=self.sim if phys is not None else None, simulate=spec.simulate,
+                            finish_projector=self.finish_sim if spec.simulate else None)
 
     def generate(self, fn: GenerateFn, captions: list[str], lengths: list[int], seed: int) -> tuple[torch.Tensor, float]:
         """Generate in batches of the protocol's size; returns ((N, T, 263) features, seconds)."""

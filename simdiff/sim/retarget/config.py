@@ -36,6 +36,12 @@ class RetargetConfig:
             touching corners (see :func:`inverse_dynamics_screen`; 0: plain NNLS).
         spike_distance: isolated joint samples this far (m) from their neighbours are
             mocap glitches and get replaced (0 = off).
+        anchor_stance: move the whole body horizontally so that feet in contact stay where
+            they touched down (:func:`~simdiff.sim.retarget.contacts.stance_anchor_shift`):
+            a skating foot then carries no body translation the floor could not give. Off for
+            the augmentation (mocap feet barely slide); on for the simulated finish of generated
+            motion, whose stance feet drift with the body (measured: a generated jump in place
+            slid 2.1 mm/frame after tracking without it, 0.06 with it).
     """
 
     fps: float = HML_FPS
@@ -53,6 +59,7 @@ class RetargetConfig:
     support_accel: float = 0.5
     support_reach: float = 0.15
     spike_distance: float = 0.25
+    anchor_stance: bool = False
 
 
 @dataclass

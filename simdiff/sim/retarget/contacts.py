@@ -33,6 +33,25 @@ def contact_schedule(height: np.ndarray, xy: np.ndarray, fps: float, cfg: Retarg
     return c
 
 
+def stance_anchor_shift(contact: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """(T, 2) horizontal offset (m) that keeps feet in contact where they touched down.
+
+    Between frames t and t+1 the body is moved back by the mean horizontal displacement of the
+    foot boxes in contact at both frames; the moves accumulate (the offset at frame 0 is 0). A
+    motion whose planted feet slide with the body (a generated "jump in place" that drifts on the
+    spot) loses that drift; a walk keeps the travel its steps make and loses the skating part.
+
+    Args:
+        contact: (T, 4) bool schedule (:func:`contact_schedule`); xy: (T, 4, 2) box centres (m).
+    """
+    contact = np.asarray(contact, dtype=bool)
+    step = np.diff(np.asarray(xy, dtype=np.float64), axis=0)  # (T-1, 4, 2)
+    held = contact[:-1] & contact[1:]  # (T-1, 4)
+    n = held.sum(axis=1, keepdims=True)
+    mean = (step * held[..., None]).sum(axis=1) / np.maximum(n, 1)
+    return np.concatenate([np.zeros((1, 2)), -np.cumsum(mean, axis=0)])
+
+
 _D2_QUADRATIC5: np.ndarray = np.array([2.0, -1.0, -2.0, -1.0, 2.0]) / 7.0
 """Least-squares quadratic over 5 equally spaced samples: its (constant) second derivative, per unit step²."""
 

@@ -5,6 +5,8 @@
 2. ground alignment and a contact schedule per foot (heel box / toe box low and slow),
    plus inferred support where the COM is held up but no foot is scheduled
    (:func:`~simdiff.sim.retarget.contacts.infer_support`: a jump's toe push, a relevé);
+   with ``anchor_stance`` the body is shifted horizontally so that planted feet stay put
+   (:func:`~simdiff.sim.retarget.contacts.stance_anchor_shift`);
 3. a second IK pass that holds every stance foot (or toe, at toe-off) flat, at a fixed xy
    and on the floor;
 4. temporal Gaussian filtering **before** anything is cropped, with odd-reflection padding
@@ -21,7 +23,8 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.sim.humanoid import hml_to_world, model_index
 from simdiff.sim.retarget.config import Reference, RetargetConfig
-from simdiff.sim.retarget.contacts import contact_schedule, ground_level, infer_support, stance_tasks
+from simdiff.sim.retarget.contacts import (contact_schedule, ground_level, infer_support, stance_anchor_shift,
+                                           stance_tasks)
 from simdiff.sim.retarget.dynamics import inverse_dynamics_screen
 from simdiff.sim.retarget.filtering import continuous_quats, despike, finite_velocity, resample_qpos, smooth
 from simdiff.sim.retarget.ik import ik_sequence
@@ -63,6 +66,12 @@ def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConf
     q1[:, 2] += shift
     h += shift
     contact = contact_schedule(h, xy, fps, cfg)
+    if cfg.anchor_stance:
+        offset = stance_anchor_shift(contact, xy)  # (T, 2), world xy
+        q1[:, :2] += offset
+        xy = xy + offset[:, None]
+        target = target.copy()
+        target[..., :2] += offset[:, None]
     reach = None
     if cfg.support_accel > 0:
         reach = infer_support(contact, h, xy, com_height(model, q1), fps, cfg.support_accel, cfg.support_reach,
