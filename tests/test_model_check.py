@@ -69,7 +69,8 @@ def test_check_writes_every_field(checked: dict) -> None:
     assert any("replications=1" in p for p in split["claim_problems"])  # the quick preset carries no claim
     for key in ("sliding", "skate_ratio", "r_precision_top3", "fid"):
         assert key in split["generated"] and key in split["ground_truth"]
-    assert set(split["ratios"]) == {"skate_ratio", "r_precision_top3", "fid_over_floor", "sliding_over_gt"}
+    assert set(split["ratios"]) == {"skate_ratio", "r_precision_top3", "fid_over_floor", "sliding_over_gt",
+                                    "sliding_own_floor_over_gt"}
     jumps = report["jumps"]
     assert [r["n"] for r in jumps["per_prompt"]] == [2] * 6 and jumps["overall"]["n"] == 12
     assert "outside every flight" in jumps["rule"]["standing_level"]
@@ -89,7 +90,8 @@ def test_verdicts_follow_the_figures(checked: dict) -> None:
     assert report["verdicts"] == verdicts(figures(report))
     by = {v["check"]: v for v in report["verdicts"]}
     f = report["figures"]
-    assert by["sliding"]["passed"] == (f["sliding"] <= 1.0)
+    assert by["sliding"]["passed"] == (f["sliding_own_floor"] <= 1.0)
+    assert by["sliding"]["value"] == f["sliding_own_floor"]
     assert by["fid"]["threshold"] == pytest.approx(3 * f["gt_fid"])
     assert by["generate_speed"]["passed"] is True
 
@@ -120,6 +122,15 @@ def test_sliding_is_na_when_the_samples_hover() -> None:
     near = {v["check"]: v for v in verdicts({**base, "floating": 17.0})}["sliding"]
     assert near["passed"] is True
     assert {v["check"]: v for v in verdicts({**base, "sliding": 2.0})}["sliding"]["passed"] is False
+
+
+def test_sliding_is_judged_on_the_samples_own_floor() -> None:
+    """With the own-floor figure present it decides: a hovering skater's CLoSD sliding of 0 does not pass."""
+    hovering_skater = {"sliding": 0.0, "floating": 23.7, "gt_floating": 12.7, "sliding_own_floor": 7.7, "own_floor": 16.8,
+                       "gt_sliding_own_floor": 0.47}
+    v = {v["check"]: v for v in verdicts(hovering_skater)}["sliding"]
+    assert v["passed"] is False and v["value"] == 7.7 and "own floor" in v["detail"]
+    assert {v["check"]: v for v in verdicts({**hovering_skater, "sliding_own_floor": 0.9})}["sliding"]["passed"] is True
 
 
 def test_jump_detection_on_ballistic_pelvis() -> None:

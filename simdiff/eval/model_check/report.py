@@ -57,8 +57,8 @@ def _split_lines(s: dict[str, Any]) -> list[str]:
         lines.append(f"R-precision batch {s['batch_size']} (not 32): not comparable with protocol numbers.")
     lines += ["", "| metric | generated | ground truth | generated / GT (per replication) |", "|---|---|---|---|"]
     ratio = {"skate_ratio": "skate_ratio", "r_precision_top3": "r_precision_top3", "fid": "fid_over_floor",
-             "sliding": "sliding_over_gt"}
-    for key in ("sliding", "skate_ratio", "penetration", "floating", "r_precision_top1", "r_precision_top3", "mm_dist",
+             "sliding": "sliding_over_gt", "sliding_own_floor": "sliding_own_floor_over_gt"}
+    for key in ("sliding", "sliding_own_floor", "own_floor", "skate_ratio", "penetration", "floating", "r_precision_top1", "r_precision_top3", "mm_dist",
                 "fid", "diversity"):
         r = s["ratios"].get(ratio.get(key, ""))
         lines.append(f"| {key}{' (FID floor for GT)' if key == 'fid' else ''} | {_ci(s['generated'].get(key))} | "

@@ -29,6 +29,7 @@ RATIOS: dict[str, tuple[str, str]] = {
     "r_precision_top3": ("r_precision_top3", "r_precision_top3"),
     "fid_over_floor": ("fid", "fid"),
     "sliding_over_gt": ("sliding", "sliding"),
+    "sliding_own_floor_over_gt": ("sliding_own_floor", "sliding_own_floor"),
 }
 """Per-replication ratios generated / ground truth (name: (generated metric, GT metric))."""
 

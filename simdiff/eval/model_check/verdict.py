@@ -11,7 +11,7 @@ import math
 from typing import Any
 
 RULES: dict[str, str] = {
-    "sliding": "generated sliding ≤ 1.0 mm/frame",
+    "sliding": "generated sliding on its own floor ≤ 1.0 mm/frame",
     "skate_ratio": "generated skate ratio ≤ 2 × ground truth's",
     "r_precision_top3": "generated R@3 ≥ 0.8 × ground truth's",
     "fid": "generated FID ≤ 3 × ground truth's FID floor (same n)",
@@ -53,17 +53,28 @@ def _at_least(check: str, value: Any, limit: Any, detail: str = "") -> dict[str,
 
 
 def _sliding(f: dict[str, Any]) -> dict[str, Any]:
-    """Sliding ≤ 1.0 mm/frame, n/a when the samples hover: sliding only counts frame pairs whose
-    lowest joint is within the metric's 5 mm slack of the floor, so a motion whose lowest joint
-    floats higher than the ground truth's by more than that slack (mean floating, mm) scores low
-    sliding without touching the floor; the figure then says nothing about foot skating."""
-    v = _at_most("sliding", f.get("sliding"), 1.0, "mm/frame")
+    """Sliding ≤ 1.0 mm/frame, measured on each motion's own floor
+    (:func:`simdiff.motion.metrics.own_floor_metrics`): CLoSD's sliding counts only frame pairs
+    whose lowest joint is within 5 mm of y = 0, so samples that hover 2 cm up score 0 however
+    their feet skate. Reports written before the own-floor figure existed fall back to CLoSD's
+    sliding, n/a when the samples float more than :data:`HOVER_MM` above the ground truth."""
+    own = _num(f.get("sliding_own_floor"))
+    if own is not None:
+        return _at_most("sliding", own, 1.0, f"mm/frame on the samples' own floor (GT {_fmt(f.get('gt_sliding_own_floor'))}; "
+                                              f"CLoSD's sliding {_fmt(f.get('sliding'))}, own floor "
+                                              f"{_fmt(f.get('own_floor'))} mm above y = 0)")
+    v = _at_most("sliding", f.get("sliding"), 1.0, "mm/frame (CLoSD's; no own-floor figure in this report)")
     fl, gt_fl = _num(f.get("floating")), _num(f.get("gt_floating"))
     if v["passed"] and fl is not None and gt_fl is not None and fl - gt_fl > HOVER_MM:
         v["passed"] = None
         v["detail"] = (f"mm/frame; n/a: the samples hover (floating {fl:.1f} mm vs ground truth {gt_fl:.1f} mm), "
                        "so few frames are within 5 mm of the floor")
     return v
+
+
+def _fmt(value: Any) -> str:
+    v = _num(value)
+    return "n/a" if v is None else f"{v:.3g}"
 
 
 def verdicts(f: dict[str, Any]) -> list[dict[str, Any]]:
@@ -103,7 +114,7 @@ def figures(report: dict[str, Any]) -> dict[str, Any]:
     f: dict[str, Any] = {}
     split = report.get("test_split") or {}
     gen, gt = split.get("generated") or {}, split.get("ground_truth") or {}
-    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid", "floating"):
+    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid", "floating", "sliding_own_floor", "own_floor"):
         f[key] = (gen.get(key) or {}).get("mean")
         f[f"gt_{key}"] = (gt.get(key) or {}).get("mean")
     f["jump_fraction"] = ((report.get("jumps") or {}).get("overall") or {}).get("fraction")
