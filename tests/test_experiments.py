@@ -373,3 +373,19 @@ def test_simulated_finish_rows_in_table1_and_fig4(setup: dict[str, Path]) -> Non
     cell = next(r for r in fig["rows"] if r["method"] == "SimDiff + simulated finish")
     assert cell["projection_median_s"] is not None and len(cell["times_s"]) == 2
     assert sim.calls[-1][0] == [24]  # the final sample's joints, once per repeat
+
+
+def test_the_simulated_finish_anchors_planted_feet_and_physdiff_does_not(setup: dict[str, Path]) -> None:
+    """One tracker for PhysDiff and re-tracking (the augmentation's), the finish's with anchored stance feet."""
+    from simdiff.eval.experiments.config import load_config
+    from simdiff.eval.experiments.runner import Runner
+
+    runner = Runner(load_config(write(setup, "table1", name="t1_anchor")))
+    try:
+        assert runner.sim._pool.cfg.retarget.anchor_stance is False
+        assert runner.finish_sim._pool.cfg.retarget.anchor_stance is True
+        assert runner.serial_projector(anchor_stance=True)._pool.cfg.retarget.anchor_stance is True
+    finally:
+        runner.close()
+    injected = EchoProjector()
+    assert Runner(load_config(write(setup, "table1", name="t1_inj")), projector=injected).finish_sim is injected
