@@ -300,6 +300,25 @@ def test_a_method_may_list_its_own_alphas_in_table1(setup: dict[str, Path], tmp_
     assert keys == ["ground_truth", "SimDiff___simulated_finish_ddim_alpha1", "SimDiff_ddim_alpha0.1", "SimDiff_ddim_alpha0.5"]
 
 
+def test_a_method_may_list_its_own_samplers(setup: dict[str, Path], tmp_path: Path) -> None:
+    """DDPM rows for MDM and SimDiff at α = 1 only; the binary model and the finish stay DDIM-only."""
+    from simdiff.eval.experiments import table1
+
+    mdm = {"name": "MDM", "model": "backbone"}
+    finish = {"name": "SimDiff + simulated finish", "model": "adapters_binary", "env_index": 1, "simulate": True,
+              "alphas": [1.0], "samplers": ["ddim"]}
+    ddim = {"name": "SimDiff", "model": "adapters_binary", "env_index": 1, "samplers": ["ddim"]}
+    ddpm = {"name": "SimDiff", "model": "adapters_binary", "env_index": 1, "samplers": ["ddpm"], "alphas": [1.0]}
+    config = load_config(write(setup, "table1", name="t1_samplers", alphas=[1.0, "best"], models=[mdm, finish, ddim, ddpm]),
+                         None, [("out_dir", str(tmp_path)), ("samplers", ["ddim", "ddpm"]), ("best_alpha", 0.1)])
+    keys = [p.key for p in table1.plan(Runner(config, progress=False))]
+    assert keys == ["ground_truth", "MDM_ddim", "MDM_ddpm", "SimDiff___simulated_finish_ddim_alpha1", "SimDiff_ddim_alpha1",
+                    "SimDiff_ddim_alpha0.1", "SimDiff_ddpm_alpha1"]
+    with pytest.raises(SimdiffError, match="model 'MDM' sampler 'ddpm' is not one of the table's samplers"):
+        load_config(write(setup, "table1", name="t1_bad_sampler", models=[{**mdm, "samplers": ["ddpm"]}]), None,
+                    [("samplers", ["ddim"])])
+
+
 def test_config_refuses_a_text_encoder_stand_in(setup: dict[str, Path]) -> None:
     with pytest.raises(SimdiffError, match="text_encoder 'hash' must be \"auto\""):
         load_config(write(setup, "fig4", name="hash_encoder", text_encoder="hash"))

@@ -149,6 +149,35 @@ def test_stance_anchor_shift_cancels_planted_drift_and_keeps_steps():
     np.testing.assert_array_equal(stance_anchor_shift(blink, xy), 0.0)
 
 
+def test_skating_support_is_the_lowest_box_where_nothing_is_planted():
+    from simdiff.sim.retarget.contacts import skating_support
+
+    contact = np.zeros((4, 4), dtype=bool)
+    contact[0, 1] = True  # frame 0 has a planted box: nothing added
+    height = np.array([[0.01, 0.0, 0.1, 0.1],  # planted
+                       [0.03, 0.025, 0.2, 0.01],  # gliding on the floor: R toe is lowest
+                       [0.3, 0.2, 0.1, 0.05],  # flight (lowest sole 5 cm ≥ reach 4 cm)
+                       [0.0, 0.005, 0.1, 0.1]])  # a flat left foot: heel and toe within 1 cm
+    out = skating_support(contact, height, 0.04)
+    assert out.dtype == bool and out.shape == (4, 4)
+    assert out.tolist() == [[False] * 4, [False, False, False, True], [False] * 4, [True, True, False, False]]
+
+
+def test_anchored_reference_holds_a_stand_that_glides_too_fast_to_count_as_planted():
+    """A stand gliding 5 cm/frame (1 m/s, above the schedule's contact speed, as a generated run's
+    stance foot does): no foot is planted, the lowest one anchors the body anyway."""
+    from simdiff.sim.retarget import RetargetConfig
+
+    glide = synthetic.standing(40)
+    glide[..., 0] += 0.05 * np.arange(40)[:, None]
+    model = load_model()
+    plain = make_reference(model, glide)
+    anchored = make_reference(model, glide, RetargetConfig(anchor_stance=True))
+    travel = lambda ref: float(np.linalg.norm(ref.qpos[-1, :2] - ref.qpos[0, :2]))  # noqa: E731
+    assert travel(plain) > 1.5
+    assert travel(anchored) < 0.05
+
+
 def test_anchored_reference_keeps_a_skating_stand_in_place():
     """A stand whose whole body glides 1 cm/frame on planted feet (what a generated 'jump in place'
     does): anchored, the reference's pelvis and feet stay put; unanchored it glides."""

@@ -74,6 +74,7 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     from simdiff.sim.project import project
     from simdiff.sim.residual import ResidualConfig
     from simdiff.sim.retarget import RetargetConfig
+    from simdiff.sim.retarget.contacts import ANCHOR_VERSION
 
     arr = np.asarray(joints, dtype=np.float64)
     if arr.ndim != 3 or arr.shape[1:] != (22, 3) or arr.shape[0] < 2:
@@ -87,7 +88,7 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     out = np.asarray(out, dtype=np.float32)
     tracking = info.to_dict()
     tracking.update(wall_s=wall, env_assumed=env is None, follow_flights=follow_flights, max_force=max_force,
-                    anchor_stance=anchor_stance,
+                    anchor_stance=anchor_stance, anchor_version=ANCHOR_VERSION if anchor_stance else None,
                     physics_generated=physics_metrics(arr), physics_simulated=physics_metrics(out) if len(out) >= 2 else None)
     return SimulatedMotion(out, _finite(tracking))
 

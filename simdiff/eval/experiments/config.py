@@ -49,6 +49,9 @@ class ModelSpec:
         alphas: this method's own α list in a table that lists α (table1: numbers and
             ``"best"``), instead of the table's ``alphas`` (None: the table's); e.g. the simulated
             finish at the shipped α only, where a best-α row of it would double the CPU time.
+        samplers: this method's own samplers, a subset of the table's ``samplers`` (None: the
+            table's); e.g. DDPM rows for MDM, PhysDiff and SimDiff only, where every method's
+            DDPM row would cost a CPU hour more.
     """
 
     name: str
@@ -63,10 +66,15 @@ class ModelSpec:
     physdiff: dict[str, Any] | None = None
     simulate: bool = False
     alphas: list[float | str] | None = None
+    samplers: list[str] | None = None
 
     def sampler_steps(self, sampler: str) -> int | None:
         """Steps of ``sampler`` for this method."""
         return self.ddpm_steps if sampler == "ddpm" else self.steps
+
+    def own_samplers(self, table: list[str]) -> list[str]:
+        """The samplers this method runs in a table that lists ``table`` (the table's order)."""
+        return [s for s in table if self.samplers is None or s in self.samplers]
 
 
 @dataclass
@@ -336,6 +344,11 @@ def check(config: ExperimentConfig, origin: str | os.PathLike[str] = "config") -
             raise SimdiffError(f"{origin}: model {spec.name!r} needs 'model' (a role) or 'path'")
         if spec.model and not spec.path and spec.model not in config.paths:
             raise SimdiffError(f"{origin}: model {spec.name!r} names role {spec.model!r}, which 'paths' does not define")
+        if spec.samplers is not None:
+            extra = [s for s in spec.samplers if s not in config.samplers]
+            if extra or not spec.samplers:
+                raise SimdiffError(f"{origin}: model {spec.name!r} sampler {extra[0] if extra else '(none)'!r} is not "
+                                   f"one of the table's samplers ({', '.join(config.samplers)})")
     for env in config.envs + config.env_control.combos:
         if len(env) != 3:
             raise SimdiffError(f"{origin}: environment {env!r} must be 3 numbers (g_z, w_x, w_y)")

@@ -69,7 +69,7 @@ def plan(runner: Runner) -> list[RowPlan]:
     machine = {"host": platform.node(), "threads": runner.provenance["machine"]["torch_threads"]}
     plans = []
     for spec in c.models:
-        for sampler in c.samplers:
+        for sampler in spec.own_samplers(c.samplers):
             repeats = t.ddpm_repeats if sampler == "ddpm" else t.repeats
             est = runner.motion_seconds(spec, sampler, repeats, t.length / FPS, workers=1)
             est += runner.motion_seconds(spec, "ddim", t.warmup, t.length / FPS, workers=1)

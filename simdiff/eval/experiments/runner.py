@@ -243,7 +243,10 @@ class Runner:
             out["physdiff"] = dataclasses.asdict(self.physdiff_config(spec, sampler, env))
             out["projector"] = dataclasses.asdict(self.config.projector)
         if spec.simulate:
+            from simdiff.sim.retarget.contacts import ANCHOR_VERSION
+
             out["simulate"] = True
+            out["anchor_version"] = ANCHOR_VERSION  # the finish anchors planted feet; a rule change re-measures
             out["projector"] = dataclasses.asdict(self.config.projector)
         return out
 

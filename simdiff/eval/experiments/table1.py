@@ -64,7 +64,7 @@ def plan(runner: Runner) -> list[RowPlan]:
     plans = [ground_truth_plan(runner)]
     sim_alphas = alphas(runner)
     for spec in c.models:
-        for sampler in c.samplers:
+        for sampler in spec.own_samplers(c.samplers):
             if runner.is_simdiff(spec):
                 pairs = (sim_alphas if spec.alphas is None else alphas(runner, spec.alphas)) or [(spec.alpha, "model")]
                 plans += [method_plan(runner, spec, sampler, a, alpha_choice=why) for a, why in pairs]
@@ -97,7 +97,7 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
                  if c.protocol.mm_prompts else "off"),
               "* DDPM rows: " + ddpm_note(runner)]
     for m in physdiff:
-        for sampler in c.samplers:
+        for sampler in m.own_samplers(c.samplers):
             cfg = runner.physdiff_config(m, sampler)
             lines.append(f"* {m.name} {sampler.upper()}: projection at t = {', '.join(map(str, cfg.project_at))} "
                          f"({cfg.steps or ('1000' if sampler == 'ddpm' else '50')} steps), residual bound {cfg.residual_bound}")

@@ -29,7 +29,7 @@ def plan(runner: Runner) -> list[RowPlan]:
     specs = [m for m in c.models if runner.is_simdiff(m)]
     if not specs:
         raise SimdiffError("table2 needs a SimDiff model (adapters) in 'models'")
-    return [method_plan(runner, spec, sampler, a) for spec in specs for sampler in c.samplers for a in alphas]
+    return [method_plan(runner, spec, sampler, a) for spec in specs for sampler in spec.own_samplers(c.samplers) for a in alphas]
 
 
 def select_alpha(rows: list[dict[str, Any]], select_by: str) -> dict[str, Any] | None:

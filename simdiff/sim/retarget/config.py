@@ -41,7 +41,10 @@ class RetargetConfig:
             a skating foot then carries no body translation the floor could not give. Off for
             the augmentation (mocap feet barely slide); on for the simulated finish of generated
             motion, whose stance feet drift with the body (measured: a generated jump in place
-            slid 2.1 mm/frame after tracking without it, 0.06 with it).
+            slid 2.1 mm/frame after tracking without it, 0.06 with it). Where no foot is slow
+            enough to count as planted but one is on the floor (a generated run gliding at
+            2 m/s), the lowest foot box anchors the body
+            (:func:`~simdiff.sim.retarget.contacts.skating_support`).
     """
 
     fps: float = HML_FPS

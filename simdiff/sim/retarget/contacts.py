@@ -15,6 +15,12 @@ from simdiff.sim.retarget.ik import IKTask
 from simdiff.sim.retarget.kinematics import box_bottom_corners, foot_geoms
 
 
+ANCHOR_VERSION: int = 2
+"""Version of the stance anchoring rule (``RetargetConfig.anchor_stance``), recorded with simulated
+finishes and in the experiments' row inputs: 1 planted feet only, 2 also the lowest foot where every
+foot on the floor glides (:func:`skating_support`)."""
+
+
 def _box_speed(xy: np.ndarray, fps: float) -> np.ndarray:
     """(T, 4) horizontal speed (m/s) of the foot boxes from their centres (T, 4, 2)."""
     return np.linalg.norm(np.gradient(xy, axis=0) * fps, axis=-1)
@@ -31,6 +37,24 @@ def contact_schedule(height: np.ndarray, xy: np.ndarray, fps: float, cfg: Retarg
             if col[t - 1] == col[t + 1] != col[t]:
                 col[t] = col[t - 1]
     return c
+
+
+def skating_support(contact: np.ndarray, height: np.ndarray, reach: float, tol: float = 0.01) -> np.ndarray:
+    """(T, 4) bool: the lowest foot boxes at frames where none is in contact but one is on the floor.
+
+    A generated motion whose stance foot glides (a "run" that skates at 2 m/s) has low feet that
+    are never slow enough for :func:`contact_schedule`; physically the lowest one is the support.
+    At frames without a scheduled contact whose lowest sole is below ``reach`` (m), every box
+    within ``tol`` (m) of the lowest is marked (a flat foot's heel and toe boxes, which a strict
+    argmin would alternate between); frames above ``reach`` are flight and get none.
+
+    Args:
+        contact: (T, 4) bool schedule; height: (T, 4) sole heights above the floor (m).
+    """
+    contact = np.asarray(contact, dtype=bool)
+    low = height.min(axis=1, keepdims=True)
+    free = ~contact.any(axis=1, keepdims=True) & (low < reach)
+    return free & (height <= low + tol)
 
 
 def stance_anchor_shift(contact: np.ndarray, xy: np.ndarray) -> np.ndarray:

@@ -6,7 +6,9 @@
    plus inferred support where the COM is held up but no foot is scheduled
    (:func:`~simdiff.sim.retarget.contacts.infer_support`: a jump's toe push, a relevé);
    with ``anchor_stance`` the body is shifted horizontally so that planted feet stay put
-   (:func:`~simdiff.sim.retarget.contacts.stance_anchor_shift`);
+   (:func:`~simdiff.sim.retarget.contacts.stance_anchor_shift`), the lowest foot standing in
+   for a planted one where every foot on the floor glides
+   (:func:`~simdiff.sim.retarget.contacts.skating_support`);
 3. a second IK pass that holds every stance foot (or toe, at toe-off) flat, at a fixed xy
    and on the floor;
 4. temporal Gaussian filtering **before** anything is cropped, with odd-reflection padding
@@ -23,8 +25,8 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.sim.humanoid import hml_to_world, model_index
 from simdiff.sim.retarget.config import Reference, RetargetConfig
-from simdiff.sim.retarget.contacts import (contact_schedule, ground_level, infer_support, stance_anchor_shift,
-                                           stance_tasks)
+from simdiff.sim.retarget.contacts import (contact_schedule, ground_level, infer_support, skating_support,
+                                           stance_anchor_shift, stance_tasks)
 from simdiff.sim.retarget.dynamics import inverse_dynamics_screen
 from simdiff.sim.retarget.filtering import continuous_quats, despike, finite_velocity, resample_qpos, smooth
 from simdiff.sim.retarget.ik import ik_sequence
@@ -67,7 +69,8 @@ def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConf
     h += shift
     contact = contact_schedule(h, xy, fps, cfg)
     if cfg.anchor_stance:
-        offset = stance_anchor_shift(contact, xy)  # (T, 2), world xy
+        support = contact | skating_support(contact, h, cfg.contact_height)
+        offset = stance_anchor_shift(support, xy)  # (T, 2), world xy
         q1[:, :2] += offset
         xy = xy + offset[:, None]
         target = target.copy()
