@@ -165,3 +165,18 @@ def test_own_floor_sliding_sees_the_skating_of_a_hovering_motion() -> None:
     jump = hovering.copy()
     jump[15:25, :, 1] += 0.3
     assert own_floor_metrics(jump)["own_floor"] == pytest.approx(20.0, abs=1e-3)
+
+
+def test_centred_mean_is_scipys_constant_mode_uniform_filter() -> None:
+    from scipy.ndimage import uniform_filter1d
+
+    from simdiff.motion.metrics import centred_mean
+
+    rng = np.random.default_rng(0)
+    for shape in [(3, 1, 2), (2, 4, 2), (5, 120, 2)]:
+        x = rng.random(shape)
+        for size in (1, 3, 5, 7):
+            want = uniform_filter1d(x, size=size, axis=1, mode="constant", cval=0.0)
+            np.testing.assert_allclose(centred_mean(x, size), want, atol=1e-12)
+    with pytest.raises(SimdiffError, match="odd window, got 4"):
+        centred_mean(np.zeros((1, 5, 2)), 4)

@@ -90,4 +90,11 @@ def test_a_stand_gliding_on_planted_feet_is_simulated_standing_still() -> None:
     assert t["status"] == "ok" and t["anchor_stance"] and t["anchor_version"] == 2
     assert t["physics_generated"]["sliding"] > 5.0
     assert t["physics_simulated"]["sliding"] <= 0.1  # measured 0.008 (0.45 unanchored, gliding 0.36 m)
+    # a glide 2 cm above the floor: CLoSD's sliding cannot see it, the own-floor sliding can
+    hover = glide.copy()
+    hover[..., 1] += 0.02
+    t = simulate_finish(hover, Environment()).tracking
+    assert t["physics_generated"]["sliding"] == 0.0 and t["physics_generated"]["sliding_own_floor"] > 5.0
+    assert abs(t["physics_generated"]["own_floor"] - 20.0) < 1.0
+    assert t["physics_simulated"]["sliding_own_floor"] <= 0.5
     assert abs(float(sim.joints[-1, 0, 0] - sim.joints[0, 0, 0])) < 0.03  # stood still instead of gliding 0.39 m

@@ -9,8 +9,8 @@ Joints are HumanML3D positions in metres, Y-up, ground plane y = 0, 20 fps. With
   ``|xz_c(t+1) - xz_c(t)| * 1000`` if ``y_c(t) <= 0.005`` and ``y_c(t+1) <= 0.005``, else 0;
 * skate_ratio (GMD): fraction of frame pairs in which foot joint 10 or 11 is below 0.05 m in
   both frames and moves faster than 0.5 m/s in xz, both at that pair and in the 5-pair
-  centred moving average (zeros beyond the valid span, scipy ``uniform_filter1d`` mode
-  'constant').
+  centred moving average (zeros beyond the valid span: scipy ``uniform_filter1d`` mode
+  'constant', :func:`centred_mean`).
 
 Aggregation as in CLoSD: penetration, floating and sliding are means over all valid frames
 (frame pairs for sliding) of all samples pooled; skate_ratio is the mean of per-sample ratios.
@@ -24,7 +24,6 @@ import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
 
 if TYPE_CHECKING:
     import torch
@@ -124,11 +123,27 @@ def _skating(arr: np.ndarray, pair_mask: np.ndarray) -> np.ndarray:
     step = feet[:, 1:] - feet[:, :-1]
     speed = np.hypot(step[..., 0], step[..., 2]) * FPS  # (B, T-1, 2) m/s
     speed = np.where(pair_mask[..., None], speed, 0.0)
-    avg = uniform_filter1d(speed, size=SKATE_WINDOW, axis=1, mode="constant", cval=0.0)
+    avg = centred_mean(speed, SKATE_WINDOW)
     low = feet[..., 1] < SKATE_HEIGHT  # (B, T, 2)
     contact = low[:, :-1] & low[:, 1:]
     skating = contact & (speed > SKATE_SPEED) & (avg > SKATE_SPEED) & pair_mask[..., None]
     return skating.any(axis=-1)
+
+
+def centred_mean(x: np.ndarray, size: int) -> np.ndarray:
+    """Moving average of odd ``size`` along axis 1, centred, zeros beyond both ends.
+
+    The same as ``scipy.ndimage.uniform_filter1d(x, size, axis=1, mode="constant", cval=0.0)``
+    without importing ``scipy.ndimage`` (about 0.3 s, a sixth of a simulated finish's budget).
+    """
+    if size < 1 or size % 2 == 0:
+        raise SimdiffError(f"centred_mean needs an odd window, got {size}")
+    half = size // 2
+    pad = [(0, 0)] * x.ndim
+    pad[1] = (half + 1, half)
+    c = np.cumsum(np.pad(np.asarray(x, dtype=np.float64), pad), axis=1)
+    n = x.shape[1]
+    return (np.take(c, np.arange(size, size + n), axis=1) - np.take(c, np.arange(n), axis=1)) / size
 
 
 def per_sample_physics_metrics(

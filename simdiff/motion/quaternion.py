@@ -6,6 +6,8 @@ vector array (..., 3), a rotation matrix (..., 3, 3), a continuous-6D rotation (
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -119,7 +121,8 @@ def quat_error(q_ref: np.ndarray, q: np.ndarray) -> np.ndarray:
     ])
     if e[0] < 0:
         e = -e
-    s = np.linalg.norm(e[1:])
+    v = e[1:]
+    s = math.sqrt(v.dot(v))  # np.linalg.norm(v), without its per-call overhead
     if s < 1e-12:
         return np.zeros(3)
     return e[1:] / s * 2.0 * np.arctan2(s, e[0])

@@ -8,6 +8,7 @@ sample ``k`` of ``--seed S-k``.
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -272,13 +273,36 @@ def simulate_samples(generator, samples: list[Sample], timer: Timer, force: bool
             s.simulated = simulate_finish(s.joints, s.env, normalizer=norm, force=force)
 
 
+def _load_simulator() -> None:
+    """Import the simulator stack and compile the humanoid (errors surface later, where they are used)."""
+    try:
+        import simdiff.motion.metrics  # noqa: F401
+        import simdiff.sim.project  # noqa: F401
+        from simdiff.sim.humanoid import HumanoidConfig, load_model
+
+        load_model(HumanoidConfig())
+    except Exception:  # noqa: BLE001 - the finish itself reports any failure with its own message
+        pass
+
+
+def warm_simulator() -> threading.Thread:
+    """Start loading MuJoCo, scipy and the humanoid (about 0.5 s) on a thread while the diffusion samples:
+    sampling runs in torch's native code, so the imports use the time (and the core) it leaves."""
+    thread = threading.Thread(target=_load_simulator, name="simdiff-warm-simulator", daemon=True)
+    thread.start()
+    return thread
+
+
 def run_generation(generator, request: GenerationRequest, out_dir: Path, model_dir: Path, timer: Timer,
                    quiet: bool = False, alpha_source: str = "default", simulate: bool = False,
                    force: bool = False) -> tuple[dict, list[Path]]:
     """Sample (and with ``simulate`` re-track under φ), write every file and ``generation.json``;
     returns (metadata, written paths in print order)."""
+    warm = warm_simulator() if simulate else None
     samples = sample_motions(generator, request, timer, quiet)
     if simulate:
+        if warm is not None:
+            warm.join()
         simulate_samples(generator, samples, timer, force)
     files, videos = write_outputs(samples, request, out_dir, timer, quiet)
     meta = metadata(request, generator, model_dir, samples, files, videos, timer, alpha_source)

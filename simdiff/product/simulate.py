@@ -34,7 +34,9 @@ class SimulatedMotion:
         joints: (T', 22, 3) float32 rollout joints, metres, Y-up, 20 fps (T' = T when tracked to the
             end; shorter after a fall; with the flight clock longer under low gravity).
         tracking: JSON-able tracking result (success, status, fall_frame, errors, residual, CPU and
-            wall seconds, physics metrics of the generated and the simulated motion).
+            wall seconds, physics metrics of the generated and the simulated motion: CLoSD's, and
+            ``sliding_own_floor``/``own_floor`` from :func:`simdiff.motion.metrics.own_floor_metrics`,
+            since a generated sample that hovers has CLoSD sliding 0 however its feet skate).
     """
 
     joints: np.ndarray
@@ -54,6 +56,13 @@ def _finite(value: Any) -> Any:
     return value
 
 
+def _physics(joints: np.ndarray) -> dict[str, float]:
+    """CLoSD's physics metrics of one motion plus sliding on its own floor (a hovering sample's skating shows there)."""
+    from simdiff.motion.metrics import own_floor_metrics, physics_metrics
+
+    return {**physics_metrics(joints), **own_floor_metrics(joints)}
+
+
 def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: Any = None, max_force: float = 0.5,
                     follow_flights: bool = True, force: bool = False, anchor_stance: bool = True) -> SimulatedMotion:
     """Re-track ``joints`` under ``env`` (Earth when None) and return the rollout with its tracking result.
@@ -69,7 +78,6 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
             taken out of the reference before tracking (see
             :attr:`simdiff.sim.retarget.RetargetConfig.anchor_stance`).
     """
-    from simdiff.motion.metrics import physics_metrics
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
     from simdiff.sim.residual import ResidualConfig
@@ -89,7 +97,7 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     tracking = info.to_dict()
     tracking.update(wall_s=wall, env_assumed=env is None, follow_flights=follow_flights, max_force=max_force,
                     anchor_stance=anchor_stance, anchor_version=ANCHOR_VERSION if anchor_stance else None,
-                    physics_generated=physics_metrics(arr), physics_simulated=physics_metrics(out) if len(out) >= 2 else None)
+                    physics_generated=_physics(arr), physics_simulated=_physics(out) if len(out) >= 2 else None)
     return SimulatedMotion(out, _finite(tracking))
 
 

@@ -25,6 +25,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 
 from simdiff.motion.quaternion import quat_error, wxyz_to_xyzw
@@ -134,17 +136,25 @@ class RootResidual:
             return False
         return bool(self.support[data.contact.geom[:n]].any())
 
-    def wrench(self, data, t: float) -> np.ndarray:
-        """(6,) world force (N) and torque (N·m) for the physics step starting at time t (s)."""
+    def wrench(self, data, t: float, supported: bool | None = None) -> np.ndarray:
+        """(6,) world force (N) and torque (N·m) for the physics step starting at time t (s).
+
+        ``supported``: :meth:`sim_support` of this step when the caller has it already (None: computed).
+        Scalar code (``min``/``max``, ``sqrt(v·v)``: what ``np.clip``/``np.linalg.norm`` compute, without
+        their per-call overhead): called at every physics step.
+        """
         if not self.cfg.enabled:
             return np.zeros(6)
         ref = self.ref
         x = t / ref.dt
-        k = int(np.clip(np.floor(x), 0, ref.num_frames - 1))
-        if not self.ref_support[min(int(round(x)), ref.num_frames - 1)] or not self.sim_support(data):
+        last = ref.num_frames - 1
+        k = min(max(math.floor(x), 0), last)
+        if not self.ref_support[min(int(round(x)), last)]:
             return np.zeros(6)
-        k1 = min(k + 1, ref.num_frames - 1)
-        a = float(np.clip(x - k, 0.0, 1.0))
+        if not (self.sim_support(data) if supported is None else supported):
+            return np.zeros(6)
+        k1 = min(k + 1, last)
+        a = min(max(x - k, 0.0), 1.0)
         com_ref = (1 - a) * ref.com[k] + a * ref.com[k1]
         vel_ref = (1 - a) * ref.com_vel[k] + a * ref.com_vel[k1]
         self.mj.mj_subtreeVel(self.m, data)
@@ -158,11 +168,11 @@ class RootResidual:
         if c.support_shift_max > 0:
             ankle_ref = (1 - a) * self.ref_ankle_z[k] + a * self.ref_ankle_z[k1]
             shift = data.xpos[self.ankles, 2].min() - ankle_ref
-            z_ref += float(np.clip(shift, -c.support_shift_max, 0.0))
+            z_ref += float(min(max(shift, -c.support_shift_max), 0.0))
         sag = z_ref - com[2]
         sag = float(np.sign(sag) * max(abs(sag) - c.z_deadband, 0.0))
         f[2] = max(0.0, self.mass * (c.kp_z * sag + c.kd_z * (vel_ref[2] - vel[2])))
-        n = np.linalg.norm(f)
+        n = math.sqrt(f.dot(f))
         if n > self.fmax:
             f *= self.fmax / max(n, 1e-12)
         q_ref = ref.qpos[k, 3:7] if a < 0.5 else ref.qpos[k1, 3:7]
@@ -172,7 +182,7 @@ class RootResidual:
         if self.ref_angmom is not None:  # subtree velocities are current (mj_subtreeVel above)
             dL = self.momentum_scale * self.ref_angmom[k] - data.subtree_angmom[p]
             tau[:2] += c.momentum_gain * dL[:2]
-        n = np.linalg.norm(tau)
+        n = math.sqrt(tau.dot(tau))
         if n > self.tmax:
             tau *= self.tmax / max(n, 1e-12)
         return np.concatenate([f, tau])

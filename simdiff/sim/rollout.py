@@ -250,11 +250,11 @@ def rollout(
         step = n * n_sub
         for j in range(n_sub):
             mujoco.mj_step1(m, d)
-            w = res.wrench(d, d.time if clock is None else k * reference.dt + j * m.opt.timestep)
+            support[step] = held = res.sim_support(d)
+            w = res.wrench(d, d.time if clock is None else k * reference.dt + j * m.opt.timestep, held)
             d.xfrc_applied[p] = w
             wrench[step] = w
             airborne[step] = d.ncon == 0
-            support[step] = res.sim_support(d)
             mujoco.mj_step2(m, d)
             if audit:
                 violations.extend(_audit(m, d, ix, env, w, airborne[step], step))
