@@ -31,6 +31,36 @@ def pose_feature_mask() -> np.ndarray:
     return mask
 
 
+def normalized_features(a: np.ndarray, b: np.ndarray, normalizer) -> tuple[np.ndarray, np.ndarray] | None:
+    """Normalised (n, 263) features of two joint sequences cut to their common length n.
+
+    Args:
+        a, b: (T, 22, 3) and (T', 22, 3) joints (metres, Y-up, 20 fps).
+        normalizer: a :class:`simdiff.motion.normalize.Normalizer`.
+    Returns:
+        (features of a, features of b), or None without a normaliser or with fewer than 2 common frames.
+    """
+    if normalizer is None:
+        return None
+    n = min(len(a), len(b))
+    if n < 2:
+        return None
+    from simdiff.sim.retarget import joints_to_features
+
+    return (np.asarray(normalizer.normalize(joints_to_features(a[:n]))),
+            np.asarray(normalizer.normalize(joints_to_features(b[:n]))))
+
+
+def feature_distance(pair: tuple[np.ndarray, np.ndarray] | None, mask: np.ndarray | None = None) -> float:
+    """Mean per-frame L2 distance of :func:`normalized_features` (over the channels in ``mask``; NaN for None)."""
+    if pair is None:
+        return float("nan")
+    fr, fo = pair
+    if mask is not None:
+        fr, fo = fr[:, mask], fo[:, mask]
+    return float(np.linalg.norm(fr - fo, axis=-1).mean())
+
+
 def pose_d_l2(source_aligned: np.ndarray, out_joints: np.ndarray, normalizer) -> float:
     """Mean per-frame L2 distance of the normalised pose channels (see module docstring).
 
@@ -41,14 +71,4 @@ def pose_d_l2(source_aligned: np.ndarray, out_joints: np.ndarray, normalizer) ->
     Returns:
         The distance, NaN with fewer than 2 common frames or without a normaliser.
     """
-    if normalizer is None:
-        return float("nan")
-    n = min(len(source_aligned), len(out_joints))
-    if n < 2:
-        return float("nan")
-    from simdiff.sim.retarget import joints_to_features
-
-    mask = pose_feature_mask()
-    fr = np.asarray(normalizer.normalize(joints_to_features(source_aligned[:n])))[:, mask]
-    fo = np.asarray(normalizer.normalize(joints_to_features(out_joints[:n])))[:, mask]
-    return float(np.linalg.norm(fr - fo, axis=-1).mean())
+    return feature_distance(normalized_features(source_aligned, out_joints, normalizer), pose_feature_mask())

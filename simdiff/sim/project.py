@@ -18,7 +18,7 @@ import numpy as np
 
 from simdiff.sim.retarget import RetargetConfig, make_reference, qpos_to_world
 from simdiff.sim.env import Environment
-from simdiff.sim.faithfulness import pose_d_l2
+from simdiff.sim.faithfulness import feature_distance, normalized_features, pose_feature_mask
 from simdiff.sim.flight import FlightConfig, aligned_source
 from simdiff.sim.humanoid import TOE_JOINT_HEIGHT, HumanoidConfig, load_model, model_index, world_to_hml
 from simdiff.sim.residual import ResidualConfig
@@ -107,16 +107,7 @@ def d_l2(ref_joints: np.ndarray, out_joints: np.ndarray, normalizer) -> float:
 
     Both motions are cut to the common length; fewer than 2 frames gives NaN.
     """
-    if normalizer is None:
-        return float("nan")
-    n = min(len(ref_joints), len(out_joints))
-    if n < 2:
-        return float("nan")
-    from simdiff.sim.retarget.kinematics import joints_to_features
-
-    fr = normalizer.normalize(joints_to_features(ref_joints[:n]))
-    fo = normalizer.normalize(joints_to_features(out_joints[:n]))
-    return float(np.linalg.norm(np.asarray(fr) - np.asarray(fo), axis=-1).mean())
+    return feature_distance(normalized_features(ref_joints, out_joints, normalizer))
 
 
 def project(
@@ -168,8 +159,9 @@ def project(
     local = diff - diff[:, :1] * np.array([1.0, 0.0, 1.0])
     err_local = float(np.linalg.norm(local, axis=-1).mean() * 1e3)
     fall_frame = None if res.fall_time is None else int(np.floor(res.fall_time * retarget.fps))
-    dl2 = d_l2(source, out, normalizer)
-    dl2_pose = pose_d_l2(source, out, normalizer)
+    features = normalized_features(source, out, normalizer)  # once for both distances
+    dl2 = feature_distance(features)
+    dl2_pose = feature_distance(features, pose_feature_mask())
     ix = model_index(model)
     info = ProjectionInfo(
         success=res.success, status=res.status, fall_frame=fall_frame, n_frames=int(joints.shape[0]),
