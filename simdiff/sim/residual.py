@@ -23,9 +23,8 @@ and summarised per rollout. ``max_force = 0`` gives the strict (paper) setting: 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
