@@ -3,14 +3,15 @@
 Usage::
 
     python benchmarks/bench_simulate.py [--model DIR] [--prompts P ...] [--gravities -9.81 -3.7]
-        [--length 6] [--seed 0] [--threads 1] [--json out.json]
+        [--length 6] [--seed 0] [--threads 1] [--repeats 1] [--compare-in-process] [--json out.json]
 
 Each (prompt, g) runs the real command, ``simdiff generate P --gravity G --length L --format npy
 --no-video --seed S``, in a fresh interpreter twice, without and with ``--simulate`` (in that order,
-back to back), and times both from outside: what ``--simulate`` **adds** is the difference (wall
-and CPU seconds of the child). The simulator's imports start on a thread while the diffusion
-samples (:func:`simdiff.product.pipeline.warm_simulator`), so the ``simulate`` stage of
-``generation.json`` alone would understate the cost; it is reported beside it. From
+back to back; ``--repeats R`` pairs, medians compared), and times both from outside: what
+``--simulate`` **adds** is the difference (wall and CPU seconds of the child). The simulator loads
+in a worker process started before the model (:mod:`simdiff.product.finisher`; on a thread on a
+one-CPU machine; ``--compare-in-process`` also times that, with ``SIMDIFF_FINISH_WORKERS=0``), so the ``simulate`` stage of ``generation.json`` alone would misstate the cost
+(and the CPU the worker adds); it is reported beside it. From
 ``sample0_tracking.json``: tracked or fell, and the sliding of the generated and the simulated
 motion (mm/frame; CLoSD's definition, which counts only feet within 5 mm of y = 0, and on the
 generated motion's own floor, :func:`simdiff.motion.metrics.own_floor_metrics`, which a hovering
@@ -26,23 +27,25 @@ import json
 import os
 import platform
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+WORKERS_ENV = "SIMDIFF_FINISH_WORKERS"  # simdiff.product.finisher.WORKERS_ENV (not imported: the bench times from outside)
 PROMPTS = ["a person jumps forward", "a person jumps up in place", "a person walks forward", "a person runs in a circle"]
 """The test prompts of the simulated finish (issue 15; the README's and the tutorial's examples)."""
 TARGET_S = 2.0
 TARGET_SLIDING = 0.5
 
 
-def timed(cmd: list[str]) -> tuple[float, float]:
-    """(wall s, CPU s of the child) of one command; exits with its stderr when it fails."""
+def timed(cmd: list[str], env: dict[str, str] | None = None) -> tuple[float, float]:
+    """(wall s, CPU s of the child and its worker) of one command; exits with its stderr when it fails."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=None if env is None else {**os.environ, **env})
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode != 0:
@@ -60,8 +63,18 @@ def run_one(prompt: str, gravity: float, args: argparse.Namespace, out: Path) ->
             "--format", "npy", "--no-video", "--seed", str(args.seed), "-q"]
     base += ["--model", args.model] if args.model else []
     base += ["--threads", str(args.threads)] if args.threads else []
-    plain_wall, plain_cpu = timed(base + ["--out", str(out / "plain")])
-    sim_wall, sim_cpu = timed(base + ["--out", str(out / "sim"), "--simulate"])
+    runs = []
+    for _ in range(args.repeats):  # back to back, so slow phases of a shared machine hit all alike
+        run = timed(base + ["--out", str(out / "plain")]) + timed(base + ["--out", str(out / "sim"), "--simulate"])
+        if args.compare_in_process:
+            run += timed(base + ["--out", str(out / "here"), "--simulate"], {WORKERS_ENV: "0"})
+        runs.append(run)
+    plain_wall, plain_cpu, sim_wall, sim_cpu = (statistics.median(r[i] for r in runs) for i in range(4))
+    here = {}
+    if args.compare_in_process:
+        here_wall, here_cpu = (statistics.median(r[i] for r in runs) for i in (4, 5))
+        here = {"added_wall_s_in_process": here_wall - plain_wall, "added_cpu_s_in_process": here_cpu - plain_cpu,
+                "runs_in_process_s": [[r[4], r[5]] for r in runs]}
     meta = json.loads((out / "sim" / "generation.json").read_text())
     track = json.loads((out / "sim" / "sample0_tracking.json").read_text())
     sim = track.get("physics_simulated") or {}
@@ -75,7 +88,13 @@ def run_one(prompt: str, gravity: float, args: argparse.Namespace, out: Path) ->
             "simulate_stage_cpu_s": meta["cpu_s"]["simulate"], "sample_wall_s": meta["timings_s"]["sample"],
             "sliding_generated": gen.get("sliding"), "sliding_simulated": sim.get("sliding"),
             "sliding_own_floor_generated": own[""], "sliding_own_floor_simulated": own["simulated_"],
-            "anchor_version": track.get("anchor_version")}
+            "anchor_version": track.get("anchor_version"), "repeats": args.repeats,
+            "runs_wall_s": [[r[0], r[2]] for r in runs], "runs_cpu_s": [[r[1], r[3]] for r in runs], **here}
+
+
+def here_note(row: dict) -> str:
+    """``; in process +X s`` when the in-process finish was timed too."""
+    return f"; in process {row['added_wall_s_in_process']:+.2f} s" if "added_wall_s_in_process" in row else ""
 
 
 def summarize(rows: list[dict]) -> dict:
@@ -87,7 +106,10 @@ def summarize(rows: list[dict]) -> dict:
             f"added_within_{TARGET_S:g}_s": sum(a <= TARGET_S for a in added),
             f"sliding_within_{TARGET_SLIDING:g}": sum(s <= TARGET_SLIDING for s in slides),
             "sliding_simulated_max": max(slides) if slides else None,
-            "tracked": sum(r["status"] == "ok" for r in rows)}
+            "tracked": sum(r["status"] == "ok" for r in rows),
+            **({"added_wall_s_in_process_median": statistics.median(r["added_wall_s_in_process"] for r in rows),
+                f"added_within_{TARGET_S:g}_s_in_process": sum(r["added_wall_s_in_process"] <= TARGET_S for r in rows)}
+               if rows and "added_wall_s_in_process" in rows[0] else {})}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -98,6 +120,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--length", type=float, default=6.0, help="seconds per motion")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=1, help="torch threads of each command (0: simdiff's default)")
+    ap.add_argument("--repeats", type=int, default=1,
+                    help="pairs of commands per (prompt, g); the medians are compared (default 1)")
+    ap.add_argument("--compare-in-process", action="store_true",
+                    help=f"also time --simulate with {WORKERS_ENV}=0 (the finish in the command's own process)")
     ap.add_argument("--json", type=Path, default=None, help="write the rows and the summary here")
     args = ap.parse_args(argv)
     rows = []
@@ -108,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
                 rows.append(r)
                 slide = "—" if r["sliding_simulated"] is None else f"{r['sliding_simulated']:.2f}"
                 print(f"{prompt!r:30} g={g:6.2f}  {r['status']:4} {r['frames_out']:4} frames  adds {r['added_wall_s']:.2f} s "
-                      f"wall / {r['added_cpu_s']:.2f} s CPU (stage {r['simulate_stage_wall_s']:.2f} s; without: "
+                      f"wall / {r['added_cpu_s']:.2f} s CPU{here_note(r)} (stage {r['simulate_stage_wall_s']:.2f} s; without: "
                       f"{r['plain_wall_s']:.2f} s)  sliding {slide} (own floor {r['sliding_own_floor_generated']:.2f} → "
                       f"{r['sliding_own_floor_simulated']:.2f}) mm/frame", flush=True)
     summary = summarize(rows)

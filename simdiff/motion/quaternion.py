@@ -21,6 +21,18 @@ def xyzw_to_wxyz(q: np.ndarray) -> np.ndarray:
     return np.asarray(q)[..., [3, 0, 1, 2]]
 
 
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of 3-vectors along the last axis, broadcasting (..., 3).
+
+    The same products and differences as ``np.cross`` (bit-identical results) without its
+    per-call overhead (axis moves and checks: about 0.1 ms, paid hundreds of times per tracked motion).
+    """
+    a, b = np.asarray(a), np.asarray(b)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
 def qnormalize(q: np.ndarray) -> np.ndarray:
     """Unit quaternions, (..., 4)."""
     return q / np.linalg.norm(q, axis=-1, keepdims=True)

@@ -13,7 +13,7 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import TYPE_CHECKING, Iterable, Iterator
 
 import numpy as np
 
@@ -23,6 +23,9 @@ from simdiff.product.outputs import env_label, render_video, write_metadata, wri
 from simdiff.product.request import GenerationRequest
 from simdiff.product.simulate import SimulatedMotion, simulate_finish, write_simulated
 from simdiff.sim.env import Environment
+
+if TYPE_CHECKING:
+    from simdiff.product.finisher import Finisher
 
 FEATURES_NOTE = ("(T, 263) float32 un-normalised HumanML3D features, one row per joint frame as the model "
                  "samples them (MDM convention); joints = simdiff.motion.features.features_to_joints(features)")
@@ -265,12 +268,19 @@ def normalizer_of(generator) -> object | None:
         return None
 
 
-def simulate_samples(generator, samples: list[Sample], timer: Timer, force: bool = False) -> None:
-    """Re-track every sample under its φ (:func:`simdiff.product.simulate.simulate_finish`), in place."""
+def simulate_samples(generator, samples: list[Sample], timer: Timer, force: bool = False,
+                     finisher: Finisher | None = None) -> None:
+    """Re-track every sample under its φ (:func:`simdiff.product.simulate.simulate_finish`), in place:
+    in ``finisher``'s worker processes when given, else here."""
     norm = normalizer_of(generator)
     with timer.stage("simulate"):
-        for s in samples:
-            s.simulated = simulate_finish(s.joints, s.env, normalizer=norm, force=force)
+        if finisher is None:
+            for s in samples:
+                s.simulated = simulate_finish(s.joints, s.env, normalizer=norm, force=force)
+            return
+        futures = [finisher.submit(s.joints, s.env, norm, force) for s in samples]
+        for s, future in zip(samples, futures):
+            s.simulated = finisher.result(future)
 
 
 def _load_simulator() -> None:
@@ -287,8 +297,9 @@ def _load_simulator() -> None:
 
 def warm_simulator() -> threading.Thread:
     """Start loading MuJoCo, scipy and the humanoid (about 1 CPU-s) on a thread while the diffusion samples:
-    sampling runs mostly in torch's native code, so the imports use the time (and the core) it leaves
-    (measured: 0.4–1.0 s less wall time per ``--simulate`` command on 2 cores)."""
+    sampling runs mostly in torch's native code, so the imports use the time it leaves (measured: 0.4–1.0 s
+    less wall time per ``--simulate`` command on 2 cores). Used where no core is idle for a
+    :class:`~simdiff.product.finisher.Finisher` process, which hides the imports entirely."""
     thread = threading.Thread(target=_load_simulator, name="simdiff-warm-simulator", daemon=True)
     thread.start()
     return thread
@@ -296,15 +307,16 @@ def warm_simulator() -> threading.Thread:
 
 def run_generation(generator, request: GenerationRequest, out_dir: Path, model_dir: Path, timer: Timer,
                    quiet: bool = False, alpha_source: str = "default", simulate: bool = False,
-                   force: bool = False) -> tuple[dict, list[Path]]:
-    """Sample (and with ``simulate`` re-track under φ), write every file and ``generation.json``;
+                   force: bool = False, finisher: Finisher | None = None) -> tuple[dict, list[Path]]:
+    """Sample (and with ``simulate`` re-track under φ: in ``finisher``'s processes when given, which
+    should have been started before the model loaded), write every file and ``generation.json``;
     returns (metadata, written paths in print order)."""
-    warm = warm_simulator() if simulate else None
+    warm = warm_simulator() if simulate and finisher is None else None
     samples = sample_motions(generator, request, timer, quiet)
     if simulate:
         if warm is not None:
             warm.join()
-        simulate_samples(generator, samples, timer, force)
+        simulate_samples(generator, samples, timer, force, finisher)
     files, videos = write_outputs(samples, request, out_dir, timer, quiet)
     meta = metadata(request, generator, model_dir, samples, files, videos, timer, alpha_source)
     meta_path = write_metadata(out_dir / "generation.json", meta)

@@ -13,7 +13,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from simdiff.motion.quaternion import quat_error, wxyz_to_xyzw
+from simdiff.motion.quaternion import cross3, quat_error, wxyz_to_xyzw
 
 from simdiff.sim.retarget.config import Reference
 from simdiff.sim.retarget.kinematics import foot_geoms
@@ -303,7 +303,7 @@ class PDTracker:
         fz_total = max(ix.mass * abs(self.model.opt.gravity[2]) + F[2], 0.0)
         for s, pt, w in zip(legs, pts, share):
             Fi = w * F
-            Mi = w * (tau - np.cross(pt - com, F))
+            Mi = w * (tau - cross3(pt - com, F))
             # the foot can only carry moments that keep its centre of pressure on the sole
             x_axis = data.xmat[self.foot_body[s]].reshape(3, 3)[:, 0]
             fwd = np.array([x_axis[0], x_axis[1], 0.0])

@@ -5,6 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from simdiff.product.finisher import Finisher
+    from simdiff.product.request import GenerationRequest
 
 EPILOG = """\
 outputs (in --out, default ./out/<prompt>/), per sample K = 0, 1, ...:
@@ -95,9 +100,7 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     from simdiff.errors import SimdiffError
-    from simdiff.product.outputs import fresh_dir, prepare_out_dir, slug
-    from simdiff.product.request import build_request, with_model_defaults
-    from simdiff.sim.env import GRAVITY_RANGE, MAX_WIND
+    from simdiff.product.request import build_request
 
     start = time.perf_counter()
     request = build_request(  # every user value is checked before torch is imported
@@ -108,6 +111,30 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.threads is not None and args.threads < 1:
         raise SimdiffError(f"--threads must be at least 1, got {args.threads}")
+    finisher = None
+    if args.simulate:  # the simulator loads in its own process while this one loads torch and samples
+        from simdiff.product.finisher import start_finisher
+
+        finisher = start_finisher(request.num_samples * len(request.envs))
+    try:
+        code = _generate(args, request, start, finisher)
+    except BaseException:
+        if finisher is not None:
+            finisher.close(cancel=True)
+        raise
+    if finisher is not None:
+        finisher.close()
+    return code
+
+
+def _generate(args: argparse.Namespace, request: GenerationRequest, start: float, finisher: Finisher | None) -> int:
+    """Load the model, sample (the finish in ``finisher``'s process when given), write and report."""
+    import time
+
+    from simdiff.errors import SimdiffError
+    from simdiff.product.outputs import fresh_dir, prepare_out_dir, slug
+    from simdiff.product.request import with_model_defaults
+    from simdiff.sim.env import GRAVITY_RANGE, MAX_WIND
     from simdiff.model.default import check_model_dir, sampling_defaults  # imports torch (simdiff.model)
 
     folder = check_model_dir(args.model)
@@ -157,7 +184,7 @@ def run(args: argparse.Namespace) -> int:
     elif generator.config.sim.mode != "continuous":
         raise SimdiffError(f"{folder} has categorical environments; use `simdiff sample --env-index` with it")
     meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet, alpha_source,
-                                 simulate=args.simulate, force=args.force)
+                                 simulate=args.simulate, force=args.force, finisher=finisher)
     for rec in meta["samples"] if args.simulate else []:
         sim = rec["simulated"]
         if not sim["success"]:

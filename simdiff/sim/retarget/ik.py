@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from simdiff.motion.quaternion import xyzw_to_wxyz
+from simdiff.motion.quaternion import cross3, xyzw_to_wxyz
 from simdiff.sim.humanoid import BODY_NAMES, BODY_PARENT, BODY_TO_HML, model_index
 from simdiff.sim.retarget.config import RetargetConfig
 
@@ -58,7 +58,7 @@ def _perp(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
 def _frame(primary: np.ndarray, secondary: np.ndarray) -> np.ndarray:
     """(T, 3, 3) orthonormal columns (p, s⊥, p × s⊥) from unit primary and any secondary."""
     s = _unit(_perp(secondary, primary))
-    return np.stack([primary, s, np.cross(primary, s)], axis=-1)
+    return np.stack([primary, s, cross3(primary, s)], axis=-1)
 
 
 def _aim(u_local: np.ndarray, a_local: np.ndarray, d_world: np.ndarray, h_world: np.ndarray) -> np.ndarray:
@@ -167,7 +167,7 @@ def analytic_ik(model, target: np.ndarray) -> np.ndarray:
             elif body.endswith(("_Knee", "_Elbow")):  # hinge-like: keep the parent's y axis
                 R = _aim(u, ey, d, Rp[:, :, 1])
             elif body.endswith("_Ankle"):  # foot: lateral axis horizontal
-                R = _aim(u, ey, d, np.cross(ez, _unit(d)))
+                R = _aim(u, ey, d, cross3(ez, _unit(d)))
             elif body == "Torso":
                 R = _aim(u, ey, d, 2 * y_pelvis + y_chest)
             elif body == "Spine":
@@ -245,7 +245,7 @@ class GaussNewtonIK:
         anchors[3:6] = d.xpos[root]
         axes[6:] = d.xaxis[self.hinge_jnt]
         anchors[6:] = d.xanchor[self.hinge_jnt]
-        J = np.cross(axes[None, 3:], p[:, None, :] - anchors[None, 3:])  # (22, nv-3, 3)
+        J = cross3(axes[None, 3:], p[:, None, :] - anchors[None, 3:])  # (22, nv-3, 3)
         out = np.zeros((22, 3, self.nv))
         out[:, :, 3:] = np.swapaxes(J, 1, 2) * self.mask[:, None, 3:]
         out[:, [0, 1, 2], [0, 1, 2]] = 1.0
