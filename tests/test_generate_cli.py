@@ -160,3 +160,16 @@ def test_generate_simulate_writes_the_simulated_motion_and_tracking(tiny_model: 
     assert set(tracking["physics_generated"]) >= {"penetration", "floating", "sliding"}
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
     assert meta["samples"][0]["simulated"]["status"] == tracking["status"] and meta["timings_s"]["simulate"] > 0
+
+
+def test_generate_simulate_in_a_worker_equals_in_process(tiny_model: Path, tmp_path: Path, capsys,
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    out = {}
+    for workers in ("1", "0"):
+        monkeypatch.setenv("SIMDIFF_FINISH_WORKERS", workers)
+        code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--simulate", "--model",
+                     str(tiny_model), "--out", str(tmp_path / workers), "--threads", "1", "--format", "npy", "-q"])
+        assert code == 0, capsys.readouterr().err
+        assert json.loads((tmp_path / workers / "generation.json").read_text())["simulate_workers"] == int(workers)
+        out[workers] = np.load(tmp_path / workers / "sample0_simulated_joints.npy")
+    np.testing.assert_array_equal(out["1"], out["0"])

@@ -298,7 +298,8 @@ def _load_simulator() -> None:
 def warm_simulator() -> threading.Thread:
     """Start loading MuJoCo, scipy and the humanoid (about 1 CPU-s) on a thread while the diffusion samples:
     sampling runs mostly in torch's native code, so the imports use the time it leaves (measured: 0.4–1.0 s
-    less wall time per ``--simulate`` command on 2 cores). Used where no core is idle for a
+    less wall time per ``--simulate`` command on 2 cores). Used when the finish runs in this process (one
+    CPU, ``SIMDIFF_FINISH_WORKERS=0``, the viewer); ``simdiff generate`` otherwise starts a
     :class:`~simdiff.product.finisher.Finisher` process, which hides the imports entirely."""
     thread = threading.Thread(target=_load_simulator, name="simdiff-warm-simulator", daemon=True)
     thread.start()
@@ -319,6 +320,8 @@ def run_generation(generator, request: GenerationRequest, out_dir: Path, model_d
         simulate_samples(generator, samples, timer, force, finisher)
     files, videos = write_outputs(samples, request, out_dir, timer, quiet)
     meta = metadata(request, generator, model_dir, samples, files, videos, timer, alpha_source)
+    if simulate:  # where the finish ran: its CPU seconds are the worker's (in each sample's tracking), not this process's
+        meta["simulate_workers"] = finisher.workers if finisher is not None else 0
     meta_path = write_metadata(out_dir / "generation.json", meta)
     paths = {p for written in files for p in written.values()} | set(videos)
     return meta, sorted(paths, key=lambda p: p.name) + [meta_path]
