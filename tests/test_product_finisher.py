@@ -69,3 +69,19 @@ def test_the_environment_variable_sets_the_workers(monkeypatch: pytest.MonkeyPat
         monkeypatch.setenv(WORKERS_ENV, bad)
         with pytest.raises(SimdiffError, match=f"{WORKERS_ENV}.*{bad}"):
             start_finisher(4)
+
+
+def test_a_killed_worker_is_a_one_line_error() -> None:
+    import os
+    import signal
+
+    finisher = Finisher()
+    try:
+        finisher._warm[0].result(timeout=120)
+        for proc in list(finisher._executor._processes.values()):
+            os.kill(proc.pid, signal.SIGKILL)
+            proc.join(timeout=10)
+        with pytest.raises(SimdiffError, match="simulator process stopped unexpectedly"):
+            finisher.result(finisher.submit(walk(8, speed=0.5), None))
+    finally:
+        finisher.close(cancel=True)

@@ -58,6 +58,12 @@ def _finish(joints: np.ndarray, env: Environment | None, normalizer: Any, force:
         raise SimdiffError(str(exc)) from None
 
 
+def _stopped(exc: BaseException) -> SimdiffError:
+    """The one-line error for a worker that died (killed, out of memory, a crash in native code)."""
+    return SimdiffError(f"the simulator process stopped unexpectedly ({exc}); run without --simulate, or with "
+                        "SIMDIFF_FINISH_WORKERS=0 to finish in this process")
+
+
 class Finisher:
     """A small process pool that re-tracks generated samples under their φ.
 
@@ -86,15 +92,17 @@ class Finisher:
         """Queue the finish of one (T, 22, 3) motion (metres, Y-up, 20 fps) under ``env``."""
         if self._executor is None:
             raise SimdiffError("the simulated-finish worker is closed")
-        return self._executor.submit(_finish, np.asarray(joints), env, normalizer, force)
+        try:
+            return self._executor.submit(_finish, np.asarray(joints), env, normalizer, force)
+        except BrokenProcessPool as exc:
+            raise _stopped(exc) from None
 
     def result(self, future: Future) -> Any:
         """The :class:`~simdiff.product.simulate.SimulatedMotion` of a submitted finish (its error re-raised)."""
         try:
             return future.result()
         except BrokenProcessPool as exc:
-            raise SimdiffError(f"the simulator process stopped unexpectedly ({exc}); "
-                               "run without --simulate, or with `simdiff track` on the written joints") from None
+            raise _stopped(exc) from None
 
     def close(self, cancel: bool = False) -> None:
         """Shut the worker down; with ``cancel`` (an error or Ctrl-C) without waiting for a running finish."""

@@ -187,11 +187,12 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
                                  simulate=args.simulate, force=args.force, finisher=finisher)
     for rec in meta["samples"] if args.simulate else []:
         sim = rec["simulated"]
+        name = rec["files"].get("tracking", f"sample {rec['index']}").removesuffix("_tracking.json")
         if not sim["success"]:
-            print(f"simdiff: warning: the simulated finish of sample {rec['index']} {sim['status']} at frame "
+            print(f"simdiff: warning: the simulated finish of {name} {sim['status']} at frame "
                   f"{sim['fall_frame']}; its simulated motion ends there ({sim['n_out']} of {sim['n_frames']} frames)",
                   file=sys.stderr)
-        _note(args, f"sample {rec['index']} simulated: {sim['status']} ({sim['n_out']} frames, joint error "
+        _note(args, f"{name} simulated: {sim['status']} ({sim['n_out']} frames, joint error "
                     f"{sim['err_mm']:.0f} mm, {sim['wall_s']:.2f} s)")
     for path in paths:
         print(path)
