@@ -173,3 +173,21 @@ def test_generate_simulate_in_a_worker_equals_in_process(tiny_model: Path, tmp_p
         assert json.loads((tmp_path / workers / "generation.json").read_text())["simulate_workers"] == int(workers)
         out[workers] = np.load(tmp_path / workers / "sample0_simulated_joints.npy")
     np.testing.assert_array_equal(out["1"], out["0"])
+
+
+def test_a_failed_finish_still_writes_the_generated_motion(tiny_model: Path, tmp_path: Path, capsys,
+                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    from simdiff.errors import SimdiffError
+
+    def broken(*args, **kwargs):
+        raise SimdiffError("the simulator broke")
+
+    monkeypatch.setenv("SIMDIFF_FINISH_WORKERS", "0")
+    monkeypatch.setattr("simdiff.product.pipeline.simulate_finish", broken)
+    code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--simulate", "--model",
+                 str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    err = capsys.readouterr().err
+    assert code != 0 and "the simulator broke (the generated motions and generation.json are written in" in err
+    assert len(err.strip().splitlines()) == 1
+    assert (tmp_path / "o" / "sample0_joints.npy").is_file() and not (tmp_path / "o" / "sample0_tracking.json").exists()
+    assert json.loads((tmp_path / "o" / "generation.json").read_text())["simulate_error"] == "the simulator broke"

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Iterable, Iterator
 import numpy as np
 
 from simdiff import __version__
+from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 from simdiff.product.outputs import env_label, render_video, write_metadata, write_motion
 from simdiff.product.request import GenerationRequest
@@ -313,15 +314,23 @@ def run_generation(generator, request: GenerationRequest, out_dir: Path, model_d
     should have been started before the model loaded), write every file and ``generation.json``;
     returns (metadata, written paths in print order)."""
     warm = warm_simulator() if simulate and finisher is None else None
+    failure: SimdiffError | None = None
     samples = sample_motions(generator, request, timer, quiet)
     if simulate:
         if warm is not None:
             warm.join()
-        simulate_samples(generator, samples, timer, force, finisher)
+        try:
+            simulate_samples(generator, samples, timer, force, finisher)
+        except SimdiffError as exc:  # the generated motions are written all the same, then the error is raised
+            failure = exc
     files, videos = write_outputs(samples, request, out_dir, timer, quiet)
     meta = metadata(request, generator, model_dir, samples, files, videos, timer, alpha_source)
     if simulate:  # where the finish ran: its CPU seconds are the worker's (in each sample's tracking), not this process's
         meta["simulate_workers"] = finisher.workers if finisher is not None else 0
+    if failure is not None:
+        meta["simulate_error"] = str(failure)
     meta_path = write_metadata(out_dir / "generation.json", meta)
+    if failure is not None:
+        raise SimdiffError(f"{failure} (the generated motions and generation.json are written in {out_dir})")
     paths = {p for written in files for p in written.values()} | set(videos)
     return meta, sorted(paths, key=lambda p: p.name) + [meta_path]
