@@ -38,9 +38,9 @@ def _init_worker() -> None:
 
 def _warm() -> bool:
     """Import the simulator stack, the feature conversion of d_L2 and compile the humanoid."""
-    from simdiff.product.pipeline import _load_simulator
+    from simdiff.product.simulate import load_simulator
 
-    _load_simulator()
+    load_simulator()
     try:
         import simdiff.motion.features  # noqa: F401 - d_L2's joints → features (torch)
     except ImportError:

@@ -22,7 +22,7 @@ from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 from simdiff.product.outputs import env_label, render_video, write_metadata, write_motion
 from simdiff.product.request import GenerationRequest
-from simdiff.product.simulate import SimulatedMotion, simulate_finish, write_simulated
+from simdiff.product.simulate import SimulatedMotion, load_simulator, simulate_finish, write_simulated
 from simdiff.sim.env import Environment
 
 if TYPE_CHECKING:
@@ -284,25 +284,13 @@ def simulate_samples(generator, samples: list[Sample], timer: Timer, force: bool
             s.simulated = finisher.result(future)
 
 
-def _load_simulator() -> None:
-    """Import the simulator stack and compile the humanoid (errors surface later, where they are used)."""
-    try:
-        import simdiff.motion.metrics  # noqa: F401
-        import simdiff.sim.project  # noqa: F401
-        from simdiff.sim.humanoid import HumanoidConfig, load_model
-
-        load_model(HumanoidConfig())
-    except Exception:  # noqa: BLE001 - the finish itself reports any failure with its own message
-        pass
-
-
 def warm_simulator() -> threading.Thread:
     """Start loading MuJoCo, scipy and the humanoid (about 1 CPU-s) on a thread while the diffusion samples:
     sampling runs mostly in torch's native code, so the imports use the time it leaves (measured: 0.4–1.0 s
     less wall time per ``--simulate`` command on 2 cores). Used when the finish runs in this process (one
     CPU, ``SIMDIFF_FINISH_WORKERS=0``, the viewer); ``simdiff generate`` otherwise starts a
     :class:`~simdiff.product.finisher.Finisher` process, which hides the imports entirely."""
-    thread = threading.Thread(target=_load_simulator, name="simdiff-warm-simulator", daemon=True)
+    thread = threading.Thread(target=load_simulator, name="simdiff-warm-simulator", daemon=True)
     thread.start()
     return thread
 

@@ -63,6 +63,18 @@ def _physics(joints: np.ndarray) -> dict[str, float]:
     return {**physics_metrics(joints), **own_floor_metrics(joints)}
 
 
+def load_simulator() -> None:
+    """Import the simulator stack and compile the humanoid, ahead of a finish (errors surface later, in the finish)."""
+    try:
+        import simdiff.motion.metrics  # noqa: F401
+        import simdiff.sim.project  # noqa: F401
+        from simdiff.sim.humanoid import HumanoidConfig, load_model
+
+        load_model(HumanoidConfig())
+    except Exception:  # noqa: BLE001 - the finish itself reports any failure with its own message
+        pass
+
+
 def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: Any = None, max_force: float = 0.5,
                     follow_flights: bool = True, force: bool = False, anchor_stance: bool = True) -> SimulatedMotion:
     """Re-track ``joints`` under ``env`` (Earth when None) and return the rollout with its tracking result.
