@@ -43,26 +43,45 @@ class CachedTextEncoder:
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the cache to ``path`` (safetensors; atomic)."""
-        import json
-
-        from simdiff.model.checkpoint import atomic_save_tensors
-
         texts = list(self._cache)
         table = torch.stack([self._cache[t] for t in texts]) if texts else torch.zeros(0, self.dim)
-        atomic_save_tensors({"embeddings": table}, path, metadata={"captions": json.dumps(texts), "encoder": self.name})
+        write_caption_file(path, texts, table, self.name)
 
     def load(self, path: str | os.PathLike[str]) -> None:
         """Add the entries stored at ``path`` (written by :meth:`save` with the same encoder)."""
-        import json
-
-        from safetensors import safe_open
-
         if not Path(path).is_file():
             return
-        with safe_open(str(path), "pt") as f:
-            meta = f.metadata() or {}
-            if meta.get("encoder") != self.name:
-                return
-            table = f.get_tensor("embeddings")
-        for text, vec in zip(json.loads(meta.get("captions", "[]")), table):
+        try:
+            captions, table, encoder = read_caption_file(path)
+        except KeyError:  # no encoder or captions recorded: nothing usable
+            return
+        if encoder != self.name:
+            return
+        for text, vec in zip(captions, table):
             self._cache[text] = vec
+
+
+def write_caption_file(path: str | os.PathLike[str], captions: list[str], table: Tensor, encoder: str) -> None:
+    """Write (N,) captions and their (N, dim) embeddings atomically: safetensors ``embeddings``, the captions
+    and the encoder's name in the metadata (the format of the cache and of :mod:`simdiff.text.table`)."""
+    import json
+
+    from simdiff.model.checkpoint import atomic_save_tensors
+
+    atomic_save_tensors({"embeddings": table}, path, metadata={"captions": json.dumps(captions), "encoder": encoder})
+
+
+def read_caption_file(path: str | os.PathLike[str]) -> tuple[list[str], Tensor, str]:
+    """(captions, (N, dim) embeddings in their stored dtype, encoder name) of a :func:`write_caption_file` file.
+
+    Raises the reader's own errors on a file that is not one (``SafetensorError``, ``KeyError``,
+    ``json.JSONDecodeError``, ``OSError``); callers turn them into their own messages.
+    """
+    import json
+
+    from safetensors import safe_open
+
+    with safe_open(str(path), "pt") as f:
+        meta = f.metadata() or {}
+        table = f.get_tensor("embeddings")
+    return json.loads(meta["captions"]), table, str(meta["encoder"])

@@ -5,7 +5,7 @@ within its 64 MiB; a corpus's captions are few (corpus3: 2,753 distinct captions
 float16), so they are encoded here once (``simdiff train text-table``) and the pipeline reads
 them there (``simdiff train pipeline --text-table FILE``). A caption that is not in the table is
 an error naming it, never a silent zero vector. The file has the layout of
-:meth:`simdiff.text.cache.CachedTextEncoder.save` (``embeddings`` + the captions in the metadata).
+:func:`simdiff.text.cache.write_caption_file`, shared with the training caption cache.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from torch import Tensor
 
 from simdiff.errors import SimdiffError
 from simdiff.text.base import TextEncoder
+from simdiff.text.cache import read_caption_file, write_caption_file
 
 
 class CaptionTable:
@@ -32,17 +33,14 @@ class CaptionTable:
     """
 
     def __init__(self, path: str | os.PathLike[str], device: torch.device | str = "cpu") -> None:
-        from safetensors import SafetensorError, safe_open
+        from safetensors import SafetensorError
 
         self.path = Path(path)
         if not self.path.is_file():
             raise SimdiffError(f"text table not found: {self.path}")
         try:
-            with safe_open(str(self.path), "pt") as f:
-                meta = f.metadata() or {}
-                table = f.get_tensor("embeddings").float()
-            captions = json.loads(meta["captions"])
-            self.name = str(meta["encoder"])
+            captions, table, self.name = read_caption_file(self.path)
+            table = table.float()
         except (SafetensorError, KeyError, json.JSONDecodeError, OSError) as exc:
             raise SimdiffError(f"{self.path}: not a text table ({type(exc).__name__}); "
                                "write one with `simdiff train text-table`") from None
@@ -90,12 +88,10 @@ def write_caption_table(captions: Iterable[str], encoder: TextEncoder, out: str 
     ``dtype``: ``float16`` (half the size; within about 1e-3 of the float32 vectors) or ``float32``.
     Returns a summary (captions, dim, dtype, bytes).
     """
-    from simdiff.model.checkpoint import atomic_save_tensors
-
     if dtype not in ("float16", "float32"):
         raise SimdiffError(f"text table dtype must be float16 or float32, got {dtype!r}")
     texts = list(dict.fromkeys(["", *captions]))
     parts = [encoder.encode(texts[i:i + chunk]).float().cpu() for i in range(0, len(texts), chunk)]
     table = torch.cat(parts).to(getattr(torch, dtype)).contiguous()
-    atomic_save_tensors({"embeddings": table}, out, metadata={"captions": json.dumps(texts), "encoder": encoder.name})
+    write_caption_file(out, texts, table, encoder.name)
     return {"captions": len(texts), "dim": int(table.shape[1]), "dtype": dtype, "bytes": Path(out).stat().st_size}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -116,15 +117,8 @@ def run(args: argparse.Namespace) -> int:
         from simdiff.product.finisher import start_finisher
 
         finisher = start_finisher(request.num_samples * len(request.envs))
-    try:
-        code = _generate(args, request, start, finisher)
-    except BaseException:
-        if finisher is not None:
-            finisher.close(cancel=True)
-        raise
-    if finisher is not None:
-        finisher.close()
-    return code
+    with finisher if finisher is not None else nullcontext():  # an error or Ctrl-C stops the worker at once
+        return _generate(args, request, start, finisher)
 
 
 def _generate(args: argparse.Namespace, request: GenerationRequest, start: float, finisher: Finisher | None) -> int:
