@@ -67,3 +67,28 @@ def test_cli_writes_a_table_of_every_corpus_caption(tiny_corpus, tmp_path, capsy
     assert len(table) == len(set(corpus_captions(tiny_corpus)) | {"", "a person jumps forward"})
     assert "wrote" in capsys.readouterr().out
     assert main(["train", "text-table", str(tmp_path / "nowhere"), "--out", str(tmp_path / "u.safetensors")]) != 0
+
+
+def test_cli_backbone_trains_from_a_table_without_loading_the_encoder(tiny_corpus, tmp_path, monkeypatch,
+                                                                       capsys) -> None:
+    path = tmp_path / "captions.safetensors"
+    write_caption_table(corpus_captions(tiny_corpus), FakeMiniLM(), path)
+
+    def no_weights(*args, **kwargs):
+        raise AssertionError("train backbone loaded the text encoder although a table was given")
+
+    monkeypatch.setattr("simdiff.text.base.load_text_encoder", no_weights)
+    run = tmp_path / "run"
+    argv = ["train", "backbone", "--data", str(tiny_corpus), "--size", "tiny", "--steps", "4", "--batch-size", "2",
+            "--save-every", "2", "--out", str(run), "--text-table", str(path), "--no-progress"]
+    assert main(argv + ["--max-minutes", "1e-9"]) == 0  # stops at the first checkpoint past the cap
+    assert "to step 2" in capsys.readouterr().out
+    assert main(argv + ["--loader-workers", "1"]) == 0  # resumes to the end with batches built ahead
+    assert "to step 4" in capsys.readouterr().out
+    assert main(argv + ["--max-minutes", "-1"]) == 2
+    assert "--max-minutes must be >= 0, got -1.0" in capsys.readouterr().err
+    assert main(argv + ["--loader-workers", "-2"]) == 2
+    assert "--loader-workers must be >= 0, got -2" in capsys.readouterr().err
+    clip = [a if a != str(run) else str(tmp_path / "clip") for a in argv]
+    assert main(clip + ["--text-encoder", "clip"]) == 2
+    assert "holds 'minilm' embeddings, the run uses 'clip'" in capsys.readouterr().err

@@ -157,3 +157,23 @@ def test_ema_warms_up_so_initial_weights_fade() -> None:
         ema.update(step)
     # without warm-up the initial zeros would still weigh 0.999**1000 = 0.37
     assert float(ema.shadow["p"][0]) > 0.99
+
+
+def test_loader_workers_give_the_same_run_as_in_process_batches(tmp_path) -> None:
+    ds = synthetic_dataset(6, 24, max_frames=24)
+    cfg = run_config(6, save_every=3)
+    Trainer(tmp_path / "a", cfg, ds, text_encoder=HashText()).train(progress=False)
+    Trainer(tmp_path / "b", cfg, ds, text_encoder=HashText(), loader_workers=2).train(progress=False)
+    a, b = _weights(tmp_path / "a" / "model"), _weights(tmp_path / "b" / "model")
+    assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
+    with pytest.raises(SimdiffError, match="loader_workers must be >= 0, got -1"):
+        Trainer(tmp_path / "c", cfg, ds, text_encoder=HashText(), loader_workers=-1)
+
+
+def test_train_for_stops_at_the_first_checkpoint_past_the_wall_clock_cap(tmp_path) -> None:
+    ds = synthetic_dataset(4, 20, max_frames=20)
+    trainer = Trainer(tmp_path, run_config(9, save_every=3), ds, text_encoder=HashText())
+    assert len(trainer.train_for(1e-9, progress=False)) == 3  # one checkpoint period, then the cap holds
+    assert trainer.step == 3 and latest_checkpoint(tmp_path).name == "step_000000003"
+    trainer.train_for(0.0, progress=False)  # no cap: to the configured steps
+    assert trainer.step == 9

@@ -67,6 +67,14 @@ class CaptionTable:
             torch.zeros(0, self.dim, device=self.device)
 
 
+def open_caption_table(path: str | os.PathLike[str], encoder: str, device: torch.device | str = "cpu") -> CaptionTable:
+    """The table at ``path``, refused in one line unless its embeddings come from ``encoder`` (e.g. ``"minilm"``)."""
+    table = CaptionTable(path, device)
+    if table.name != encoder:
+        raise SimdiffError(f"text table {path} holds {table.name!r} embeddings, the run uses {encoder!r}")
+    return table
+
+
 def corpus_captions(corpus: str | os.PathLike[str]) -> list[str]:
     """Every caption of a HumanML3D-layout corpus (``texts/*.txt``, all splits), in file order, without repeats."""
     from simdiff.data.humanml3d import read_captions

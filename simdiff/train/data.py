@@ -135,3 +135,30 @@ def synthetic_dataset(num_clips: int = 8, frames: int = 60, max_frames: int = 19
         captions.append(f"synthetic motion number {i}")
         envs.append([float(rng.uniform(-15, -3)), float(rng.uniform(-10, 10)), float(rng.uniform(-10, 10))])
     return TensorMotionDataset(motions, captions, envs if with_env else None, max_frames=max_frames)
+
+
+class StepBatches(torch.utils.data.Dataset):
+    """The collated, cropped batches of steps ``start .. end - 1`` of a run, item ``i`` being step ``start + i``.
+
+    A batch depends only on ``(seed, step, rank)``, so DataLoader worker processes can build them ahead of the
+    training loop (``Trainer(loader_workers=N)``) and the run stays bit-identical to building them in-process.
+    """
+
+    def __init__(self, dataset: MotionDataset, batcher: StepBatcher, seed: int, rank: int, crop: Any,
+                 start: int = 0, end: int = 0) -> None:
+        self.dataset, self.batcher, self.seed, self.rank, self.crop = dataset, batcher, seed, rank, crop
+        self.start, self.end = start, end
+
+    def __len__(self) -> int:
+        return max(0, self.end - self.start)
+
+    def batch(self, step: int) -> dict[str, Any]:
+        """The batch of ``step`` for this process."""
+        from simdiff.train.geometric import crop_batch
+
+        rng = np.random.default_rng([self.seed, step, self.rank])
+        batch = collate([fetch(self.dataset, i, rng) for i in self.batcher.indices(step)])
+        return crop_batch(batch, self.crop, rng)
+
+    def __getitem__(self, index: int) -> dict[str, Any]:
+        return self.batch(self.start + index)

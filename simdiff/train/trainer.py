@@ -13,8 +13,9 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 import torch
@@ -29,9 +30,9 @@ from simdiff.model.provenance import Provenance, write_provenance
 from simdiff.model.simdiff_net import SimDiffNet
 from simdiff.text.cache import CachedTextEncoder
 from simdiff.train.config import RunConfig
-from simdiff.train.data import MotionDataset, StepBatcher, collate, fetch
+from simdiff.train.data import MotionDataset, StepBatcher, StepBatches
 from simdiff.train.ema import EMA
-from simdiff.train.geometric import crop_batch, geometric_loss
+from simdiff.train.geometric import geometric_loss
 from simdiff.train.state import latest_checkpoint, read_checkpoint, write_checkpoint
 
 
@@ -61,13 +62,19 @@ class Trainer:
         rank, world_size: DDP process (``torch.distributed`` must already be initialised when > 1).
         provenance: what the run trains on (:mod:`simdiff.model.provenance`); written as
             ``model/provenance.json`` with every export when given.
+        loader_workers: DataLoader processes that build batches ahead (0: in this process); the batches, and
+            so the run, are the same either way.
     """
 
     def __init__(self, run_dir: str | Path, config: RunConfig, dataset: MotionDataset, *, text_encoder: Any = None,
                  device: torch.device | str = "cpu", init_model: str | Path | None = None,
                  mean: Tensor | None = None, std: Tensor | None = None, resume: bool = True,
-                 rank: int = 0, world_size: int = 1, provenance: Provenance | None = None) -> None:
+                 rank: int = 0, world_size: int = 1, provenance: Provenance | None = None,
+                 loader_workers: int = 0) -> None:
         self.run_dir = Path(run_dir)
+        if loader_workers < 0:
+            raise SimdiffError(f"loader_workers must be >= 0, got {loader_workers}")
+        self.loader_workers = loader_workers
         self.provenance = provenance
         self.config = config
         self.dataset = dataset
@@ -162,9 +169,22 @@ class Trainer:
 
     def batch(self, step: int) -> dict[str, Any]:
         """The collated batch of step ``step`` for this process."""
-        rng = np.random.default_rng([self.config.train.seed, step, self.rank])
-        batch = collate([fetch(self.dataset, i, rng) for i in self.batcher.indices(step)])
-        return crop_batch(batch, self.config.train.crop, rng)
+        return self._step_batches().batch(step)
+
+    def _step_batches(self, start: int = 0, end: int = 0) -> StepBatches:
+        tc = self.config.train
+        return StepBatches(self.dataset, self.batcher, tc.seed, self.rank, tc.crop, start, end)
+
+    def _batches(self, end: int) -> Iterator[dict[str, Any]]:
+        """Batches of steps ``self.step .. end - 1`` in order: built here, or ahead by ``loader_workers`` processes."""
+        if self.loader_workers <= 0:
+            for step in range(self.step, end):
+                yield self.batch(step)
+            return
+        loader = torch.utils.data.DataLoader(self._step_batches(self.step, end), batch_size=None, shuffle=False,
+                                             num_workers=self.loader_workers, prefetch_factor=4,
+                                             pin_memory=self.device.type == "cuda")
+        yield from loader
 
     def condition(self, batch: dict[str, Any], generator: torch.Generator) -> Condition:
         """Text vectors with per-sample dropout (p = ``cond_mask_prob``) and φ (never dropped)."""
@@ -182,11 +202,12 @@ class Trainer:
         return Condition(text=self.text.encode(batch["captions"]), uncond=uncond.to(self.device),
                          frame_mask=batch["mask"].to(self.device), env=mv(env), env_index=mv(env_index), alpha=1.0)
 
-    def train_step(self) -> float:
-        """One optimiser step; returns the (local) loss."""
+    def train_step(self, batch: dict[str, Any] | None = None) -> float:
+        """One optimiser step on ``batch`` (default: this step's batch, built here); returns the (local) loss."""
         tc = self.config.train
         self.model.train()
-        batch = self.batch(self.step)
+        if batch is None:
+            batch = self.batch(self.step)
         data_seed, dropout_seed = _seeds(tc.seed, self.step, self.rank)
         generator = torch.Generator().manual_seed(data_seed)
         cond = self.condition(batch, generator)
@@ -225,8 +246,9 @@ class Trainer:
             bar = tqdm(total=tc.steps, initial=self.step, desc=f"train {tc.mode}", unit="step", dynamic_ncols=True)
         losses: list[float] = []
         window: list[float] = []
+        batches = self._batches(end)
         while self.step < end:
-            value = self.train_step()
+            value = self.train_step(next(batches))
             losses.append(value)
             window = (window + [value])[-max(1, tc.log_every):]
             if bar is not None:
@@ -243,6 +265,23 @@ class Trainer:
         if self._saved_step != self.step:
             self.save()
         self.history.extend(losses)
+        return losses
+
+    def train_for(self, max_minutes: float, progress: bool = True) -> list[float]:
+        """Train to ``config.train.steps``, or stop at the first checkpoint after ``max_minutes`` of wall clock.
+
+        ``max_minutes <= 0`` means no limit. At least one checkpoint period runs; the run stays resumable.
+        Returns the losses of the steps run in this call.
+        """
+        if max_minutes <= 0:
+            return self.train(progress=progress)
+        start = time.monotonic()
+        chunk = max(1, self.config.train.save_every or 100)
+        losses: list[float] = []
+        while self.step < self.config.train.steps:
+            losses += self.train(until=self.step + chunk, progress=progress)
+            if time.monotonic() - start >= 60.0 * max_minutes:
+                break
         return losses
 
     # --- output -----------------------------------------------------------------------------

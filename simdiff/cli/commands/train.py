@@ -33,6 +33,13 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--save-every", type=int, help="checkpoint period in steps")
     p.add_argument("--device", default="cpu", help="torch device, e.g. cpu, cuda, cuda:1 (default: cpu)")
     p.add_argument("--clip-weights", help="local CLIP ViT-B/32 weights file (with --text-encoder clip)")
+    p.add_argument("--text-table", type=Path,
+                   help="precomputed caption embeddings (`simdiff train text-table`) instead of loading the text "
+                        "encoder's weights (a GPU machine without them)")
+    p.add_argument("--max-minutes", type=float, default=0.0,
+                   help="stop at the first checkpoint after this much wall clock (0 = run to --steps); resumable")
+    p.add_argument("--loader-workers", type=int, default=0,
+                   help="processes that build batches ahead of the training loop (0: none; same batches either way)")
     p.add_argument("--no-resume", action="store_true", help="refuse to continue an existing run folder")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
@@ -100,6 +107,10 @@ def _run_config(args: argparse.Namespace):
         tc.optim.lr = args.lr
     if tc.steps < 1 or tc.batch_size < 1:
         raise SimdiffError("--steps and --batch-size must be positive")
+    if args.loader_workers < 0:
+        raise SimdiffError(f"--loader-workers must be >= 0, got {args.loader_workers}")
+    if args.max_minutes < 0:
+        raise SimdiffError(f"--max-minutes must be >= 0, got {args.max_minutes}")
     if args.mode == "backbone":
         model = config.model
         if args.size is not None:
@@ -177,12 +188,17 @@ def run(args: argparse.Namespace) -> int:
     if device.type == "cuda" and dist.world_size > 1:
         device = torch.device("cuda", dist.local_rank)
     try:
-        encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
+        if args.text_table is not None:
+            from simdiff.text.table import open_caption_table
+
+            encoder = open_caption_table(args.text_table, config.model.text_encoder, device)
+        else:
+            encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
         dataset = _dataset(args, config.train.seed)
         trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
                           init_model=getattr(args, "init", None), rank=dist.rank, world_size=dist.world_size,
-                          provenance=_provenance(args))
-        losses = trainer.train(progress=not args.no_progress)
+                          provenance=_provenance(args), loader_workers=args.loader_workers)
+        losses = trainer.train_for(args.max_minutes, progress=not args.no_progress)
         if dist.is_main:
             tail = losses[-10:]
             final = f", final loss {sum(tail) / len(tail):.4f}" if tail else ""

@@ -39,14 +39,9 @@ class PipelineContext:
         """The text encoder: injected, else ``config.text_table``'s captions when set, else the named encoder."""
         if self.text_encoder is None:
             if self.config.text_table:
-                from simdiff.errors import SimdiffError
-                from simdiff.text.table import CaptionTable
+                from simdiff.text.table import open_caption_table
 
-                table = CaptionTable(self.config.text_table, self.device)
-                if table.name != self.config.text_encoder:
-                    raise SimdiffError(f"text table {self.config.text_table} holds {table.name!r} embeddings, "
-                                       f"the run uses {self.config.text_encoder!r}")
-                self.text_encoder = table
+                self.text_encoder = open_caption_table(self.config.text_table, self.config.text_encoder, self.device)
             else:
                 from simdiff.text.base import load_text_encoder
 

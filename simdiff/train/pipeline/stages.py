@@ -94,17 +94,9 @@ def adapters_settings(ctx: PipelineContext) -> dict[str, Any]:
 def _train(ctx: PipelineContext, trainer: Any, max_minutes: float) -> dict[str, Any]:
     """Train to the configured steps, or until ``max_minutes`` of wall clock (stopping at a checkpoint)."""
     start = time.monotonic()
-    tc = trainer.config.train
-    if max_minutes <= 0:
-        trainer.train(progress=ctx.progress)
-    else:
-        chunk = max(1, tc.save_every or 100)
-        while trainer.step < tc.steps:  # at least one chunk, then stop at the first checkpoint past the cap
-            trainer.train(until=trainer.step + chunk, progress=ctx.progress)
-            if time.monotonic() - start >= 60.0 * max_minutes:
-                break
+    trainer.train_for(max_minutes, progress=ctx.progress)
     tail = trainer.history[-10:]
-    return {"step": trainer.step, "steps": tc.steps, "wall_s": round(time.monotonic() - start, 2),
+    return {"step": trainer.step, "steps": trainer.config.train.steps, "wall_s": round(time.monotonic() - start, 2),
             "final_loss": round(sum(tail) / len(tail), 6) if tail else None}
 
 
