@@ -15,6 +15,7 @@ import torch
 from torch import Tensor
 
 from simdiff.errors import SimdiffError
+from simdiff.train.geometric import crop_batch
 
 
 class MotionDataset(Protocol):
@@ -154,8 +155,6 @@ class StepBatches(torch.utils.data.Dataset):
 
     def batch(self, step: int) -> dict[str, Any]:
         """The batch of ``step`` for this process."""
-        from simdiff.train.geometric import crop_batch
-
         rng = np.random.default_rng([self.seed, step, self.rank])
         batch = collate([fetch(self.dataset, i, rng) for i in self.batcher.indices(step)])
         return crop_batch(batch, self.crop, rng)

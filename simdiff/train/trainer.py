@@ -178,8 +178,9 @@ class Trainer:
     def _batches(self, end: int) -> Iterator[dict[str, Any]]:
         """Batches of steps ``self.step .. end - 1`` in order: built here, or ahead by ``loader_workers`` processes."""
         if self.loader_workers <= 0:
+            source = self._step_batches()
             for step in range(self.step, end):
-                yield self.batch(step)
+                yield source.batch(step)
             return
         loader = torch.utils.data.DataLoader(self._step_batches(self.step, end), batch_size=None, shuffle=False,
                                              num_workers=self.loader_workers, prefetch_factor=4,
@@ -232,10 +233,12 @@ class Trainer:
         return value
 
     def train(self, until: int | None = None, progress: bool = True,
-              on_step: Callable[[int, float], None] | None = None) -> list[float]:
+              on_step: Callable[[int, float], None] | None = None,
+              stop: Callable[[], bool] | None = None) -> list[float]:
         """Train up to ``until`` (default ``config.train.steps``) steps, checkpointing on the way.
 
-        Returns the losses of the steps run in this call.
+        ``stop`` is asked at every checkpoint (every 100 steps when ``save_every`` is 0); ``True`` ends the call
+        there. Returns the losses of the steps run in this call.
         """
         tc = self.config.train
         end = min(tc.steps, until) if until is not None else tc.steps
@@ -260,6 +263,9 @@ class Trainer:
                 on_step(self.step, value)
             if tc.save_every and self.step % tc.save_every == 0:
                 self.save()
+            if stop is not None and self.step % (tc.save_every or 100) == 0 and stop():
+                break
+        batches.close()
         if bar is not None:
             bar.close()
         if self._saved_step != self.step:
@@ -270,19 +276,12 @@ class Trainer:
     def train_for(self, max_minutes: float, progress: bool = True) -> list[float]:
         """Train to ``config.train.steps``, or stop at the first checkpoint after ``max_minutes`` of wall clock.
 
-        ``max_minutes <= 0`` means no limit. At least one checkpoint period runs; the run stays resumable.
-        Returns the losses of the steps run in this call.
+        ``max_minutes <= 0`` means no limit. The run stays resumable. Returns the losses of the steps run in this call.
         """
         if max_minutes <= 0:
             return self.train(progress=progress)
-        start = time.monotonic()
-        chunk = max(1, self.config.train.save_every or 100)
-        losses: list[float] = []
-        while self.step < self.config.train.steps:
-            losses += self.train(until=self.step + chunk, progress=progress)
-            if time.monotonic() - start >= 60.0 * max_minutes:
-                break
-        return losses
+        deadline = time.monotonic() + 60.0 * max_minutes
+        return self.train(progress=progress, stop=lambda: time.monotonic() >= deadline)
 
     # --- output -----------------------------------------------------------------------------
 
