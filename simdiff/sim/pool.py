@@ -29,6 +29,7 @@ from simdiff.sim.env import Environment
 from simdiff.sim.flight import FlightConfig
 from simdiff.sim.project import ProjectionInfo, project
 from simdiff.sim.residual import ResidualConfig
+from simdiff.sim.retime import RetimeConfig
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,7 @@ class PoolConfig:
         force: skip φ range validation.
         ray_address: address for ``ray.init`` (None: local or RAY_ADDRESS).
         flight: the flight clock passed to :func:`project` (None: the reference's own clock).
+        retime: the weak-gravity second try passed to :func:`project` (None: one try).
     """
 
     workers: int = 0
@@ -54,6 +56,7 @@ class PoolConfig:
     ray_address: str | None = None
     extra: dict = field(default_factory=dict)
     flight: FlightConfig | None = None
+    retime: RetimeConfig | None = None
 
 
 Result = tuple[np.ndarray | None, Any]
@@ -101,7 +104,7 @@ def _run_one(args: tuple[np.ndarray, tuple[float, float, float], PoolConfig]) ->
     try:
         return project(
             joints, Environment(*phi), residual=cfg.residual, retarget=cfg.retarget,
-            normalizer=_normalizer(cfg.stats_dir), force=cfg.force, flight=cfg.flight,
+            normalizer=_normalizer(cfg.stats_dir), force=cfg.force, flight=cfg.flight, retime=cfg.retime,
         )
     except Exception as exc:  # one bad motion must not stop the batch
         return None, f"{type(exc).__name__}: {exc}"

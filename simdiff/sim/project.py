@@ -22,6 +22,7 @@ from simdiff.sim.faithfulness import feature_distance, normalized_features, pose
 from simdiff.sim.flight import FlightConfig, aligned_source
 from simdiff.sim.humanoid import TOE_JOINT_HEIGHT, HumanoidConfig, load_model, model_index, world_to_hml
 from simdiff.sim.residual import ResidualConfig
+from simdiff.sim.retime import RetimeConfig, better, stretch
 from simdiff.sim.rollout import FallConfig, RolloutResult, rollout
 from simdiff.sim.strength import StrengthConfig
 from simdiff.sim.tracker import Tracker
@@ -59,6 +60,10 @@ class ProjectionInfo:
         d_l2_pose: :func:`simdiff.sim.faithfulness.pose_d_l2` against the re-timed source
             (pose channels only); NaN without a normaliser.
         time_warp: rollout length / source length (1 without a flight clock).
+        retime_scale: slow-down of the source this rollout tracked (1: as given; > 1: the
+            second, dynamically similar try of :mod:`simdiff.sim.retime`).
+        attempts: rollouts simulated (2 when a re-timed try was made, whichever was kept);
+            ``cpu_s`` and ``sim_cpu_s`` count both.
     """
 
     success: bool
@@ -78,6 +83,8 @@ class ProjectionInfo:
     violations: list[str] = field(default_factory=list)
     d_l2_pose: float = float("nan")
     time_warp: float = 1.0
+    retime_scale: float = 1.0
+    attempts: int = 1
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -124,6 +131,7 @@ def project(
     audit: bool = False,
     flight: FlightConfig | None = None,
     strength: StrengthConfig | None = StrengthConfig(),
+    retime: RetimeConfig | None = None,
 ) -> tuple[np.ndarray, ProjectionInfo]:
     """P_φ,π(τ): replay ``joints`` in MuJoCo under ``env`` and return the rollout.
 
@@ -139,13 +147,37 @@ def project(
             None: the reference's own clock (output at most as long as the input).
         strength: actuator strength under |g_z| > 9.81 (:mod:`simdiff.sim.strength`; default
             × max(1, |g_z|/9.81); None: Earth strength at every g).
+        retime: under |g_z| < 9.81, when the rollout fell or its pose d_L2 exceeds the
+            trigger, track the source slowed to the same Froude number as well and keep the
+            better rollout (:mod:`simdiff.sim.retime`); None (default): one try.
     Returns:
         (rollout joints (T', 22, 3) float32, :class:`ProjectionInfo`).
     """
-    t0 = time.process_time()
     env.validate(force=force)
     model = model if model is not None else load_model(HumanoidConfig())
     joints = np.asarray(joints, dtype=np.float64)
+    kw = dict(model=model, tracker=tracker, residual=residual, retarget=retarget, fall=fall, normalizer=normalizer,
+              audit=audit, flight=flight, strength=strength)
+    out, info = _project_once(joints, env, **kw)
+    scale = 1.0 if retime is None else retime.scale(env.gravity)
+    if scale == 1.0 or not retime.should_retry(info.status, info.d_l2_pose):
+        return out, info
+    out2, info2 = _project_once(stretch(joints, scale).astype(np.float64), env, **kw)
+    cpu, sim_cpu = info.cpu_s + info2.cpu_s, info.sim_cpu_s + info2.sim_cpu_s
+    if better((info.status, info.d_l2_pose), (info2.status, info2.d_l2_pose)):
+        out, info = out2, info2
+        info.n_frames = int(joints.shape[0])
+        info.time_warp = float(info.n_out / max(joints.shape[0], 1))
+        info.retime_scale = float(scale)
+    info.cpu_s, info.sim_cpu_s, info.attempts = cpu, sim_cpu, 2
+    return out, info
+
+
+def _project_once(joints: np.ndarray, env: Environment, *, model, tracker: Tracker | None, residual: ResidualConfig,
+                  retarget: RetargetConfig, fall: FallConfig, normalizer, audit: bool, flight: FlightConfig | None,
+                  strength: StrengthConfig | None) -> tuple[np.ndarray, ProjectionInfo]:
+    """One rollout of ``joints`` (float64, validated φ) and its distances; see :func:`project`."""
+    t0 = time.process_time()
     ref = make_reference(model, joints, retarget, gravity=env.gravity)
     res = rollout(model, ref, env, tracker, residual, fall, audit=audit, flight=flight, strength=strength)
     out = rollout_joints(model, res, joints.shape[0] if flight is None else None, retarget.fps)

@@ -60,6 +60,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "version (records' sim_version), re-derive their mirrors, rewrite their files and shards, "
                         "then finalise; resumable. -9.81: exactly the pairs changed by the gravity-scaled "
                         "actuators (issue 13)")
+    p.add_argument("--no-retime", action="store_true",
+                   help="one try per pair: do not retry a weak-gravity (|g_z| < 9.81) rollout that fell or strayed on "
+                        "the source slowed to the same Froude number (simdiff.sim.retime; on by default). Runs made "
+                        "before retiming existed resume only with this flag")
     p.add_argument("--limit", type=int, help="augment only the first N clips of the split")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(func=run)
@@ -90,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
                                                residual_follows_strength=not args.residual_fixed),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip, share_mirrors=args.share_mirrors,
-                           resimulate_gravity_below=args.resimulate_gravity_below)
+                           resimulate_gravity_below=args.resimulate_gravity_below, retime=not args.no_retime)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)
     frac = report["kept_fraction"]
     cal = report["filter"].get("calibration")

@@ -16,6 +16,7 @@ from simdiff.sim.env import Environment
 from simdiff.sim.flight import FlightConfig
 from simdiff.sim.pool import PoolConfig, ProjectionPool, Projector, Result
 from simdiff.sim.residual import ResidualConfig
+from simdiff.sim.retime import RetimeConfig
 from simdiff.sim.retarget.config import RetargetConfig
 
 __all__ = ["Projector", "Result", "SimProjector"]
@@ -32,6 +33,9 @@ class SimProjector:
         max_force: root residual bound (fraction of m·|g_z|) passed to the tracker.
         flight: the flight clock (default on: flights last as long as φ makes them, the
             rollout may be longer than its source); None: the reference's own clock.
+        retime: under |g_z| < 9.81, a second try on the source slowed to the same Froude number
+            when the first rollout fell or strayed (:mod:`simdiff.sim.retime`; the augmentation's
+            default); None: one try (PhysDiff, the evaluation's re-tracking).
         anchor_stance: :attr:`simdiff.sim.retarget.RetargetConfig.anchor_stance` (planted feet
             stay put; the simulated finish of generated motion; off for augmentation and PhysDiff).
     Raises:
@@ -44,10 +48,11 @@ class SimProjector:
     max_force: float = 0.5
     flight: FlightConfig | None = FlightConfig()
     anchor_stance: bool = False
+    retime: RetimeConfig | None = None
 
     def __post_init__(self) -> None:
         self._pool = ProjectionPool(PoolConfig(workers=self.workers, backend=self.backend, stats_dir=self.stats_dir,
-                                               residual=ResidualConfig(max_force=self.max_force), flight=self.flight,
+                                               residual=ResidualConfig(max_force=self.max_force), flight=self.flight, retime=self.retime,
                                                retarget=RetargetConfig(anchor_stance=self.anchor_stance)))
 
     def __call__(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:

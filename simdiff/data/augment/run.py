@@ -42,7 +42,7 @@ import json
 import os
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
@@ -60,6 +60,7 @@ from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_
 from simdiff.errors import SimdiffError
 from simdiff.sim.env import Environment
 from simdiff.sim.project import SIM_VERSION
+from simdiff.sim.retime import RetimeConfig
 
 BINARY_SIM_INDEX: int = 1
 """``env_index`` of simulated clips in binary mode (0 = source clips)."""
@@ -92,6 +93,10 @@ class AugmentConfig:
             below this (m/s²) that an older simulator version made, and their mirrors
             (:mod:`simdiff.data.augment.resim`; −9.81: what issue 13 changed). Not a setting:
             a resumed run may add it. None: off.
+        retime: under |g_z| < 9.81, retry a rollout that fell or strayed from the source's pose on
+            the source slowed to the same Froude number and keep the better one
+            (:mod:`simdiff.sim.retime`; records carry ``retime_scale``). A setting: a run made
+            before it existed resumes only with ``retime=False``.
 
     Modes (:mod:`simdiff.data.augment.conditions`): ``paired`` (default; Earth + ``conditions``
     (default 6) draws per clip), ``paper`` (every clip under all ``conditions`` (30) random
@@ -111,6 +116,7 @@ class AugmentConfig:
     per_clip: int | None = None
     share_mirrors: bool = False
     resimulate_gravity_below: float | None = None
+    retime: bool = True
 
     @property
     def n_conditions(self) -> int:
@@ -130,6 +136,8 @@ class AugmentConfig:
             settings["per_clip"] = self.per_clip
         if self.share_mirrors:
             settings["share_mirrors"] = True
+        if self.retime:
+            settings["retime"] = asdict(RetimeConfig())
         return settings
 
 
@@ -370,7 +378,8 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
         if not (path.is_file() and _read_json(path).get("clips") == shard):
             todo.append(i)
     own = projector is None
-    proj: Projector = projector or SimProjector(str(corpus), config.workers, config.backend, config.residual_bound)
+    proj: Projector = projector or SimProjector(str(corpus), config.workers, config.backend, config.residual_bound,
+                                                 retime=RetimeConfig() if config.retime else None)
     total = sum(len(assigned[c]) for c in clips)
     done = sum(len(assigned[c]) for i in range(len(shards)) if i not in todo for c in shards[i])
     start = time.time()
