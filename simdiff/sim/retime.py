@@ -22,9 +22,9 @@ Only the reference is slowed; the body, its gains and the tracker are as at Eart
 the actuators the similar strength, kp × |g|/9.81 and kd × sqrt(|g|/9.81), kept fewer pairs
 on a 28-pair sample, 5 against 9).
 
-Measured (``benchmarks/bench_flight_keep.py`` → ``reports/augment/retime.md``; 100 corpus3
-train clips with flight, augmentation filter): kept at g ∈ [−3, −1) 5 → 26 %, [−5, −3)
-16 → 57 %, [−8.5, −5) 34 → 47 % (Earth 39 %); CPU per pair 0.7 → 2.3 s at [−3, −1).
+Measured (``benchmarks/bench_flight_keep.py`` → ``reports/augment/retime.md``; corpus3 train
+clips with flight, augmentation filter): kept at g ∈ [−3, −1) 10 → 32 % (200 clips), [−5, −3)
+16 → 57 %, [−8.5, −5) 34 → 47 % (100 clips; Earth 39 %); CPU per pair 0.7 → 2.3 s at [−3, −1).
 """
 
 from __future__ import annotations
