@@ -52,7 +52,8 @@ class SimProjector:
 
     def __post_init__(self) -> None:
         self._pool = ProjectionPool(PoolConfig(workers=self.workers, backend=self.backend, stats_dir=self.stats_dir,
-                                               residual=ResidualConfig(max_force=self.max_force), flight=self.flight, retime=self.retime,
+                                               residual=ResidualConfig(max_force=self.max_force), flight=self.flight,
+                                               retime=self.retime,
                                                retarget=RetargetConfig(anchor_stance=self.anchor_stance)))
 
     def __call__(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:
