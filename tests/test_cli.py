@@ -76,29 +76,3 @@ def test_parsers_can_be_built_repeatedly():
         build_parser()
         gc.collect()
     assert build_parser().parse_args(["data", "report", "x"]).command == "data"
-
-
-def test_sigterm_stops_a_command_like_ctrl_c_and_runs_its_cleanup(monkeypatch, capsys):
-    import argparse
-    import os
-    import signal
-
-    import simdiff.cli.main as cli
-
-    cleaned = []
-
-    def command(args):
-        try:
-            os.kill(os.getpid(), signal.SIGTERM)
-            raise AssertionError("SIGTERM did not stop the command")
-        finally:
-            cleaned.append(True)  # e.g. a worker pool's close()
-
-    parser = argparse.ArgumentParser()
-    parser.set_defaults(func=command)
-    monkeypatch.setattr(cli, "build_parser", lambda: parser)
-    before = signal.getsignal(signal.SIGTERM)
-    assert cli.main([]) == 130
-    assert cleaned == [True]
-    assert "interrupted" in capsys.readouterr().err
-    assert signal.getsignal(signal.SIGTERM) is before  # the handler is restored after the command

@@ -11,9 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import pkgutil
-import signal
 import sys
-import threading
 from typing import Sequence
 
 from simdiff import __version__
@@ -57,7 +55,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: parse, dispatch, and turn user errors into one-line messages."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    previous = _raise_on_sigterm()
     try:
         return int(args.func(args) or 0)
     except SimdiffError as exc:
@@ -74,22 +71,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"simdiff: error: {where}{reason(exc)}", file=sys.stderr)
         return 1
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
-
-
-def _on_sigterm(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
-
-
-def _raise_on_sigterm():
-    """Make SIGTERM (``kill``, a job scheduler) stop a command like Ctrl-C: ``finally`` blocks run, so worker
-    pools are shut down and partial files cleaned instead of orphaned. Returns the previous handler (None when
-    not installed: not the main thread)."""
-    if threading.current_thread() is not threading.main_thread():
-        return None
-    return signal.signal(signal.SIGTERM, _on_sigterm)
 
 
 if __name__ == "__main__":  # pragma: no cover
