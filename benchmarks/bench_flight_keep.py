@@ -96,6 +96,7 @@ _STATE: dict = {}
 
 def run_task(task: dict) -> dict:
     """Project one task (in a worker: single-threaded, model and normaliser loaded once)."""
+    from simdiff.data.augment.filter import FilterConfig, keep_pair
     from simdiff.motion.flight import flight_stats
     from simdiff.sim.env import Environment
     from simdiff.sim.flight import FlightConfig
@@ -117,8 +118,7 @@ def run_task(task: dict) -> dict:
                         flight=FlightConfig(), retime=RetimeConfig() if task["variant"] == "retime" else None)
     fs = flight_stats(out) if len(out) >= 2 else {"flight_s": 0.0, "apex_gain_m": 0.0}
     res_n = float(info.residual["force_mean_n"])
-    budget = task["residual_n"] * max(1.0, abs(task["g"]) / 9.81)
-    kept = bool(info.status == "ok" and info.d_l2_pose <= task["pose_bound"] and res_n <= budget)
+    kept = keep_pair(info, FilterConfig(max_pose_d_l2=task["pose_bound"], max_residual_n=task["residual_n"]))[0]
     rec = {k: v for k, v in task.items() if k not in ("corpus",)}
     rec.update(status=info.status, pose=float(info.d_l2_pose), residual_n=res_n, kept=kept, n_out=info.n_out,
                time_warp=info.time_warp, retime_scale=info.retime_scale, attempts=info.attempts,
@@ -126,19 +126,10 @@ def run_task(task: dict) -> dict:
     return rec
 
 
-def wilson(k: int, n: int) -> list[float]:
-    """Wilson 95 % interval of k/n."""
-    if n == 0:
-        return [float("nan"), float("nan")]
-    z = 1.959964
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return [float(c - h), float(c + h)]
-
-
 def summary(path: Path) -> dict:
     """Per bin × variant: pairs, finished, kept (Wilson 95 %), re-timed kept, medians, CPU s."""
+    from simdiff.eval.model_check.detect import wilson
+
     recs = [json.loads(x) for x in path.read_text().splitlines() if x.strip()]
     earth_flight = {r["clip"]: r["flight_s"] for r in recs if r["bin"] == "earth" and r["status"] == "ok"}
     out: dict = {"records": len(recs), "clips": len({r["clip"] for r in recs}), "pose_bound": None}
@@ -153,7 +144,7 @@ def summary(path: Path) -> dict:
                       if r["status"] == "ok" and earth_flight.get(r["clip"], 0) > 0]
             out[f"{b} {v}"] = {
                 "pairs": len(rs), "finished": int(sum(r["status"] == "ok" for r in rs)), "kept": int(k),
-                "kept_rate": k / len(rs), "kept_wilson95": wilson(int(k), len(rs)),
+                "kept_rate": k / len(rs), "kept_wilson95": list(wilson(int(k), len(rs))[1:]),
                 "kept_retimed": int(sum(r["kept"] and r["retime_scale"] > 1 for r in rs)),
                 "second_tries": int(sum(r["attempts"] > 1 for r in rs)),
                 "pose_median": float(np.nanmedian([r["pose"] for r in rs])),
