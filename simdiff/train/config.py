@@ -35,6 +35,12 @@ class TrainConfig:
         log_every: loss averaging window for the progress bar.
         losses: MDM's geometric loss weights (all 0 by default: plain x₀ MSE).
         crop: length-cropped batches (off by default).
+        env_pairs: weight λ of the paired φ-difference loss (adapters mode; 0 = off, the paper's plain loss).
+            Each batch is B/2 clips and their twins (the same source clip simulated under another φ, the Earth
+            one when kept), both with the same caption, window, t, ε and text dropout, and the loss adds
+            ``λ · MSE(x̂₀(φ) − x̂₀(φ'), x₀(φ) − x₀(φ'))``: the response to φ, which the plain loss sees only as a
+            small part of each sample's error. The frozen backbone then runs without dropout so twin
+            predictions differ only through φ.
     """
 
     mode: str = "backbone"
@@ -50,6 +56,7 @@ class TrainConfig:
     optim: OptimConfig = field(default_factory=OptimConfig)
     losses: GeometricLossConfig = field(default_factory=GeometricLossConfig)
     crop: CropConfig = field(default_factory=CropConfig)
+    env_pairs: float = 0.0
 
 
 @dataclass

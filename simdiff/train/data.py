@@ -146,9 +146,14 @@ class StepBatches(torch.utils.data.Dataset):
     """
 
     def __init__(self, dataset: MotionDataset, batcher: StepBatcher, seed: int, rank: int, crop: Any,
-                 start: int = 0, end: int = 0) -> None:
+                 start: int = 0, end: int = 0, pairs: bool = False) -> None:
         self.dataset, self.batcher, self.seed, self.rank, self.crop = dataset, batcher, seed, rank, crop
         self.start, self.end = start, end
+        if pairs and not callable(getattr(dataset, "twin", None)):
+            raise SimdiffError("paired batches need a simulator-augmented dataset with twins (items of one source under several φ)")
+        if pairs and batcher.local_batch % 2:
+            raise SimdiffError(f"paired batches need an even batch per process, got {batcher.local_batch}")
+        self.pairs = pairs
 
     def __len__(self) -> int:
         return max(0, self.end - self.start)
@@ -156,8 +161,27 @@ class StepBatches(torch.utils.data.Dataset):
     def batch(self, step: int) -> dict[str, Any]:
         """The batch of ``step`` for this process."""
         rng = np.random.default_rng([self.seed, step, self.rank])
+        if self.pairs:
+            return self._paired(step, rng)
         batch = collate([fetch(self.dataset, i, rng) for i in self.batcher.indices(step)])
         return crop_batch(batch, self.crop, rng)
+
+    def _paired(self, step: int, rng: np.random.Generator) -> dict[str, Any]:
+        """h = B/2 anchors (the first half of the step's indices) then their twins, drawn alike; ``paired`` (h,) bool.
+
+        An anchor without a twin is repeated (``paired`` False: it counts in the plain loss only).
+        """
+        anchors = self.batcher.indices(step)[: self.batcher.local_batch // 2]
+        first, second, paired = [], [], []
+        for j, index in enumerate(anchors):
+            twin = self.dataset.twin(index, np.random.default_rng([self.seed, step, self.rank, j, 1]))  # type: ignore[attr-defined]
+            first.append(fetch(self.dataset, index, np.random.default_rng([self.seed, step, self.rank, j, 0])))
+            second.append(fetch(self.dataset, index if twin is None else twin,
+                                np.random.default_rng([self.seed, step, self.rank, j, 0])))
+            paired.append(twin is not None and int(first[-1]["length"]) == int(second[-1]["length"]))
+        batch = crop_batch(collate(first + second), self.crop, rng, pairs=len(anchors))
+        batch["paired"] = torch.tensor(paired, dtype=torch.bool)
+        return batch
 
     def __getitem__(self, index: int) -> dict[str, Any]:
         return self.batch(self.start + index)

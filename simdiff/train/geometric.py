@@ -60,8 +60,11 @@ class CropConfig:
         return self.max_frames > 0 or self.trim_padding
 
 
-def crop_batch(batch: dict[str, Any], config: CropConfig, rng: np.random.Generator) -> dict[str, Any]:
-    """Apply ``config`` to a collated batch (motion (B, T, F), lengths, mask) in place; returns it."""
+def crop_batch(batch: dict[str, Any], config: CropConfig, rng: np.random.Generator, pairs: int = 0) -> dict[str, Any]:
+    """Apply ``config`` to a collated batch (motion (B, T, F), lengths, mask) in place; returns it.
+
+    ``pairs`` = h > 0: items ``i`` and ``i + h`` (i < h) are twins of equal length and get the same window.
+    """
     if not config.active:
         return batch
     motion, lengths = batch["motion"], batch["lengths"].clone()
@@ -69,9 +72,16 @@ def crop_batch(batch: dict[str, Any], config: CropConfig, rng: np.random.Generat
     if config.max_frames > 0:
         cap = max(4, config.max_frames // 4 * 4)
         motion = motion.clone()
-        for i, n in enumerate(lengths.tolist()):
+        offsets: dict[int, int] = {}
+        full = lengths.tolist()
+        for i, n in enumerate(full):
             if n > cap:
-                off = int(rng.integers(n - cap + 1))
+                twin_of = i - pairs if pairs and i >= pairs else -1
+                if twin_of >= 0 and twin_of in offsets and full[twin_of] == n:
+                    off = offsets[twin_of]
+                else:
+                    off = int(rng.integers(n - cap + 1))
+                offsets[i] = off
                 motion[i, :cap] = motion[i, off: off + cap].clone()
                 motion[i, cap:] = 0.0
                 lengths[i] = cap

@@ -83,6 +83,10 @@ class Trainer:
         tc = config.train
         if tc.mode not in ("backbone", "adapters"):
             raise SimdiffError(f"training mode must be backbone or adapters, got {tc.mode!r}")
+        if not (math.isfinite(tc.env_pairs) and tc.env_pairs >= 0):
+            raise SimdiffError(f"env_pairs must be a finite weight >= 0, got {tc.env_pairs}")
+        if tc.env_pairs > 0 and tc.mode != "adapters":
+            raise SimdiffError(f"env_pairs = {tc.env_pairs} needs adapters mode (the φ-difference loss trains the adapters)")
         with torch.random.fork_rng(devices=[]):
             torch.manual_seed(tc.seed)  # the initial weights depend on the seed only
             self.network = build_network(config.model)
@@ -173,7 +177,7 @@ class Trainer:
 
     def _step_batches(self, start: int = 0, end: int = 0) -> StepBatches:
         tc = self.config.train
-        return StepBatches(self.dataset, self.batcher, tc.seed, self.rank, tc.crop, start, end)
+        return StepBatches(self.dataset, self.batcher, tc.seed, self.rank, tc.crop, start, end, pairs=tc.env_pairs > 0)
 
     def _batches(self, end: int) -> Iterator[dict[str, Any]]:
         """Batches of steps ``self.step .. end - 1`` in order: built here, or ahead by ``loader_workers`` processes."""
@@ -188,9 +192,15 @@ class Trainer:
         yield from loader
 
     def condition(self, batch: dict[str, Any], generator: torch.Generator) -> Condition:
-        """Text vectors with per-sample dropout (p = ``cond_mask_prob``) and φ (never dropped)."""
+        """Text vectors with per-sample dropout (p = ``cond_mask_prob``) and φ (never dropped).
+
+        Paired batches (``batch["paired"]``) drop the text of both twins alike.
+        """
         b = len(batch["captions"])
-        uncond = torch.rand(b, generator=generator) < self.config.train.cond_mask_prob
+        if "paired" in batch:
+            uncond = (torch.rand(b // 2, generator=generator) < self.config.train.cond_mask_prob).repeat(2)
+        else:
+            uncond = torch.rand(b, generator=generator) < self.config.train.cond_mask_prob
         env = env_index = None
         sim = self.config.model.sim
         if sim is not None:
@@ -215,10 +225,16 @@ class Trainer:
         torch.manual_seed(dropout_seed)
         x0 = batch["motion"].to(self.device)
         mask = batch["mask"].to(self.device)
-        pred = diffusion_prediction(self.model, self.scheduler, x0, cond, generator=generator)
+        if "paired" in batch:
+            self.network.backbone.eval()  # frozen: no dropout, so twins differ only through φ
+            pred = self._paired_prediction(x0, cond, generator)
+        else:
+            pred = diffusion_prediction(self.model, self.scheduler, x0, cond, generator=generator)
         loss = masked_mse(pred, x0, mask)
         if tc.losses.active:
             loss = loss + geometric_loss(pred, x0, mask, self.mean, self.std, tc.losses)
+        if "paired" in batch:
+            loss = loss + tc.env_pairs * self._pair_loss(pred, x0, mask, batch["paired"].to(self.device))
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
         if tc.optim.grad_clip > 0:
@@ -231,6 +247,22 @@ class Trainer:
         if not math.isfinite(value):
             raise SimdiffError(f"loss became {value} at step {self.step}")
         return value
+
+    def _paired_prediction(self, x0: Tensor, cond: Condition, generator: torch.Generator) -> Tensor:
+        """x̂₀ (B, T, F) with one t and one ε per twin pair (items i and i + B/2)."""
+        h = x0.shape[0] // 2
+        t = torch.randint(0, self.scheduler.num_train_timesteps, (h,), generator=generator).repeat(2).to(self.device)
+        noise = torch.randn((h, *x0.shape[1:]), generator=generator).repeat(2, 1, 1).to(self.device)
+        return self.model(self.scheduler.add_noise(x0, noise, t), t, cond)
+
+    @staticmethod
+    def _pair_loss(pred: Tensor, x0: Tensor, mask: Tensor, paired: Tensor) -> Tensor:
+        """MSE between predicted and true twin differences over the valid frames of paired twins (0 when none)."""
+        h = x0.shape[0] // 2
+        if not bool(paired.any()):
+            return pred.new_zeros(())
+        keep = paired.nonzero().flatten()
+        return masked_mse((pred[:h] - pred[h:])[keep], (x0[:h] - x0[h:])[keep], (mask[:h] & mask[h:])[keep])
 
     def train(self, until: int | None = None, progress: bool = True,
               on_step: Callable[[int, float], None] | None = None,

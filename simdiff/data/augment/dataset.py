@@ -67,6 +67,40 @@ class AugmentedHumanML3D:
         if source is not None:
             self.source = HumanML3D(source, source_split, normalizer=self.normalizer, unit_length=unit_length,
                                     seed=seed + 1)
+        self._twins = self._twin_groups()
+
+    def _twin_groups(self) -> dict[int, tuple[list[int], list[int]]]:
+        """Per simulated item: (Earth twins, other twins) — items of the same source clip with the same frames and captions."""
+        groups: dict[tuple[Any, ...], list[int]] = {}
+        for i, it in enumerate(self.sim.items):
+            row = self.env_table[it.clip_id]
+            key = (row.get("source", it.clip_id), it.start, it.stop, tuple(c.text for c in it.captions))
+            groups.setdefault(key, []).append(i)
+        twins: dict[int, tuple[list[int], list[int]]] = {}
+        for members in groups.values():
+            for i in members:
+                others = [j for j in members if j != i]
+                earth = [j for j in others if self._is_earth(j)]
+                twins[i] = (earth, [j for j in others if j not in earth])
+        return twins
+
+    def _is_earth(self, index: int) -> bool:
+        env = self.env_table[self.sim.items[index].clip_id]["env"]
+        return abs(env[0] - EARTH_GRAVITY) < 1e-6 and abs(env[1]) < 1e-9 and abs(env[2]) < 1e-9
+
+    def twin(self, index: int, rng: np.random.Generator) -> int | None:
+        """A simulated item of the same source clip, frames and captions as ``index`` under another φ, or None.
+
+        The Earth twin when there is one (so paired differences are effects relative to Earth, as the
+        environment-response benchmark measures them); for an Earth item, one of its other twins drawn with ``rng``.
+        Source (kinematic) items have no twins.
+        """
+        if not 0 <= index < len(self.sim):
+            return None
+        earth, other = self._twins[index]
+        if earth:
+            return earth[0]
+        return other[int(rng.integers(len(other)))] if other and self._is_earth(index) else None
 
     def __len__(self) -> int:
         return len(self.sim) + (len(self.source) if self.source is not None else 0)
@@ -123,6 +157,13 @@ class ConcatItems:
         local = index - int(self.offsets[k])
         get = getattr(part, "get", None)
         return get(local, rng) if callable(get) else part[local]
+
+    def twin(self, index: int, rng: np.random.Generator) -> int | None:
+        """The twin of item ``index`` within its own part (see :meth:`AugmentedHumanML3D.twin`), or None."""
+        k = int(np.searchsorted(self.offsets, index, side="right") - 1)
+        twin = getattr(self.parts[k], "twin", None)
+        local = twin(index - int(self.offsets[k]), rng) if callable(twin) else None
+        return None if local is None else local + int(self.offsets[k])
 
     def __getitem__(self, index: int) -> dict[str, Any]:
         return self.get(index)
