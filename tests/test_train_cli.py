@@ -128,7 +128,7 @@ def test_train_on_a_humanml3d_directory(tmp_path, capsys) -> None:
     assert main(["train", "backbone", "--data", str(tmp_path / "missing"), "--steps", "1", "--out", str(run)]) == 2
 
 
-def test_adapters_train_on_a_simulator_augmented_corpus(runs, tmp_path) -> None:
+def test_adapters_train_on_a_simulator_augmented_corpus(runs, tmp_path, capsys) -> None:
     from simdiff.data.augment import AugmentConfig, augment
     from simdiff.eval.testing import write_tiny_corpus
     from simdiff.sim.env import Environment
@@ -145,6 +145,13 @@ def test_adapters_train_on_a_simulator_augmented_corpus(runs, tmp_path) -> None:
                  "--init", str(runs / "bb" / "model"), "--steps", "2", "--batch-size", "2",
                  "--out", str(tmp_path / "ad"), "--no-progress"]) == 0
     assert (tmp_path / "ad" / "model" / "model.safetensors").is_file()
+    # The paired φ-difference loss needs twins: a binary augmentation has one φ per clip (one-line error).
+    assert main(["train", "adapters", "--data", str(tmp_path / "aug"), "--source", str(corpus),
+                 "--init", str(runs / "bb" / "model"), "--steps", "1", "--env-pairs", "5", "--out", str(tmp_path / "ad3"), "--no-progress"]) == 2
+    assert "twins" in capsys.readouterr().err
+    assert main(["train", "adapters", "--data", str(tmp_path / "aug"), "--source", str(corpus),
+                 "--init", str(runs / "bb" / "model"), "--steps", "1", "--env-pairs", "-1", "--out", str(tmp_path / "ad4"), "--no-progress"]) == 2
+    assert "env_pairs must be a finite weight >= 0, got -1.0" in capsys.readouterr().err
     # Adapters refuse a corpus without φ.
     assert main(["train", "adapters", "--data", str(corpus), "--init", str(runs / "bb" / "model"),
                  "--steps", "1", "--out", str(tmp_path / "ad2"), "--no-progress"]) == 2

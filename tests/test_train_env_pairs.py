@@ -213,3 +213,15 @@ def test_paired_training_learns_a_response_to_phi_and_resumes_exactly(tmp_path: 
     cut, _, _ = load_pretrained(tmp_path / "cut" / "model", "cpu")
     for (k, a), b in zip(full.state_dict().items(), cut.state_dict().values()):
         assert torch.equal(a, b), k
+
+
+def test_pipeline_adapters_stage_hashes_env_pairs_only_when_on(tmp_path: Path) -> None:
+    from simdiff.train.pipeline.config import budget_config
+    from simdiff.train.pipeline.context import PipelineContext
+    from simdiff.train.pipeline.stages import adapters_settings
+
+    ctx = PipelineContext(out=tmp_path, config=budget_config("quick"), progress=False)
+    off = adapters_settings(ctx)
+    assert "env_pairs" not in off  # the same hash as before the setting existed: older runs stay current
+    ctx.config.adapters.env_pairs = 10.0
+    assert adapters_settings(ctx) == {**off, "env_pairs": 10.0}

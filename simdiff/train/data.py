@@ -149,8 +149,9 @@ class StepBatches(torch.utils.data.Dataset):
                  start: int = 0, end: int = 0, pairs: bool = False) -> None:
         self.dataset, self.batcher, self.seed, self.rank, self.crop = dataset, batcher, seed, rank, crop
         self.start, self.end = start, end
-        if pairs and not callable(getattr(dataset, "twin", None)):
-            raise SimdiffError("paired batches need a simulator-augmented dataset with twins (items of one source under several φ)")
+        if pairs and (not callable(getattr(dataset, "twin", None)) or getattr(dataset, "twin_count", lambda: 1)() == 0):
+            raise SimdiffError("paired batches need a simulator-augmented dataset with twins (items of one source clip "
+                               "under several φ: `simdiff data augment --mode paired`)")
         if pairs and batcher.local_batch % 2:
             raise SimdiffError(f"paired batches need an even batch per process, got {batcher.local_batch}")
         self.pairs = pairs

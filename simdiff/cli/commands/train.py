@@ -61,6 +61,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--init", type=Path, help="backbone model folder (model.safetensors + config.json)")
     a.add_argument("--sim-mode", choices=["continuous", "categorical"], help="φ as (g_z, w_x, w_y) floats or a category")
     a.add_argument("--num-categories", type=int, help="number of environment categories (categorical)")
+    a.add_argument("--env-pairs", type=float, metavar="WEIGHT",
+                   help="weight of the paired φ-difference loss on twin clips (a paired augmentation; 0 = off, "
+                        "the paper's loss); see TrainConfig.env_pairs")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -105,6 +108,8 @@ def _run_config(args: argparse.Namespace):
             setattr(tc, field, getattr(args, flag))
     if args.lr is not None:
         tc.optim.lr = args.lr
+    if getattr(args, "env_pairs", None) is not None:
+        tc.env_pairs = args.env_pairs
     if tc.steps < 1 or tc.batch_size < 1:
         raise SimdiffError("--steps and --batch-size must be positive")
     if args.loader_workers < 0:

@@ -88,6 +88,10 @@ class AugmentedHumanML3D:
         env = self.env_table[self.sim.items[index].clip_id]["env"]
         return abs(env[0] - EARTH_GRAVITY) < 1e-6 and abs(env[1]) < 1e-9 and abs(env[2]) < 1e-9
 
+    def twin_count(self) -> int:
+        """How many simulated items have a twin (0 for a binary augmentation: one φ per source clip)."""
+        return sum(1 for earth, other in self._twins.values() if earth or other)
+
     def twin(self, index: int, rng: np.random.Generator) -> int | None:
         """A simulated item of the same source clip, frames and captions as ``index`` under another φ, or None.
 
@@ -157,6 +161,10 @@ class ConcatItems:
         local = index - int(self.offsets[k])
         get = getattr(part, "get", None)
         return get(local, rng) if callable(get) else part[local]
+
+    def twin_count(self) -> int:
+        """Items with a twin, over all parts."""
+        return sum(int(getattr(p, "twin_count", lambda: 0)()) for p in self.parts)
 
     def twin(self, index: int, rng: np.random.Generator) -> int | None:
         """The twin of item ``index`` within its own part (see :meth:`AugmentedHumanML3D.twin`), or None."""

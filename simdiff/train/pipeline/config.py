@@ -80,6 +80,8 @@ class AdapterStage:
     ema_decay: float = 0.999
     save_every: int = 250
     max_minutes: float = 0.0
+    env_pairs: float = 0.0
+    """Weight of the paired φ-difference loss (``TrainConfig.env_pairs``; needs a paired augmentation)."""
 
 
 @dataclass

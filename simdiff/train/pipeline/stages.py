@@ -88,7 +88,10 @@ def backbone_settings(ctx: PipelineContext) -> dict[str, Any]:
 
 
 def adapters_settings(ctx: PipelineContext) -> dict[str, Any]:
-    return _train_settings(ctx, "adapters")
+    settings = _train_settings(ctx, "adapters")
+    if not settings.get("env_pairs"):  # off: hashed as before the setting existed, so older runs stay current
+        settings.pop("env_pairs", None)
+    return settings
 
 
 def _train(ctx: PipelineContext, trainer: Any, max_minutes: float) -> dict[str, Any]:
@@ -133,7 +136,8 @@ def run_adapters(ctx: PipelineContext) -> dict[str, Any]:
     model = read_config(init)
     model.sim = SimConfig(mode=a.sim_mode)
     train = TrainConfig(mode="adapters", steps=a.steps, batch_size=a.batch_size, seed=seed, ema=a.ema,
-                        ema_decay=a.ema_decay, save_every=a.save_every, optim=OptimConfig(lr=a.lr))
+                        ema_decay=a.ema_decay, save_every=a.save_every, optim=OptimConfig(lr=a.lr),
+                        env_pairs=a.env_pairs)
     dataset = open_training_dataset(ctx.augmented_dir(), "train", seed)
     if len(dataset) == 0:
         raise SimdiffError(f"{ctx.augmented_dir()}: the augmented corpus kept no training clip "
