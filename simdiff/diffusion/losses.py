@@ -29,6 +29,18 @@ def masked_mse(pred: Tensor, target: Tensor, mask: Tensor) -> Tensor:
     return per_sample.mean()
 
 
+def twin_difference_mse(pred: Tensor, x0: Tensor, mask: Tensor, paired: Tensor) -> Tensor:
+    """MSE between predicted and true twin differences (items i and i + B/2) over the rows with ``paired`` set.
+
+    pred, x0: (B, T, F); mask: (B, T) bool; paired: (B/2,) bool. 0 when no row is paired.
+    """
+    h = x0.shape[0] // 2
+    if not bool(paired.any()):
+        return pred.new_zeros(())
+    keep = paired.nonzero().flatten()
+    return masked_mse((pred[:h] - pred[h:])[keep], (x0[:h] - x0[h:])[keep], (mask[:h] & mask[h:])[keep])
+
+
 def diffusion_prediction(denoiser: Denoiser, scheduler: BaseScheduler, x0: Tensor, cond: Condition,
                          generator: torch.Generator | None = None) -> Tensor:
     """Draw t ~ U{0..T−1} and ε ~ N(0, I), noise ``x0`` to x_t and return the predicted x₀ (B, T, F)."""

@@ -25,7 +25,7 @@ import torch
 from torch import nn
 
 from simdiff.diffusion.ddpm import DDPMScheduler
-from simdiff.diffusion.losses import masked_mse
+from simdiff.diffusion.losses import masked_mse, twin_difference_mse
 from simdiff.errors import SimdiffError
 from simdiff.model.condition import Condition
 from simdiff.train.data import StepBatcher, StepBatches
@@ -73,16 +73,12 @@ def phi_usage(network: nn.Module, dataset: Any, text_encoder: Any, *, batches: i
                 preds[name] = network(x_t, t, cond)
                 rows[name].append(float(masked_mse(preds[name], x0, mask)))
             rows["gain"].append(rows["shuffled"][-1] - rows["true"][-1])
-            keep = b["paired"].nonzero().flatten().to(device)
-            if len(keep):
-                pair_mask = (mask[:h] & mask[h:])[keep]
-                truth = (x0[:h] - x0[h:])[keep]
-                null = float(masked_mse(torch.zeros_like(truth), truth, pair_mask))
-                if null > 0:
-                    for name in ("true", "shuffled", "backbone"):
-                        pred = (preds[name][:h] - preds[name][h:])[keep]
-                        rows[f"r2_{name}"].append(1.0 - float(masked_mse(pred, truth, pair_mask)) / null)
-                pairs += len(keep)
+            paired = b["paired"].to(device)
+            null = float(twin_difference_mse(torch.zeros_like(x0), x0, mask, paired))
+            if null > 0:
+                for name in ("true", "shuffled", "backbone"):
+                    rows[f"r2_{name}"].append(1.0 - float(twin_difference_mse(preds[name], x0, mask, paired)) / null)
+            pairs += int(paired.sum())
     if not rows["r2_true"]:
         raise SimdiffError("no twin pairs with a difference in these batches: is this a paired augmentation?")
 

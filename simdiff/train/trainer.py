@@ -22,7 +22,7 @@ import torch
 from torch import Tensor, nn
 
 from simdiff.diffusion.ddpm import DDPMScheduler
-from simdiff.diffusion.losses import diffusion_prediction, masked_mse
+from simdiff.diffusion.losses import diffusion_prediction, masked_mse, twin_difference_mse
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import build_network, load_pretrained, save_pretrained
 from simdiff.model.condition import Condition
@@ -258,11 +258,7 @@ class Trainer:
     @staticmethod
     def _pair_loss(pred: Tensor, x0: Tensor, mask: Tensor, paired: Tensor) -> Tensor:
         """MSE between predicted and true twin differences over the valid frames of paired twins (0 when none)."""
-        h = x0.shape[0] // 2
-        if not bool(paired.any()):
-            return pred.new_zeros(())
-        keep = paired.nonzero().flatten()
-        return masked_mse((pred[:h] - pred[h:])[keep], (x0[:h] - x0[h:])[keep], (mask[:h] & mask[h:])[keep])
+        return twin_difference_mse(pred, x0, mask, paired)
 
     def train(self, until: int | None = None, progress: bool = True,
               on_step: Callable[[int, float], None] | None = None,

@@ -154,11 +154,8 @@ class ConcatItems:
 
     def get(self, index: int, rng: np.random.Generator | None = None) -> dict[str, Any]:
         """Item ``index`` of the concatenation, drawn with ``rng``."""
-        if not 0 <= index < len(self):
-            raise SimdiffError(f"index {index} out of range for {len(self)} items")
-        k = int(np.searchsorted(self.offsets, index, side="right") - 1)
+        k, local = self._locate(index)
         part = self.parts[k]
-        local = index - int(self.offsets[k])
         get = getattr(part, "get", None)
         return get(local, rng) if callable(get) else part[local]
 
@@ -168,10 +165,17 @@ class ConcatItems:
 
     def twin(self, index: int, rng: np.random.Generator) -> int | None:
         """The twin of item ``index`` within its own part (see :meth:`AugmentedHumanML3D.twin`), or None."""
-        k = int(np.searchsorted(self.offsets, index, side="right") - 1)
+        k, local = self._locate(index)
         twin = getattr(self.parts[k], "twin", None)
-        local = twin(index - int(self.offsets[k]), rng) if callable(twin) else None
-        return None if local is None else local + int(self.offsets[k])
+        found = twin(local, rng) if callable(twin) else None
+        return None if found is None else found + int(self.offsets[k])
+
+    def _locate(self, index: int) -> tuple[int, int]:
+        """(part, index within it) of item ``index``."""
+        if not 0 <= index < len(self):
+            raise SimdiffError(f"index {index} out of range for {len(self)} items")
+        k = int(np.searchsorted(self.offsets, index, side="right") - 1)
+        return k, index - int(self.offsets[k])
 
     def __getitem__(self, index: int) -> dict[str, Any]:
         return self.get(index)
