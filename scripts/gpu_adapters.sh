@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Adapters-only GPU run (issue 14): unpack an augmented pack and train several SimDiff adapter variants side by
+# side on one GPU (the small backbone leaves it mostly idle; the batch loaders share the cores) until a wall-clock
+# cap, then tar each run's exported model and logs into $OUT (one file per run, <= 16 MiB each; the device
+# returns at most 8 files, so at most 7 runs).
+#
+# Carried (prepare on CPU):
+#   $AUG_PACK    augmented pack, e.g. `simdiff train pack AUGMENTED --out .gpu/aug --splits all`
+#   $TEXT_TABLE  caption embeddings (`simdiff train text-table CORPUS --out FILE`); the device has no MiniLM
+#   $BACKBONE    the frozen backbone's model folder (model.safetensors + config.json)
+# Device command (repository root; device timeout_s 570):
+#   OUT=$OUT AUG_PACK=.gpu/aug TEXT_TABLE=.gpu/captions.safetensors BACKBONE=.gpu/backbone \
+#     RUNS="plain:0 pair10:10" bash scripts/gpu_adapters.sh
+# RUNS: space-separated NAME:LAMBDA (λ of --env-pairs; 0 = the paper's plain loss).
+# Overrides: CONFIG (configs/adapters_paired_gpu.json) SPLIT (all) MINUTES (7) LOADER_WORKERS (cores / runs)
+#   DEVICE (cuda) PYTHON (python)
+set -uo pipefail
+: "${OUT:?set OUT to the output folder}"
+: "${AUG_PACK:?set AUG_PACK to an augmented pack folder}"
+: "${TEXT_TABLE:?set TEXT_TABLE to the caption table}"
+: "${BACKBONE:?set BACKBONE to the backbone model folder}"
+: "${RUNS:?set RUNS, e.g. \"plain:0 pair10:10\"}"
+CONFIG="${CONFIG:-configs/adapters_paired_gpu.json}"
+SPLIT="${SPLIT:-all}"
+MINUTES="${MINUTES:-7}"
+DEVICE="${DEVICE:-cuda}"
+PY="${PYTHON:-python}"
+WORK="${WORK:-${TMPDIR:-/tmp}/simdiff_gpu_adapters}"
+nruns=$(echo $RUNS | wc -w)
+ncores=$(getconf _NPROCESSORS_ONLN)  # not nproc: it follows OMP_NUM_THREADS
+LOADER_WORKERS="${LOADER_WORKERS:-$(( ncores / nruns > 0 ? ncores / nruns : 1 ))}"
+export PYTHONPATH="$PWD${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
+start=$(date +%s)
+mkdir -p "$OUT" "$WORK"
+log() { echo "[$(( $(date +%s) - start ))s] $*" | tee -a "$OUT/run.log"; }
+log "unpack $AUG_PACK"
+"$PY" -m simdiff train unpack "$AUG_PACK" --out "$WORK/aug" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log"
+( while sleep 30; do for r in $RUNS; do n=${r%%:*}; log "$n $(tail -n 1 "$WORK/$n/train_log.jsonl" 2>/dev/null)"; done; done ) &
+watcher=$!
+mkdir -p "$WORK/logs"
+pids=()
+for r in $RUNS; do
+  n=${r%%:*}; lam=${r#*:}
+  log "train $n: --env-pairs $lam --max-minutes $MINUTES --loader-workers $LOADER_WORKERS"
+  "$PY" -m simdiff train adapters --data "$WORK/aug" --split "$SPLIT" --init "$BACKBONE" --out "$WORK/$n" \
+    --config "$CONFIG" --env-pairs "$lam" --device "$DEVICE" --text-table "$TEXT_TABLE" --max-minutes "$MINUTES" \
+    --loader-workers "$LOADER_WORKERS" --no-progress > "$WORK/logs/$n.log" 2>&1 &
+  pids+=($!)
+done
+status=0
+for p in "${pids[@]}"; do wait "$p" || status=$?; done
+kill "$watcher" 2>/dev/null
+for r in $RUNS; do
+  n=${r%%:*}
+  tail -n 3 "$WORK/logs/$n.log" | tee -a "$OUT/run.log"
+  tar -C "$WORK/$n" -cf "$OUT/$n.tar" model train_log.jsonl train_config.json -C "$WORK/logs" "$n.log" \
+    2>>"$OUT/run.log" || log "$n: nothing to tar"
+done
+log "done status=$status"
+exit "$status"
