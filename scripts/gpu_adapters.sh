@@ -5,7 +5,8 @@
 # returns at most 8 files, so at most 7 runs).
 #
 # Carried (prepare on CPU):
-#   $AUG_PACK    augmented pack, e.g. `simdiff train pack AUGMENTED --out .gpu/aug --splits all`
+#   $AUG_PACK    augmented pack(s), e.g. `simdiff train pack AUGMENTED --out .gpu/aug --splits all`; several
+#                space-separated packs are trained on as one dataset
 #   $TEXT_TABLE  caption embeddings (`simdiff train text-table CORPUS --out FILE`); the device has no MiniLM
 #   $BACKBONE    the frozen backbone's model folder (model.safetensors + config.json)
 # Device command (repository root; device timeout_s 570):
@@ -33,8 +34,13 @@ export PYTHONPATH="$PWD${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
 start=$(date +%s)
 mkdir -p "$OUT" "$WORK"
 log() { echo "[$(( $(date +%s) - start ))s] $*" | tee -a "$OUT/run.log"; }
-log "unpack $AUG_PACK"
-"$PY" -m simdiff train unpack "$AUG_PACK" --out "$WORK/aug" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log"
+data=()
+for pk in $AUG_PACK; do  # several packs are read as one dataset (train adapters --data A B …)
+  d="$WORK/data/$(basename "$pk")"
+  log "unpack $pk"
+  "$PY" -m simdiff train unpack "$pk" --out "$d" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log"
+  data+=("$d")
+done
 ( while sleep 30; do for r in $RUNS; do n=${r%%:*}; log "$n $(tail -n 1 "$WORK/$n/train_log.jsonl" 2>/dev/null)"; done; done ) &
 watcher=$!
 mkdir -p "$WORK/logs"
@@ -42,7 +48,7 @@ pids=()
 for r in $RUNS; do
   n=${r%%:*}; lam=${r#*:}
   log "train $n: --env-pairs $lam --max-minutes $MINUTES --loader-workers $LOADER_WORKERS"
-  "$PY" -m simdiff train adapters --data "$WORK/aug" --split "$SPLIT" --init "$BACKBONE" --out "$WORK/$n" \
+  "$PY" -m simdiff train adapters --data "${data[@]}" --split "$SPLIT" --init "$BACKBONE" --out "$WORK/$n" \
     --config "$CONFIG" --env-pairs "$lam" --device "$DEVICE" --text-table "$TEXT_TABLE" --max-minutes "$MINUTES" \
     --loader-workers "$LOADER_WORKERS" --no-progress > "$WORK/logs/$n.log" 2>&1 &
   pids+=($!)

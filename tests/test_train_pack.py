@@ -178,7 +178,7 @@ def test_gpu_backbone_script_rehearsal_from_a_train_split_pack(corpus, tmp_path)
 
 
 def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, tmp_path) -> None:
-    """scripts/gpu_adapters.sh on CPU: unpack a paired augmented pack, train a plain and a paired adapter run side by
+    """scripts/gpu_adapters.sh on CPU: unpack two paired augmented packs (read as one dataset), train a plain and a paired adapter run side by
     side from the caption table without MiniLM, and tar each run (model + logs) into OUT."""
     import tarfile
 
@@ -186,6 +186,7 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
     augment(corpus, aug, AugmentConfig(mode="paired", conditions=2, shard_size=4), projector=EchoProjector(),
             progress=False)
     pack(aug, tmp_path / "packs" / "aug")
+    pack(aug, tmp_path / "packs" / "aug2", splits=["all"])  # a second pack: both are read as one dataset
     write_caption_table(corpus_captions(corpus), FakeMiniLM(), tmp_path / "packs" / "captions.safetensors")
     tiny = backbone_preset("tiny")
     save_pretrained(tmp_path / "packs" / "backbone", build_network(ModelConfig(backbone=tiny, sim=None)),
@@ -199,7 +200,8 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
     stub.mkdir(parents=True)
     (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
     out = tmp_path / "OUT"
-    env = {**os.environ, "OUT": str(out), "AUG_PACK": str(tmp_path / "packs" / "aug"), "DEVICE": "cpu",
+    env = {**os.environ, "OUT": str(out), "DEVICE": "cpu",
+           "AUG_PACK": f"{tmp_path / 'packs' / 'aug'} {tmp_path / 'packs' / 'aug2'}",
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
            "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5", "LOADER_WORKERS": "0",
            "MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
@@ -215,4 +217,5 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
         assert json.loads((run / "train_log.jsonl").read_text().splitlines()[-1])["step"] == 2
         assert json.loads((run / "train_config.json").read_text())["train"]["env_pairs"] == lam
         assert "trained adapters to step 2" in (run / f"{name}.log").read_text()
+        assert len(json.loads((run / "model" / "provenance.json").read_text())["trained_on"]) == 3  # bb + 2 parts
         assert MotionGenerator.load(run / "model", load_text=False).is_simdiff
