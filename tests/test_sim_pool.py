@@ -83,3 +83,49 @@ def test_sim_projector_runs_on_the_projection_pool():
     assert joints.shape[1:] == (22, 3) and info.success
     with pytest.raises(SimdiffError, match="backend"):
         SimProjector(None, backend="threads")
+
+
+_ORPHAN_PARENT = """
+import os, sys, time
+import multiprocessing as mp
+from concurrent.futures import ProcessPoolExecutor
+from simdiff.sim.pool import worker_init
+if __name__ == "__main__":
+    ex = ProcessPoolExecutor(1, mp_context=mp.get_context("spawn"), initializer=worker_init, initargs=(1, os.getpid()))
+    print(ex.submit(os.getpid).result(timeout=120), flush=True)
+    ex.submit(time.sleep, 600)
+    time.sleep(600)
+"""
+
+
+def _running(pid: int) -> bool:
+    """True while ``pid`` exists and is not a zombie (an orphan's zombie may wait for a reaper that never comes)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="reads process states from /proc")
+def test_pool_workers_exit_when_their_parent_is_killed(tmp_path):
+    """A command killed without its cleanup (SIGKILL here) leaves no worker simulating on as an orphan."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "parent.py"
+    script.write_text(_ORPHAN_PARENT)
+    parent = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    try:
+        worker = int(parent.stdout.readline())
+        assert _running(worker)
+        parent.send_signal(signal.SIGKILL)
+        parent.wait(timeout=30)
+        deadline = time.monotonic() + 20
+        while _running(worker) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not _running(worker), "the worker outlived its killed parent"
+    finally:
+        parent.kill()

@@ -93,10 +93,10 @@ def _pool_map(fn: Callable[[Any], Any], tasks: list[Any], workers: int) -> Itera
     if workers <= 1 or len(tasks) <= 1:
         yield from map(fn, tasks)
         return
-    from simdiff.sim.pool import limit_threads
+    from simdiff.sim.pool import worker_init
 
-    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"), initializer=limit_threads,
-                             initargs=(1,)) as pool:
+    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"), initializer=worker_init,
+                             initargs=(1, os.getpid())) as pool:
         yield from pool.map(fn, tasks, chunksize=max(1, min(16, len(tasks) // (4 * workers))))
 
 

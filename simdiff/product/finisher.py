@@ -28,12 +28,13 @@ from simdiff.errors import SimdiffError
 from simdiff.sim.env import Environment
 
 
-def _init_worker() -> None:
-    """Ctrl-C is the parent's to handle (it shuts the worker down); one BLAS/torch thread (the finish is serial)."""
+def _init_worker(parent: int) -> None:
+    """Ctrl-C is the parent's to handle (it shuts the worker down); one BLAS/torch thread (the finish is serial);
+    the worker ends when its parent is gone."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    from simdiff.sim.pool import limit_threads
+    from simdiff.sim.pool import worker_init
 
-    limit_threads(1)
+    worker_init(1, parent)
 
 
 def _warm() -> bool:
@@ -78,7 +79,8 @@ class Finisher:
 
         self.workers = max(1, int(workers))
         self._executor: ProcessPoolExecutor | None = ProcessPoolExecutor(
-            max_workers=self.workers, mp_context=mp.get_context("spawn"), initializer=_init_worker)
+            max_workers=self.workers, mp_context=mp.get_context("spawn"), initializer=_init_worker,
+            initargs=(os.getpid(),))
         self._warm = [self._executor.submit(_warm) for _ in range(self.workers)]
 
     def __enter__(self) -> "Finisher":

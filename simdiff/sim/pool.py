@@ -83,6 +83,30 @@ def limit_threads(n: int = 1) -> None:
         sys.modules["torch"].set_num_threads(n)
 
 
+def exit_with_parent(parent: int, period_s: float = 1.0) -> None:
+    """In a worker process: end it (exit status 1) once ``parent`` (its creator's pid) is gone.
+
+    A command killed without running its cleanup (SIGTERM from a scheduler, SIGKILL, a crashed
+    parent) would otherwise leave its pool's workers simulating as orphans; a daemon thread checks
+    ``os.getppid()`` every ``period_s`` seconds (a re-parented orphan sees another pid).
+    """
+    import threading
+    import time
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(period_s)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
+def worker_init(threads: int, parent: int) -> None:
+    """Pool initializer: :func:`limit_threads` and :func:`exit_with_parent`. Pass ``(n, os.getpid())``."""
+    limit_threads(threads)
+    exit_with_parent(parent)
+
+
 @functools.lru_cache(maxsize=1)
 def _single_threaded_worker() -> None:
     """:func:`limit_threads` once per worker process (Ray workers have no initializer)."""
@@ -171,7 +195,7 @@ class ProjectionPool:
             import multiprocessing as mp
 
             self._executor = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
-                                                 initializer=limit_threads, initargs=(1,))
+                                                 initializer=worker_init, initargs=(1, os.getpid()))
         return self._executor.map(_run_one, tasks, chunksize=1)
 
     def close(self) -> None:

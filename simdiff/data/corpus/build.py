@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
@@ -156,7 +157,10 @@ def build(cfg: CorpusConfig) -> CorpusResult:
         for item, key in todo:
             finish(item, key, _run_item(item, settings))
     else:
-        with ProcessPoolExecutor(max_workers=cfg.workers) as pool:
+        from simdiff.sim.pool import exit_with_parent
+
+        with ProcessPoolExecutor(max_workers=cfg.workers, initializer=exit_with_parent,
+                                 initargs=(os.getpid(),)) as pool:
             futures = [(item, key, pool.submit(_run_item, item, settings)) for item, key in todo]
             for item, key, future in futures:
                 finish(item, key, future.result())
