@@ -148,6 +148,11 @@ def test_adapters_join_their_backbones_provenance(tmp_path: Path) -> None:
     prov = training_provenance("adapters", [aug], init=backbone)
     assert [(p.what, p.data) for p in prov.trained_on] == [("backbone", "cmu"), ("adapters", "aug")]
     assert prov.weights_licence.startswith("non-commercial")
+    # a whole SimDiff model as --init: only its backbone is loaded, so only its backbone entries carry over
+    simdiff_folder = tmp_path / "simdiff"
+    write_provenance(simdiff_folder, prov)
+    again = training_provenance("adapters", [aug], init=simdiff_folder)
+    assert [(p.what, p.data) for p in again.trained_on] == [("backbone", "cmu"), ("adapters", "aug")]
     (tmp_path / "bare").mkdir()
     bare = training_provenance("adapters", [aug], init=tmp_path / "bare")
     assert bare.trained_on[0].what == "backbone" and bare.weights_licence == "unknown (no licence record for bare)"
