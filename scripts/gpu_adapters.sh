@@ -8,7 +8,8 @@
 #   $AUG_PACK    augmented pack(s), e.g. `simdiff train pack AUGMENTED --out .gpu/aug --splits all`; several
 #                space-separated packs are trained on as one dataset
 #   $TEXT_TABLE  caption embeddings (`simdiff train text-table CORPUS --out FILE`); the device has no MiniLM
-#   $BACKBONE    the frozen backbone's model folder (model.safetensors + config.json)
+#   $BACKBONE    the frozen backbone's model folder (model.safetensors + config.json); a SimDiff model folder
+#                works too (only its backbone is loaded), e.g. simdiff/assets/default_model, which travels anyway
 # Device command (repository root; device timeout_s 570):
 #   OUT=$OUT AUG_PACK=.gpu/aug TEXT_TABLE=.gpu/captions.safetensors BACKBONE=.gpu/backbone \
 #     RUNS="plain:0 pair10:10" bash scripts/gpu_adapters.sh
@@ -37,8 +38,10 @@ log() { echo "[$(( $(date +%s) - start ))s] $*" | tee -a "$OUT/run.log"; }
 data=()
 for pk in $AUG_PACK; do  # several packs are read as one dataset (train adapters --data A B …)
   d="$WORK/data/$(basename "$pk")"
+  case " ${data[*]} " in *" $d "*) echo "gpu_adapters.sh: two packs named $(basename "$pk") in AUG_PACK" >&2; exit 2;; esac
   log "unpack $pk"
-  "$PY" -m simdiff train unpack "$pk" --out "$d" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log"
+  "$PY" -m simdiff train unpack "$pk" --out "$d" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log" \
+    || { log "unpack of $pk failed"; exit 1; }
   data+=("$d")
 done
 ( while sleep 30; do for r in $RUNS; do n=${r%%:*}; log "$n $(tail -n 1 "$WORK/$n/train_log.jsonl" 2>/dev/null)"; done; done ) &
