@@ -198,3 +198,28 @@ def test_residual_budget_follows_body_strength_only_above_earth_gravity() -> Non
     assert keep_pair(info(-19.62, 141.0), config) == (False, "residual")
     fixed = FilterConfig(max_pose_d_l2=5.0, max_residual_n=70.0, residual_follows_strength=False)
     assert keep_pair(info(-19.62, 71.0), fixed) == (False, "residual")
+
+
+class RetimingProjector(FakeProjector):
+    """FakeProjector whose rollouts under w_x > 0 report a retime second try (slow-down 1.4; any rule will do)."""
+
+    def __call__(self, motions, envs):
+        for (rollout, info), e in zip(super().__call__(motions, envs), envs):
+            if e.as_tuple()[1] > 0:
+                info = {**info, "retime_scale": 1.4}
+            yield rollout, info
+
+
+def test_retimed_pairs_are_marked_in_env_json_and_left_out_of_first_try(tmp_path: Path) -> None:
+    corpus = write_tiny_corpus(tmp_path / "c", n_train=3, n_test=1, frames=48)
+    out = tmp_path / "aug"
+    augment(corpus, out, AugmentConfig(mode="random", conditions=8, seed=1, shard_size=2,
+                                       filter=FilterConfig(max_pose_d_l2=11.0)), projector=RetimingProjector(),
+            progress=False)
+    env = json.loads((out / "env.json").read_text(encoding="utf-8"))
+    retimed = {i for i, row in env.items() if row["env"][1] > 0}
+    assert retimed and set(env) - retimed  # both kinds kept
+    assert all(env[i]["retime_scale"] == pytest.approx(1.4) for i in retimed)
+    assert not any("retime_scale" in env[i] for i in set(env) - retimed)
+    first_try = (out / "first_try.txt").read_text(encoding="utf-8").split()
+    assert set(first_try) == set(env) - retimed and set(_ids(out)) == set(env)

@@ -9,7 +9,10 @@ Output (``out``), in the HumanML3D layout plus φ::
     Mean.npy, Std.npy         copied from the source corpus (the model's normaliser)
     train.txt, all.txt        kept ids (``<clip>_e<condition:02d>``)
                               (features/joints/texts exist for every tracked pair, kept or not)
-    env.json                  {id: {env: [g_z, w_x, w_y], env_index, condition, factor, source}}
+    first_try.txt             the kept ids whose rollout tracked the source as given (no retime second try:
+                              a re-timed pair keeps its Earth apex by construction, reports/augment/retime.md)
+    env.json                  {id: {env: [g_z, w_x, w_y], env_index, condition, factor, source
+                              [, retime_scale: the source's slow-down, only when re-timed]}}
     conditions.json           the condition list
     report.json, report.md    kept fraction per condition, reasons, CPU time
     augment_settings.json     what a resumed run must match
@@ -424,14 +427,19 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
             return AugmentEnv(int(r["condition"]), str(r.get("factor", "")), Environment(*map(float, r["env"])))
         return by_index[r["condition"]]
 
+    def retime_scale(r: dict[str, Any]) -> float:
+        return float((r.get("info") or {}).get("retime_scale", 1.0))
+
     env = {
         r["id"]: {"env": list(cond_of(r).env.as_tuple()), "env_index": env_index_for(config.mode, cond_of(r)),
-                  "condition": r["condition"], "factor": cond_of(r).factor, "source": r["clip"]}
+                  "condition": r["condition"], "factor": cond_of(r).factor, "source": r["clip"],
+                  **({"retime_scale": retime_scale(r)} if retime_scale(r) != 1.0 else {})}
         for r in kept
     }
     ids = [r["id"] for r in kept]
     write_lines(out / "train.txt", ids)
     write_lines(out / "all.txt", ids)
+    write_lines(out / "first_try.txt", [r["id"] for r in kept if retime_scale(r) == 1.0])
     write_json(out / "env.json", env)
     write_json(out / "conditions.json", [c.to_dict() for c in conditions])
     from simdiff.model.provenance import SOURCE_CORPUS_NAME, source_record
