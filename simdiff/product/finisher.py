@@ -116,11 +116,6 @@ class Finisher:
         for proc in processes:  # idle after the last result (or cancelled): its exit would only tear down imports
             if proc.is_alive():
                 proc.terminate()
-        if cancel:  # a worker that has not died 2 s after SIGTERM (still starting, or stuck in I/O) gets SIGKILL
-            for proc in processes:
-                proc.join(timeout=2.0)
-                if proc.is_alive():
-                    proc.kill()
 
 
 WORKERS_ENV = "SIMDIFF_FINISH_WORKERS"

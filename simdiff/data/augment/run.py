@@ -427,19 +427,18 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
             return AugmentEnv(int(r["condition"]), str(r.get("factor", "")), Environment(*map(float, r["env"])))
         return by_index[r["condition"]]
 
-    def retime_scale(r: dict[str, Any]) -> float:
-        return float((r.get("info") or {}).get("retime_scale", 1.0))
-
+    retimed = {r["id"]: float(r["info"]["retime_scale"]) for r in kept
+               if float((r.get("info") or {}).get("retime_scale", 1.0)) != 1.0}
     env = {
         r["id"]: {"env": list(cond_of(r).env.as_tuple()), "env_index": env_index_for(config.mode, cond_of(r)),
                   "condition": r["condition"], "factor": cond_of(r).factor, "source": r["clip"],
-                  **({"retime_scale": retime_scale(r)} if retime_scale(r) != 1.0 else {})}
+                  **({"retime_scale": retimed[r["id"]]} if r["id"] in retimed else {})}
         for r in kept
     }
     ids = [r["id"] for r in kept]
     write_lines(out / "train.txt", ids)
     write_lines(out / "all.txt", ids)
-    write_lines(out / "first_try.txt", [r["id"] for r in kept if retime_scale(r) == 1.0])
+    write_lines(out / "first_try.txt", [i for i in ids if i not in retimed])
     write_json(out / "env.json", env)
     write_json(out / "conditions.json", [c.to_dict() for c in conditions])
     from simdiff.model.provenance import SOURCE_CORPUS_NAME, source_record
