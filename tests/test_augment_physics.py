@@ -32,6 +32,47 @@ def test_paired_conditions_earth_plus_k_one_factor_seeded_by_clip_id() -> None:
         paired_conditions("16_05", 0)
 
 
+def test_paired_conditions_narrowed_to_weak_gravity_keep_the_default_draw() -> None:
+    default = paired_conditions("16_05", 6, seed=0)
+    assert paired_conditions("16_05", 6, 0, ("gravity", "wind_x", "wind_y"), (-20.0, -1.0)) == default
+    weak = paired_conditions("16_05", 8, 0, factors=("gravity",), gravity_range=(-5.0, -1.0))
+    assert [c.factor for c in weak] == ["earth"] + ["gravity"] * 8
+    gs = [c.env.as_tuple()[0] for c in weak[1:]]
+    assert all(-5.0 <= g <= -1.0 for g in gs) and len(set(gs)) == 8
+    assert all(c.env.as_tuple()[1:] == (0.0, 0.0) for c in weak)
+    winds = paired_conditions("16_05", 4, 0, factors=("wind_y", "wind_x"))
+    assert sorted(c.factor for c in winds[1:]) == ["wind_x", "wind_x", "wind_y", "wind_y"]
+    with pytest.raises(SimdiffError, match="'drag'"):
+        paired_conditions("16_05", 2, factors=("drag",))
+    with pytest.raises(SimdiffError, match="-0.5"):
+        paired_conditions("16_05", 2, gravity_range=(-5.0, -0.5))
+    with pytest.raises(SimdiffError, match="gravity-range -1 -5"):
+        paired_conditions("16_05", 2, gravity_range=(-1.0, -5.0))
+
+
+def test_augment_cli_narrows_the_draw_and_refuses_it_outside_paired_mode(tmp_path: Path, capsys) -> None:
+    import json
+
+    from simdiff.cli.main import main
+    from simdiff.data.augment import AugmentConfig, augment
+    from simdiff.eval.testing import write_tiny_corpus
+
+    from test_augment import FakeProjector
+
+    corpus = write_tiny_corpus(tmp_path / "src", n_train=2, n_test=1)
+    config = AugmentConfig(mode="paired", conditions=2, factors=("gravity",), gravity_range=(-3.0, -1.0))
+    report = augment(corpus, tmp_path / "aug", config, projector=FakeProjector(), progress=False)
+    assert report["settings"]["factors"] == ["gravity"] and report["settings"]["gravity_range"] == [-3.0, -1.0]
+    for row in json.loads((tmp_path / "aug" / "env.json").read_text()).values():
+        assert row["env"][0] == -9.81 or -3.0 <= row["env"][0] <= -1.0
+    with pytest.raises(SimdiffError, match="mode 'binary'"):
+        augment(corpus, tmp_path / "b", AugmentConfig(mode="binary", factors=("gravity",)), projector=FakeProjector(),
+                progress=False)
+    assert main(["data", "augment", "--corpus", str(corpus), "--out", str(tmp_path / "c"),
+                 "--gravity-range", "-3", "0.5"]) != 0
+    assert "gravity-range -3 0.5" in capsys.readouterr().err
+
+
 def test_paired_draws_are_uncorrelated_with_content_but_round_robin_is_not() -> None:
     """Content that repeats with the round-robin cycle (30 conditions, 2 per clip: 15 clips), so
     that each condition always meets the same kind of clip, as in issue 13: paired passes,

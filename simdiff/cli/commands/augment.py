@@ -64,6 +64,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="one try per pair: do not retry a weak-gravity (|g_z| < 9.81) rollout that fell or strayed on "
                         "the source slowed to the same Froude number (simdiff.sim.retime; on by default). Runs made "
                         "before retiming existed resume only with this flag")
+    p.add_argument("--factors", nargs="+", metavar="FACTOR",
+                   help="paired: draw only these factors (gravity, wind_x, wind_y; default all three, cycled)")
+    p.add_argument("--gravity-range", nargs=2, type=float, metavar=("LO", "HI"),
+                   help="paired: draw g_z uniformly in [LO, HI] m/s^2 (default -20 -1), e.g. -5 -1 for weak gravity")
     p.add_argument("--limit", type=int, help="augment only the first N clips of the split")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(func=run)
@@ -79,7 +83,9 @@ def _pose_bound(text: str) -> float | str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simdiff.data.augment.conditions import FACTORS, check_factors, check_gravity_range
     from simdiff.data.augment.filter import AUTO, FilterConfig
+    from simdiff.sim.env import GRAVITY_RANGE
     from simdiff.data.augment.run import AugmentConfig, augment
 
     defaults = FilterConfig()
@@ -87,6 +93,8 @@ def run(args: argparse.Namespace) -> int:
     if pose is None:
         pose = AUTO if args.mode in ("paired", "binary") else defaults.max_pose_d_l2
     residual_n = defaults.max_residual_n if args.max_residual_n is None else args.max_residual_n
+    factors = FACTORS if args.factors is None else check_factors(args.factors)
+    gravity_range = GRAVITY_RANGE if args.gravity_range is None else check_gravity_range(args.gravity_range)
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
                            filter=FilterConfig(max_pose_d_l2=pose, earth_keep=args.earth_keep, max_residual_n=residual_n,
@@ -94,7 +102,8 @@ def run(args: argparse.Namespace) -> int:
                                                residual_follows_strength=not args.residual_fixed),
                            residual_bound=args.residual_bound, workers=args.workers, backend=args.backend,
                            per_clip=args.per_clip, share_mirrors=args.share_mirrors,
-                           resimulate_gravity_below=args.resimulate_gravity_below, retime=not args.no_retime)
+                           resimulate_gravity_below=args.resimulate_gravity_below, retime=not args.no_retime,
+                           factors=factors, gravity_range=gravity_range)
     report = augment(args.corpus, args.out, config, progress=not args.no_progress)
     frac = report["kept_fraction"]
     cal = report["filter"].get("calibration")

@@ -11,12 +11,15 @@
   (indices 1..k), drawn one factor at a time from a generator seeded by (seed, clip id) and
   nothing else, so φ is independent of the clip's content; the factors cycle gravity,
   wind_x, wind_y from a per-clip random start (k = 6 gives each factor twice). Each clip's
-  Earth rollout is the baseline its physics signal is measured against.
+  Earth rollout is the baseline its physics signal is measured against. ``factors`` and
+  ``gravity_range`` narrow the draw (e.g. gravity only, g_z in [−5, −1] for a weak-gravity run);
+  the defaults draw exactly as before.
 """
 
 from __future__ import annotations
 
 import zlib
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,32 +79,60 @@ def random_conditions(n: int = 30, seed: int = 0) -> list[AugmentEnv]:
     return out
 
 
-def _draw(rng: np.random.Generator, factor: str) -> Environment:
-    lo, hi = GRAVITY_RANGE
+def _draw(rng: np.random.Generator, factor: str,
+          gravity_range: tuple[float, float] = GRAVITY_RANGE) -> Environment:
+    lo, hi = gravity_range
     if factor == "gravity":
         return Environment(round(float(rng.uniform(lo, hi)), 4), 0.0, 0.0)
     w = round(float(rng.uniform(-MAX_WIND, MAX_WIND)), 4)
     return Environment(EARTH_GRAVITY, w, 0.0) if factor == "wind_x" else Environment(EARTH_GRAVITY, 0.0, w)
 
 
-def paired_conditions(clip: str, k: int = DEFAULT_PAIRED_K, seed: int = 0) -> list[AugmentEnv]:
+def check_factors(factors: Sequence[str]) -> tuple[str, ...]:
+    """``factors`` as a tuple in :data:`FACTORS` order; a one-line error names an unknown or repeated one."""
+    factors = tuple(factors)
+    if not factors:
+        raise SimdiffError("--factors: name at least one of " + ", ".join(FACTORS))
+    for f in factors:
+        if f not in FACTORS:
+            raise SimdiffError(f"--factors: unknown factor {f!r}; choose from {', '.join(FACTORS)}")
+    if len(set(factors)) != len(factors):
+        raise SimdiffError(f"--factors: {', '.join(factors)} names a factor twice")
+    return tuple(f for f in FACTORS if f in factors)
+
+
+def check_gravity_range(gravity_range: Sequence[float]) -> tuple[float, float]:
+    """``(lo, hi)`` m/s² within :data:`GRAVITY_RANGE` with lo < hi, else a one-line error naming it."""
+    lo, hi = (float(v) for v in gravity_range)
+    glo, ghi = GRAVITY_RANGE
+    if not (np.isfinite(lo) and np.isfinite(hi)) or not glo <= lo < hi <= ghi:
+        raise SimdiffError(f"--gravity-range {lo:g} {hi:g}: need {glo:g} <= LO < HI <= {ghi:g} (m/s^2, negative = down)")
+    return lo, hi
+
+
+def paired_conditions(clip: str, k: int = DEFAULT_PAIRED_K, seed: int = 0, factors: Sequence[str] = FACTORS,
+                      gravity_range: Sequence[float] = GRAVITY_RANGE) -> list[AugmentEnv]:
     """Earth and ``k`` one-factor conditions of one clip, seeded by (seed, clip id) only.
 
     Args:
         clip: the clip id (its bytes seed the draw, through CRC-32; its content never does).
         k: conditions besides Earth.
         seed: run seed.
+        factors: the factors drawn, cycled from a per-clip random start (default all three).
+        gravity_range: ``(lo, hi)`` of the uniform g_z draw, m/s² (default the validated range).
     Returns:
         ``[Earth (index 0), draw 1, …, draw k]``, values rounded to 1e-4.
     """
     if k < 1:
         raise SimdiffError(f"--conditions must be at least 1 in paired mode, got {k}")
+    factors = check_factors(factors)
+    gravity_range = check_gravity_range(gravity_range)
     rng = np.random.default_rng([seed, 0xA13, zlib.crc32(clip.encode("utf-8"))])
     start = int(rng.integers(3))
     out = [AugmentEnv(0, "earth", Environment(EARTH_GRAVITY, 0.0, 0.0))]
     for i in range(k):
-        factor = FACTORS[(start + i) % 3]
-        out.append(AugmentEnv(i + 1, factor, _draw(rng, factor).validate()))
+        factor = factors[(start + i) % len(factors)]
+        out.append(AugmentEnv(i + 1, factor, _draw(rng, factor, gravity_range).validate()))
     return out
 
 

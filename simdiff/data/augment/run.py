@@ -53,7 +53,8 @@ import numpy as np
 
 from simdiff.fsio import read_json as _read_json, write_text
 from simdiff.data.augment.classes import load_motion_types
-from simdiff.data.augment.conditions import DEFAULT_PAIRED_K, AugmentEnv, make_conditions, paired_conditions
+from simdiff.data.augment.conditions import (DEFAULT_PAIRED_K, FACTORS, AugmentEnv, check_factors, check_gravity_range,
+                                             make_conditions, paired_conditions)
 from simdiff.data.augment.decide import decide
 from simdiff.data.augment.filter import AUTO, FilterConfig
 from simdiff.data.augment.report import build_report, report_markdown
@@ -61,7 +62,7 @@ from simdiff.data.augment.share import group_mirrors, mirror_condition, mirror_i
 from simdiff.data.augment.projector import Projector, SimProjector
 from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_npy
 from simdiff.errors import SimdiffError
-from simdiff.sim.env import Environment
+from simdiff.sim.env import GRAVITY_RANGE, Environment
 from simdiff.sim.project import SIM_VERSION
 from simdiff.sim.retime import RetimeConfig
 
@@ -100,6 +101,8 @@ class AugmentConfig:
             the source slowed to the same Froude number and keep the better one
             (:mod:`simdiff.sim.retime`; records carry ``retime_scale``). A setting: a run made
             before it existed resumes only with ``retime=False``.
+        factors: paired mode: the factors drawn (default all three; e.g. ``("gravity",)``).
+        gravity_range: paired mode: ``(lo, hi)`` of the g_z draw, m/s² (default the validated range).
 
     Modes (:mod:`simdiff.data.augment.conditions`): ``paired`` (default; Earth + ``conditions``
     (default 6) draws per clip), ``paper`` (every clip under all ``conditions`` (30) random
@@ -120,6 +123,8 @@ class AugmentConfig:
     share_mirrors: bool = False
     resimulate_gravity_below: float | None = None
     retime: bool = True
+    factors: tuple[str, ...] = FACTORS
+    gravity_range: tuple[float, float] = GRAVITY_RANGE
 
     @property
     def n_conditions(self) -> int:
@@ -141,6 +146,10 @@ class AugmentConfig:
             settings["share_mirrors"] = True
         if self.retime:
             settings["retime"] = asdict(RetimeConfig())
+        if tuple(self.factors) != FACTORS:
+            settings["factors"] = list(self.factors)
+        if tuple(self.gravity_range) != GRAVITY_RANGE:
+            settings["gravity_range"] = list(self.gravity_range)
         return settings
 
 
@@ -163,7 +172,8 @@ def conditions_for(clips: Sequence[str], conditions: Sequence[AugmentEnv], confi
                    ) -> dict[str, list[AugmentEnv]]:
     """Conditions of every clip under ``config``'s mode (paired: drawn per clip)."""
     if config.mode == "paired":
-        out = {c: paired_conditions(c, config.n_conditions, config.seed) for c in clips}
+        out = {c: paired_conditions(c, config.n_conditions, config.seed, config.factors, config.gravity_range)
+               for c in clips}
     else:
         out = assign_conditions(clips, conditions, config.per_clip if config.mode == "random" else None)
     if config.share_mirrors:
@@ -236,6 +246,11 @@ def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[AugmentEn
         raise SimdiffError("refusing to augment the test split (it must stay unseen)")
     if config.shard_size < 1:
         raise SimdiffError(f"shard size must be at least 1, got {config.shard_size}")
+    if tuple(config.factors) != FACTORS or tuple(config.gravity_range) != GRAVITY_RANGE:
+        if config.mode != "paired":
+            raise SimdiffError(f"--factors/--gravity-range narrow paired mode's draws; mode {config.mode!r} has none")
+        check_factors(config.factors)
+        check_gravity_range(config.gravity_range)
     clips = read_split(corpus / f"{config.split}.txt")
     if config.limit is not None:
         if config.limit < 1:
