@@ -156,3 +156,19 @@ def test_test_split_and_errors(hml_dir: Path, tmp_path_factory: pytest.TempPathF
         read_captions(bad)
     bad.write_text("nan tags#a/DET#nan#nan\n")
     assert read_captions(bad)[0].whole
+
+
+def test_a_split_is_any_id_list_in_the_folder_and_an_unknown_one_is_named(tmp_path: Path) -> None:
+    from simdiff.data.humanml3d import HumanML3D, read_split
+    from simdiff.errors import SimdiffError
+    from simdiff.eval.testing import write_tiny_corpus
+
+    root = write_tiny_corpus(tmp_path / "c", n_train=4, n_test=2)
+    train = read_split(root / "train.txt")
+    (root / "first_try.txt").write_text("\n".join(train[:2]) + "\n", encoding="utf-8")
+    ds = HumanML3D(root, "first_try", unit_length=0)
+    assert sorted({item.clip_id for item in ds.items}) == sorted(train[:2])
+    with pytest.raises(SimdiffError, match=r"unknown split 'second_try'; expected one of .*first_try"):
+        HumanML3D(root, "second_try")
+    with pytest.raises(SimdiffError, match="unknown split '../c/train'"):
+        HumanML3D(root, "../c/train")

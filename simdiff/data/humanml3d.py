@@ -52,6 +52,18 @@ class Caption:
         return self.start == 0.0 and self.end == 0.0
 
 
+def split_path(root: Path, split: str) -> Path:
+    """``root/<split>.txt`` for a standard split or any other split file in ``root`` (e.g. an augmented
+    corpus's ``first_try``); a one-line error names an unknown one and the split files that exist."""
+    path = root / f"{split}.txt"
+    plain = split and "/" not in split and "\\" not in split and not split.startswith(".")
+    if split in SPLITS or (plain and path.is_file()):
+        return path
+    extra = sorted(p.stem for p in root.glob("*.txt") if p.stem not in SPLITS)
+    raise SimdiffError(f"unknown split {split!r}; expected one of {', '.join(SPLITS + tuple(extra))} "
+                       f"(a split is a <name>.txt id list in {root})")
+
+
 @dataclass(frozen=True)
 class Item:
     """One dataset entry: frames [start, stop) of clip ``clip_id`` and its captions."""
@@ -192,9 +204,7 @@ class HumanML3D(Dataset):
         if max_frames < MIN_FRAMES:
             raise SimdiffError(f"max_frames must be >= {MIN_FRAMES}, got {max_frames}")
         if isinstance(split, str):
-            if split not in SPLITS:
-                raise SimdiffError(f"unknown split {split!r}; expected one of {', '.join(SPLITS)}")
-            ids = read_split(self.root / f"{split}.txt")
+            ids = read_split(split_path(self.root, split))
         else:
             ids = list(split)
         self.normalizer = normalizer if normalizer is not None else Normalizer.from_dir(self.root)
