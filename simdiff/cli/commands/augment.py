@@ -83,7 +83,7 @@ def _pose_bound(text: str) -> float | str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from simdiff.data.augment.conditions import FACTORS, check_factors, check_gravity_range
+    from simdiff.data.augment.conditions import FACTORS
     from simdiff.data.augment.filter import AUTO, FilterConfig
     from simdiff.sim.env import GRAVITY_RANGE
     from simdiff.data.augment.run import AugmentConfig, augment
@@ -93,8 +93,8 @@ def run(args: argparse.Namespace) -> int:
     if pose is None:
         pose = AUTO if args.mode in ("paired", "binary") else defaults.max_pose_d_l2
     residual_n = defaults.max_residual_n if args.max_residual_n is None else args.max_residual_n
-    factors = FACTORS if args.factors is None else check_factors(args.factors)
-    gravity_range = GRAVITY_RANGE if args.gravity_range is None else check_gravity_range(args.gravity_range)
+    factors = FACTORS if args.factors is None else tuple(args.factors)
+    gravity_range = GRAVITY_RANGE if args.gravity_range is None else tuple(args.gravity_range)
     config = AugmentConfig(mode=args.mode, conditions=args.conditions, seed=args.seed, split=args.split,
                            shard_size=args.shard_size, limit=args.limit,
                            filter=FilterConfig(max_pose_d_l2=pose, earth_keep=args.earth_keep, max_residual_n=residual_n,

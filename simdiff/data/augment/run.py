@@ -126,6 +126,11 @@ class AugmentConfig:
     factors: tuple[str, ...] = FACTORS
     gravity_range: tuple[float, float] = GRAVITY_RANGE
 
+    def __post_init__(self) -> None:
+        # one canonical form (FACTORS order, floats), so a resumed run's settings compare equal
+        self.factors = check_factors(self.factors)
+        self.gravity_range = check_gravity_range(self.gravity_range)
+
     @property
     def n_conditions(self) -> int:
         """``conditions`` with its mode's default (paired: 6 per clip; random/paper: 30; binary: 1)."""
@@ -146,9 +151,9 @@ class AugmentConfig:
             settings["share_mirrors"] = True
         if self.retime:
             settings["retime"] = asdict(RetimeConfig())
-        if tuple(self.factors) != FACTORS:
+        if self.factors != FACTORS:
             settings["factors"] = list(self.factors)
-        if tuple(self.gravity_range) != GRAVITY_RANGE:
+        if self.gravity_range != GRAVITY_RANGE:
             settings["gravity_range"] = list(self.gravity_range)
         return settings
 
@@ -246,11 +251,8 @@ def plan(corpus: Path, config: AugmentConfig) -> tuple[list[str], list[AugmentEn
         raise SimdiffError("refusing to augment the test split (it must stay unseen)")
     if config.shard_size < 1:
         raise SimdiffError(f"shard size must be at least 1, got {config.shard_size}")
-    if tuple(config.factors) != FACTORS or tuple(config.gravity_range) != GRAVITY_RANGE:
-        if config.mode != "paired":
-            raise SimdiffError(f"--factors/--gravity-range narrow paired mode's draws; mode {config.mode!r} has none")
-        check_factors(config.factors)
-        check_gravity_range(config.gravity_range)
+    if config.mode != "paired" and (config.factors != FACTORS or config.gravity_range != GRAVITY_RANGE):
+        raise SimdiffError(f"--factors/--gravity-range narrow paired mode's draws; mode {config.mode!r} has none")
     clips = read_split(corpus / f"{config.split}.txt")
     if config.limit is not None:
         if config.limit < 1:
