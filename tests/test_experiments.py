@@ -300,6 +300,40 @@ def test_a_method_may_list_its_own_alphas_in_table1(setup: dict[str, Path], tmp_
     assert keys == ["ground_truth", "SimDiff___simulated_finish_ddim_alpha1", "SimDiff_ddim_alpha0.1", "SimDiff_ddim_alpha0.5"]
 
 
+def test_a_backbone_role_on_a_simdiff_folder_runs_its_backbone_alone(setup: dict[str, Path], tmp_path: Path) -> None:
+    """`--backbone simdiff/assets/default_model` (a SimDiff folder): the MDM and PhysDiff rows must be the frozen
+    backbone, φ-blind, one row (no α list), generating exactly what `train export-backbone`'s folder generates."""
+    import torch
+
+    from simdiff.eval.experiments import table1
+    from simdiff.model.checkpoint import export_backbone
+
+    exported = export_backbone(setup["adapters"], tmp_path / "exported")
+    models = [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
+              {"name": "SimDiff", "model": "adapters", **FAST}]
+    config = load_config(write(setup, "table1", name="t1_bb", models=models), None,
+                         [("out_dir", str(tmp_path)), ("samplers", ["ddim"]), ("alphas", [0.5, 1.0]),
+                          ("paths.backbone", str(setup["adapters"]))])
+    runner = Runner(config, progress=False, text_encoder=hash_text)
+    mdm, physdiff, simdiff = config.models
+    keys = [p.key for p in table1.plan(runner)]
+    assert keys == ["ground_truth", "MDM_ddim", "PhysDiff_ddim", "SimDiff_ddim_alpha0.5", "SimDiff_ddim_alpha1"]
+    assert runner.sim_mode(mdm) is None and runner.sim_mode(physdiff) is None and runner.sim_mode(simdiff) == "continuous"
+    assert not runner.model(mdm).is_simdiff and runner.model(simdiff).is_simdiff
+    assert runner.method_inputs(mdm, "ddim", None)["backbone_only"] is True
+    assert "backbone_only" not in runner.method_inputs(simdiff, "ddim", 0.5)
+    lengths = np.array([40, 40])
+    got = runner.generate_fn(mdm, "ddim", env=(-1.6, 5.0, 0.0))(["a person jumps", "a person walks"], lengths, 3)
+    plain = load_config(write(setup, "table1", name="t1_exp", models=models[:1]), None,
+                        [("out_dir", str(tmp_path)), ("paths.backbone", str(exported))])
+    ref_runner = Runner(plain, progress=False, text_encoder=hash_text)
+    want = ref_runner.generate_fn(plain.models[0], "ddim")(["a person jumps", "a person walks"], lengths, 3)
+    torch.testing.assert_close(torch.as_tensor(np.asarray(got)), torch.as_tensor(np.asarray(want)))
+    adapters = runner.generate_fn(simdiff, "ddim", alpha=1.0, env=(-1.6, 5.0, 0.0))(["a person jumps", "a person walks"],
+                                                                                   lengths, 3)
+    assert not np.allclose(np.asarray(adapters), np.asarray(got))
+
+
 def test_a_method_may_list_its_own_samplers(setup: dict[str, Path], tmp_path: Path) -> None:
     """DDPM rows for MDM and SimDiff at α = 1 only; the binary model and the finish stay DDIM-only."""
     from simdiff.eval.experiments import table1

@@ -47,7 +47,7 @@ def _common(p: argparse.ArgumentParser) -> None:
                    help="CPU budget preset from the config's 'budgets' (default full: the config as written)")
     p.add_argument("--corpus", help="HumanML3D-layout corpus folder (overrides 'corpus')")
     p.add_argument("--evaluator", help="evaluator folder (overrides 'evaluator.path')")
-    p.add_argument("--backbone", help="MDM backbone model folder (overrides 'paths.backbone')")
+    p.add_argument("--backbone", help="MDM backbone model folder (overrides 'paths.backbone'); a SimDiff model folder gives its frozen backbone alone")
     p.add_argument("--adapters", help="continuous (φ) SimDiff model folder (overrides 'paths.adapters')")
     p.add_argument("--adapters-binary", help="categorical (binary) SimDiff model folder (overrides 'paths.adapters_binary')")
     p.add_argument("--set", dest="assignments", action="append", default=[], metavar="KEY=VALUE",

@@ -108,9 +108,14 @@ class Runner:
         return self._encoders[name]
 
     def model(self, spec: ModelSpec) -> Any:
-        """The :class:`simdiff.model.MotionGenerator` of ``spec`` (loaded once per folder)."""
+        """The :class:`simdiff.model.MotionGenerator` of ``spec`` (loaded once per folder and role).
+
+        A ``backbone`` role (MDM, PhysDiff) whose folder holds a SimDiff model gets that model's frozen
+        backbone alone (φ-blind, as ``simdiff train export-backbone`` writes it), never its adapters.
+        """
         path = self.config.model_path(spec)
-        key = str(path)
+        strip = self.backbone_of_simdiff(spec)
+        key = str(path) + ("#backbone" if strip else "")
         if key not in self._models:
             from simdiff.model import MotionGenerator
 
@@ -118,12 +123,15 @@ class Runner:
                 hint = f" (set it with --{spec.model.replace('_', '-')} DIR)" if spec.model and not spec.path else ""
                 raise SimdiffError(f"model folder {path} of {spec.name!r} has no model.safetensors{hint}")
             gen = MotionGenerator.load(path, self.config.device, load_text=False)
+            if strip:
+                gen = MotionGenerator(gen.network.backbone, dataclasses.replace(gen.config, sim=None), None,
+                                      gen.mean, gen.std, self.config.device)
             gen.text_encoder = self.text_encoder(gen.config.text_encoder)
             self._models[key] = gen
         return self._models[key]
 
-    def sim_mode(self, spec: ModelSpec) -> str | None:
-        """``continuous``, ``categorical`` or None (backbone) from the model's config.json (by role without one)."""
+    def folder_sim_mode(self, spec: ModelSpec) -> str | None:
+        """``continuous``, ``categorical`` or None (backbone) from the folder's config.json (by role without one)."""
         path = self.config.model_path(spec) / "config.json"
         if path.is_file():
             try:
@@ -132,6 +140,15 @@ class Runner:
             except (json.JSONDecodeError, AttributeError):
                 pass
         return {"adapters": "continuous", "adapters_binary": "categorical"}.get(spec.model)
+
+    def backbone_of_simdiff(self, spec: ModelSpec) -> bool:
+        """True when a ``backbone`` role points at a SimDiff model folder (its backbone alone is used)."""
+        return spec.model == "backbone" and self.folder_sim_mode(spec) is not None
+
+    def sim_mode(self, spec: ModelSpec) -> str | None:
+        """How ``spec`` generates: ``continuous``, ``categorical`` or None (φ-blind backbone: always for the
+        ``backbone`` role, whatever its folder holds)."""
+        return None if spec.model == "backbone" else self.folder_sim_mode(spec)
 
     def is_simdiff(self, spec: ModelSpec) -> bool:
         return self.sim_mode(spec) is not None
@@ -239,6 +256,8 @@ class Runner:
                                "steps": spec.sampler_steps(sampler), "guidance": spec.guidance,
                                "alpha": alpha, "env": None if env is None else [float(v) for v in env],
                                "env_index": spec.env_index, "device": self.config.device}
+        if self.backbone_of_simdiff(spec):
+            out["backbone_only"] = True  # the folder's SimDiff model, adapters left out
         if spec.physdiff is not None:
             out["physdiff"] = dataclasses.asdict(self.physdiff_config(spec, sampler, env))
             out["projector"] = dataclasses.asdict(self.config.projector)
