@@ -194,3 +194,65 @@ def test_anchored_reference_keeps_a_skating_stand_in_place():
     assert travel(anchored) < 0.02
     feet = anchored.body_pos[:, [7, 8, 10, 11], :2]
     assert np.abs(feet - feet[:1]).max() < 0.02
+
+
+def test_swing_lift_raises_only_fast_low_feet_off_contact():
+    from simdiff.sim.retarget.contacts import swing_lift
+
+    T = 15
+    contact = np.zeros((T, 4), dtype=bool)
+    contact[:, :2] = True  # left foot planted throughout
+    contact[:3, 2:] = contact[12:, 2:] = True  # right foot down at both ends, swinging in between
+    height = np.zeros((T, 4))  # ... and its swing scrapes the floor
+    xy = np.zeros((T, 4, 2))
+    xy[3:, 2:, 0] = 0.1 * np.arange(1, T - 2)[:, None]  # 2 m/s from frame 3
+    xy[12:, 2:, 0] = xy[11, 2, 0]
+    lift = swing_lift(contact, height, xy, 20.0, 0.02, 0.6, 1.2)
+    assert lift.shape == (T, 2)
+    np.testing.assert_array_equal(lift[:, 0], 0.0)  # a planted foot is never lifted
+    np.testing.assert_array_equal(lift[contact[:, 2], 1], 0.0)
+    np.testing.assert_allclose(lift[5:10, 1], 0.02, atol=1e-3)  # full clearance mid-swing
+    assert np.all(np.diff(lift[3:7, 1]) >= 0)  # ramps in, tapered next to the contact
+    assert lift[3, 1] <= 0.02 / 3 + 1e-9 and lift[11, 1] <= 0.02 / 3 + 1e-9
+    # a foot already clear, one that moves slowly, or clearance 0: no lift
+    np.testing.assert_array_equal(swing_lift(contact, height + 0.03, xy, 20.0, 0.02, 0.6, 1.2), 0.0)
+    np.testing.assert_array_equal(swing_lift(contact, height, xy * 0.2, 20.0, 0.02, 0.6, 1.2), 0.0)
+    np.testing.assert_array_equal(swing_lift(contact, height, xy, 20.0, 0.0, 0.6, 1.2), 0.0)
+    # half the deficit when the sole is already 1 cm up
+    np.testing.assert_allclose(swing_lift(contact, height + 0.01, xy, 20.0, 0.02, 0.6, 1.2)[5:10, 1], 0.01, atol=1e-3)
+
+
+def test_the_stance_pass_lifts_the_feet_swing_lift_asks_for(monkeypatch):
+    """Wiring: a lift of 3 cm asked for the right foot while it is raised 5 cm (off contact) raises
+    the reference's right sole by about that much there; the planted left foot and the frames
+    without lift stay as they were; clearance 0 (the augmentation) asks swing_lift for nothing."""
+    import simdiff.sim.retarget.reference as reference
+    from simdiff.sim.retarget import RetargetConfig, finish_retarget, foot_heights
+    from simdiff.sim.retarget.config import FINISH_SWING_CLEARANCE
+
+    asked = []
+
+    def fake_lift(contact, height, xy, fps, clearance, lo, hi):
+        asked.append(clearance)
+        lift = np.zeros((len(contact), 2))
+        if clearance > 0:
+            lift[15:26, 1] = 0.03
+        return lift
+
+    monkeypatch.setattr(reference, "swing_lift", fake_lift)
+    raised = synthetic.standing(40)
+    raised[12:29, [8, 11], 1] += 0.05
+    model = load_model()
+    plain = make_reference(model, raised, RetargetConfig())
+    lifted = make_reference(model, raised, RetargetConfig(swing_clearance=FINISH_SWING_CLEARANCE))
+    assert asked == [0.0, FINISH_SWING_CLEARANCE]
+    h_plain, _ = foot_heights(model, plain.qpos)
+    h_lift, _ = foot_heights(model, lifted.qpos)
+    t = np.arange(plain.num_frames) * plain.dt * 20.0  # input frame of each control frame
+    mid, away = (t >= 17) & (t <= 23), (t <= 8) | (t >= 33)
+    gain = h_lift[mid, 2:].min(axis=1) - h_plain[mid, 2:].min(axis=1)
+    assert np.all(gain > 0.02) and np.all(gain < 0.04)
+    np.testing.assert_allclose(h_lift[away], h_plain[away], atol=2e-3)
+    np.testing.assert_allclose(h_lift[:, :2], h_plain[:, :2], atol=3e-3)
+    assert finish_retarget().swing_clearance == FINISH_SWING_CLEARANCE and finish_retarget().anchor_stance
+    assert finish_retarget(False) == RetargetConfig()

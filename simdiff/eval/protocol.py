@@ -221,8 +221,10 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
     ``simulate``: the simulated finish: every final sample is re-tracked by ``finish_projector``
     (default ``projector``) under φ (``env``, Earth when None) and its features are replaced by the
     rollout's where it tracked (frames after a fall keep the generated ones, as a PhysDiff
-    projection does).
+    projection does). The returned function's ``finish_log`` lists one entry per finished sample
+    (``success``: tracked to the end; ``frames_replaced``), in generation order.
     """
+    finish_log: list[dict[str, Any]] = []
 
     def generate(captions: list[str], lengths: list[int], seed: int) -> Tensor:
         kwargs: dict[str, Any] = {}
@@ -236,15 +238,19 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
             out = generator.generate(captions, lengths, sampler=sampler, steps=steps, guidance=guidance, seed=seed, **kwargs)
         feats = out.features.detach().cpu()
         if simulate:
-            feats = simulated_finish(generator, feats, lengths, env, finish_projector or projector)
+            feats = simulated_finish(generator, feats, lengths, env, finish_projector or projector, log=finish_log)
         return feats
 
+    generate.finish_log = finish_log  # type: ignore[attr-defined]
     return generate
 
 
 def simulated_finish(generator: Any, features: Tensor, lengths: Sequence[int], env: Sequence[float] | None,
-                     projector: Any) -> Tensor:
-    """(B, T, 263) raw features → the same with each motion replaced by its re-tracked rollout under φ."""
+                     projector: Any, log: list[dict[str, Any]] | None = None) -> Tensor:
+    """(B, T, 263) raw features → the same with each motion replaced by its re-tracked rollout under φ.
+
+    ``log``, when given, gets one entry per motion: ``success`` (tracked to the end) and ``frames_replaced``.
+    """
     from simdiff.baselines.physdiff import ProjectionHook
     from simdiff.motion.normalize import Normalizer
     from simdiff.sim.env import Environment
@@ -256,5 +262,7 @@ def simulated_finish(generator: Any, features: Tensor, lengths: Sequence[int], e
     hook = ProjectionHook(norm, [int(n) for n in lengths], phi, projector)
     x0 = norm.normalize(features.float())
     out = norm.denormalize(hook(x0, 0, x0))
+    if log is not None:
+        log.extend({"success": e["success"], "frames_replaced": e["frames_replaced"]} for e in hook.log[-1]["samples"])
     mask = (torch.arange(out.shape[1])[None, :] < torch.as_tensor([int(n) for n in lengths])[:, None]).to(out.dtype)
     return out * mask[..., None]

@@ -86,14 +86,15 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
         max_force: tracker root-residual bound (fraction of m·|g_z|), as in the augmentation.
         follow_flights: flights last as long as φ makes them (the rollout may change length).
         force: allow φ outside the validated range.
-        anchor_stance: planted feet stay where they touched down; the body's skating drift is
-            taken out of the reference before tracking (see
-            :attr:`simdiff.sim.retarget.RetargetConfig.anchor_stance`).
+        anchor_stance: the finish's retargeting (:func:`simdiff.sim.retarget.finish_retarget`):
+            planted feet stay where they touched down, the body's skating drift taken out of the
+            reference before tracking, and fast swing feet lifted clear of the floor; False: the
+            augmentation's plain retargeting.
     """
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
     from simdiff.sim.residual import ResidualConfig
-    from simdiff.sim.retarget import RetargetConfig
+    from simdiff.sim.retarget import finish_retarget
     from simdiff.sim.retarget.contacts import ANCHOR_VERSION
 
     arr = np.asarray(joints, dtype=np.float64)
@@ -103,7 +104,7 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     start = time.perf_counter()
     out, info = project(arr, phi, residual=ResidualConfig(max_force=max_force), normalizer=normalizer, force=force,
                         flight=FlightConfig() if follow_flights else None,
-                        retarget=RetargetConfig(anchor_stance=anchor_stance))
+                        retarget=finish_retarget(anchor_stance))
     wall = time.perf_counter() - start
     out = np.asarray(out, dtype=np.float32)
     tracking = info.to_dict()

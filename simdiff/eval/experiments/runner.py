@@ -324,13 +324,18 @@ class Runner:
                          protocol: ProtocolConfig | None = None) -> dict[str, Any]:
         """The T2M protocol + physics metrics of one method row."""
         proto = protocol or self.config.protocol
-        result = evaluate_t2m(self.evaluator, self.dataset, self.generate_fn(spec, sampler, alpha, env), proto,
-                              self.progress)
+        fn = self.generate_fn(spec, sampler, alpha, env)
+        result = evaluate_t2m(self.evaluator, self.dataset, fn, proto, self.progress)
         reps = result["replications"]
-        return {"summary": result["summary"]["generated"], "replications": [r["generated"] for r in reps],
-                "s_per_motion": float(np.mean([r["gen_s_per_sample"] for r in reps])),
-                "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps),
-                "split_size": result["split_size"], "seeds": protocol_seeds(proto)}
+        out = {"summary": result["summary"]["generated"], "replications": [r["generated"] for r in reps],
+               "s_per_motion": float(np.mean([r["gen_s_per_sample"] for r in reps])),
+               "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps),
+               "split_size": result["split_size"], "seeds": protocol_seeds(proto)}
+        log = getattr(fn, "finish_log", None)
+        if spec.simulate and log:
+            tracked = sum(bool(e["success"]) for e in log)
+            out["finish"] = {"motions": len(log), "tracked": tracked, "tracked_frac": tracked / len(log)}
+        return out
 
     def gt_measure(self) -> dict[str, Any]:
         """The ground-truth row of the protocol."""

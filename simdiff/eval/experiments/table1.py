@@ -101,6 +101,11 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
             cfg = runner.physdiff_config(m, sampler)
             lines.append(f"* {m.name} {sampler.upper()}: projection at t = {', '.join(map(str, cfg.project_at))} "
                          f"({cfg.steps or ('1000' if sampler == 'ddpm' else '50')} steps), residual bound {cfg.residual_bound}")
+    for row in report["rows"]:
+        if row.get("finish"):
+            f = row["finish"]
+            lines.append(f"* {row['method']} {row['sampler'].upper()}: the simulator tracked {f['tracked']} of {f['motions']} "
+                         f"final samples to the end ({100 * f['tracked_frac']:.0f} %); after a fall the generated frames stay")
     lines.append("* s/motion: generation time per motion in the protocol's batches of 32 (PhysDiff: with projection); "
                  "see fig4 for batch-1 latency")
     lines += speed_comparison(report["rows"], "s_per_motion")

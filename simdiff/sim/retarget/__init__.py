@@ -7,12 +7,12 @@ and its Gauss-Newton polish), ``kinematics`` (forward kinematics: joints, foot s
 ``reference`` (:func:`make_reference`, the whole forward conversion). MuJoCo is imported lazily.
 """
 
-from simdiff.sim.retarget.config import CONTROL_HZ, HML_FPS, Reference, RetargetConfig
+from simdiff.sim.retarget.config import CONTROL_HZ, HML_FPS, Reference, RetargetConfig, finish_retarget
 from simdiff.sim.retarget.ik import analytic_ik, ik_sequence
 from simdiff.sim.retarget.kinematics import foot_heights, joints_to_features, qpos_to_joints, qpos_to_world
 from simdiff.sim.retarget.reference import make_reference
 
 __all__ = [
-    "CONTROL_HZ", "HML_FPS", "Reference", "RetargetConfig", "analytic_ik", "foot_heights", "ik_sequence",
+    "CONTROL_HZ", "HML_FPS", "Reference", "RetargetConfig", "analytic_ik", "finish_retarget", "foot_heights", "ik_sequence",
     "joints_to_features", "make_reference", "qpos_to_joints", "qpos_to_world",
 ]

@@ -10,7 +10,8 @@
    for a planted one where every foot on the floor glides
    (:func:`~simdiff.sim.retarget.contacts.skating_support`);
 3. a second IK pass that holds every stance foot (or toe, at toe-off) flat, at a fixed xy
-   and on the floor;
+   and on the floor, and with ``swing_clearance`` lifts fast swing feet clear of it
+   (:func:`~simdiff.sim.retarget.contacts.swing_lift`);
 4. temporal Gaussian filtering **before** anything is cropped, with odd-reflection padding
    so that the boundary velocities survive;
 5. cubic resampling to the control rate (30 Hz), velocities and accelerations;
@@ -26,7 +27,7 @@ from simdiff.errors import SimdiffError
 from simdiff.sim.humanoid import hml_to_world, model_index
 from simdiff.sim.retarget.config import Reference, RetargetConfig
 from simdiff.sim.retarget.contacts import (contact_schedule, ground_level, infer_support, skating_support,
-                                           stance_anchor_shift, stance_tasks)
+                                           stance_anchor_shift, stance_tasks, swing_lift)
 from simdiff.sim.retarget.dynamics import inverse_dynamics_screen
 from simdiff.sim.retarget.filtering import continuous_quats, despike, finite_velocity, resample_qpos, smooth
 from simdiff.sim.retarget.ik import ik_sequence
@@ -80,10 +81,11 @@ def make_reference(model, joints: np.ndarray, cfg: RetargetConfig = RetargetConf
         reach = infer_support(contact, h, xy, com_height(model, q1), fps, cfg.support_accel, cfg.support_reach,
                               cfg.contact_speed)
         contact = contact | reach
+    lift = swing_lift(contact, h, xy, fps, cfg.swing_clearance, cfg.contact_speed, 2.0 * cfg.contact_speed)
     q = q1
     # 3. stance pass
-    if cfg.stance_pass and contact.any():
-        tasks = stance_tasks(model, q1, contact, reach=reach)
+    if cfg.stance_pass and (contact.any() or lift.any()):
+        tasks = stance_tasks(model, q1, contact, reach=reach, lift=lift if lift.any() else None)
         q, err = ik_sequence(model, target + np.array([0.0, 0.0, shift]), cfg, tasks=tasks, init=q1)
     # 4. smoothing (before any cropping; odd-reflection keeps the boundary velocity)
     qs = q.copy()
