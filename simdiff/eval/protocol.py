@@ -245,6 +245,12 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
     return generate
 
 
+def finish_summary(log: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """How many of the finished samples of a :func:`generator_fn` ``finish_log`` tracked to the end."""
+    tracked = sum(bool(e["success"]) for e in log)
+    return {"motions": len(log), "tracked": tracked, "tracked_frac": tracked / max(1, len(log))}
+
+
 def simulated_finish(generator: Any, features: Tensor, lengths: Sequence[int], env: Sequence[float] | None,
                      projector: Any, log: list[dict[str, Any]] | None = None) -> Tensor:
     """(B, T, 263) raw features → the same with each motion replaced by its re-tracked rollout under φ.

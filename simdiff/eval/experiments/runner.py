@@ -28,7 +28,7 @@ import torch
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ExperimentConfig, ModelSpec
 from simdiff.eval.experiments.provenance import provenance
-from simdiff.eval.protocol import GenerateFn, ProtocolConfig, evaluate_t2m, generator_fn
+from simdiff.eval.protocol import GenerateFn, ProtocolConfig, evaluate_t2m, finish_summary, generator_fn
 
 EARTH: tuple[float, float, float] = (-9.81, 0.0, 0.0)
 FPS: float = 20.0
@@ -331,10 +331,8 @@ class Runner:
                "s_per_motion": float(np.mean([r["gen_s_per_sample"] for r in reps])),
                "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps),
                "split_size": result["split_size"], "seeds": protocol_seeds(proto)}
-        log = getattr(fn, "finish_log", None)
-        if spec.simulate and log:
-            tracked = sum(bool(e["success"]) for e in log)
-            out["finish"] = {"motions": len(log), "tracked": tracked, "tracked_frac": tracked / len(log)}
+        if spec.simulate and getattr(fn, "finish_log", None):
+            out["finish"] = finish_summary(fn.finish_log)
         return out
 
     def gt_measure(self) -> dict[str, Any]:
