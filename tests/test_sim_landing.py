@@ -256,3 +256,25 @@ def test_the_stance_pass_lifts_the_feet_swing_lift_asks_for(monkeypatch):
     np.testing.assert_allclose(h_lift[:, :2], h_plain[:, :2], atol=3e-3)
     assert finish_retarget().swing_clearance == FINISH_SWING_CLEARANCE and finish_retarget().anchor_stance
     assert finish_retarget(False) == RetargetConfig()
+
+
+def test_the_finish_tracker_config_reaches_the_default_tracker(monkeypatch):
+    """project(tracker_config=...) builds the default tracker from it (landing sync set by the flight clock)."""
+    import simdiff.sim.rollout as rollout_module
+    from simdiff.sim.flight import FlightConfig
+    from simdiff.sim.project import project
+    from simdiff.sim.tracker import FINISH_LEAD, PDTracker, finish_tracker_config
+
+    seen = []
+
+    class Recording(PDTracker):
+        def __init__(self, config):
+            seen.append(config)
+            super().__init__(config)
+
+    monkeypatch.setattr(rollout_module, "PDTracker", Recording)
+    stand = synthetic.standing(12)
+    project(stand, Environment(), tracker_config=finish_tracker_config(), flight=FlightConfig())
+    project(stand, Environment())
+    assert seen[0].lead == FINISH_LEAD and seen[0].landing_sync is False  # the flight clock syncs landings
+    assert seen[1].lead == 1.5 and seen[1].landing_sync is True

@@ -88,13 +88,15 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
         force: allow φ outside the validated range.
         anchor_stance: the finish's retargeting (:func:`simdiff.sim.retarget.finish_retarget`):
             planted feet stay where they touched down, the body's skating drift taken out of the
-            reference before tracking, and fast swing feet lifted clear of the floor; False: the
-            augmentation's plain retargeting.
+            reference before tracking, and fast swing feet lifted clear of the floor; and the
+            finish's tracker lead (:func:`simdiff.sim.tracker.finish_tracker_config`). False: the
+            augmentation's plain retargeting and tracker.
     """
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
     from simdiff.sim.residual import ResidualConfig
     from simdiff.sim.retarget import finish_retarget
+    from simdiff.sim.tracker import finish_tracker_config
     from simdiff.sim.retarget.contacts import ANCHOR_VERSION
 
     arr = np.asarray(joints, dtype=np.float64)
@@ -104,7 +106,8 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     start = time.perf_counter()
     out, info = project(arr, phi, residual=ResidualConfig(max_force=max_force), normalizer=normalizer, force=force,
                         flight=FlightConfig() if follow_flights else None,
-                        retarget=finish_retarget(anchor_stance))
+                        retarget=finish_retarget(anchor_stance),
+                        tracker_config=finish_tracker_config() if anchor_stance else None)
     wall = time.perf_counter() - start
     out = np.asarray(out, dtype=np.float32)
     tracking = info.to_dict()

@@ -30,6 +30,7 @@ from simdiff.sim.flight import FlightConfig
 from simdiff.sim.project import ProjectionInfo, project
 from simdiff.sim.residual import ResidualConfig
 from simdiff.sim.retime import RetimeConfig
+from simdiff.sim.tracker import PDTrackerConfig
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,7 @@ class PoolConfig:
         ray_address: address for ``ray.init`` (None: local or RAY_ADDRESS).
         flight: the flight clock passed to :func:`project` (None: the reference's own clock).
         retime: the weak-gravity second try passed to :func:`project` (None: one try).
+        tracker_config: the default tracker's settings passed to :func:`project` (None: its defaults).
     """
 
     workers: int = 0
@@ -57,6 +59,7 @@ class PoolConfig:
     extra: dict = field(default_factory=dict)
     flight: FlightConfig | None = None
     retime: RetimeConfig | None = None
+    tracker_config: PDTrackerConfig | None = None
 
 
 Result = tuple[np.ndarray | None, Any]
@@ -129,6 +132,7 @@ def _run_one(args: tuple[np.ndarray, tuple[float, float, float], PoolConfig]) ->
         return project(
             joints, Environment(*phi), residual=cfg.residual, retarget=cfg.retarget,
             normalizer=_normalizer(cfg.stats_dir), force=cfg.force, flight=cfg.flight, retime=cfg.retime,
+            tracker_config=cfg.tracker_config,
         )
     except Exception as exc:  # one bad motion must not stop the batch
         return None, f"{type(exc).__name__}: {exc}"

@@ -25,7 +25,7 @@ from simdiff.sim.residual import ResidualConfig
 from simdiff.sim.retime import RetimeConfig, better, stretch
 from simdiff.sim.rollout import FallConfig, RolloutResult, rollout
 from simdiff.sim.strength import StrengthConfig
-from simdiff.sim.tracker import Tracker
+from simdiff.sim.tracker import PDTrackerConfig, Tracker
 
 SIM_VERSION: int = 4
 """Version of the physics behind :func:`project` with its defaults, recorded with augmented pairs.
@@ -132,6 +132,7 @@ def project(
     flight: FlightConfig | None = None,
     strength: StrengthConfig | None = StrengthConfig(),
     retime: RetimeConfig | None = None,
+    tracker_config: PDTrackerConfig | None = None,
 ) -> tuple[np.ndarray, ProjectionInfo]:
     """P_φ,π(τ): replay ``joints`` in MuJoCo under ``env`` and return the rollout.
 
@@ -150,6 +151,8 @@ def project(
         retime: under |g_z| < 9.81, when the rollout fell or its pose d_L2 exceeds the
             trigger, track the source slowed to the same Froude number as well and keep the
             better rollout (:mod:`simdiff.sim.retime`); None (default): one try.
+        tracker_config: settings of the default tracker (None: the default's; the simulated
+            finish's: :func:`simdiff.sim.tracker.finish_tracker_config`).
     Returns:
         (rollout joints (T', 22, 3) float32, :class:`ProjectionInfo`).
     """
@@ -157,7 +160,7 @@ def project(
     model = model if model is not None else load_model(HumanoidConfig())
     joints = np.asarray(joints, dtype=np.float64)
     kw = dict(model=model, tracker=tracker, residual=residual, retarget=retarget, fall=fall, normalizer=normalizer,
-              audit=audit, flight=flight, strength=strength)
+              audit=audit, flight=flight, strength=strength, tracker_config=tracker_config)
     out, info = _project_once(joints, env, **kw)
     scale = 1.0 if retime is None else retime.scale(env.gravity)
     if scale == 1.0 or not retime.should_retry(info.status, info.d_l2_pose):
@@ -175,11 +178,13 @@ def project(
 
 def _project_once(joints: np.ndarray, env: Environment, *, model, tracker: Tracker | None, residual: ResidualConfig,
                   retarget: RetargetConfig, fall: FallConfig, normalizer, audit: bool, flight: FlightConfig | None,
-                  strength: StrengthConfig | None) -> tuple[np.ndarray, ProjectionInfo]:
+                  strength: StrengthConfig | None,
+                  tracker_config: PDTrackerConfig | None = None) -> tuple[np.ndarray, ProjectionInfo]:
     """One rollout of ``joints`` (float64, validated φ) and its distances; see :func:`project`."""
     t0 = time.process_time()
     ref = make_reference(model, joints, retarget, gravity=env.gravity)
-    res = rollout(model, ref, env, tracker, residual, fall, audit=audit, flight=flight, strength=strength)
+    res = rollout(model, ref, env, tracker, residual, fall, audit=audit, flight=flight, strength=strength,
+                  tracker_config=tracker_config)
     out = rollout_joints(model, res, joints.shape[0] if flight is None else None, retarget.fps)
     if flight is None:
         source = joints[: len(out)]

@@ -25,6 +25,8 @@ Without it the clock is the reference's own (one frame per control step).
 
 from __future__ import annotations
 
+import dataclasses
+
 import copy
 import time
 from dataclasses import dataclass, field, replace
@@ -163,6 +165,7 @@ def rollout(
     recovery: RecoveryConfig | None = None,
     flight: FlightConfig | None = None,
     strength: StrengthConfig | None = StrengthConfig(),
+    tracker_config: PDTrackerConfig | None = None,
 ) -> RolloutResult:
     """Simulate the reference under ``env`` with ``tracker`` and the gated residual.
 
@@ -183,6 +186,8 @@ def rollout(
             recovery variants and the residual's torque bound scaled for s
             (:mod:`simdiff.sim.strength`); a tracker passed in is used as given. None: Earth
             strength at every g.
+        tracker_config: settings of the default tracker (None: :class:`PDTrackerConfig`'s); its
+            landing sync and balance strength are set as for the default.
     Returns:
         A :class:`RolloutResult`.
     """
@@ -201,7 +206,8 @@ def rollout(
     mujoco.mj_forward(m, d)
     clock = FlightClock(reference.contact, 1.0 / reference.dt, flight) if flight is not None else None
     s_bal = s if strength is not None and strength.balance else 1.0
-    tracker = tracker or PDTracker(scale_balance(PDTrackerConfig(landing_sync=clock is None), s_bal))
+    base = dataclasses.replace(tracker_config or PDTrackerConfig(), landing_sync=clock is None)
+    tracker = tracker or PDTracker(scale_balance(base, s_bal))
     tracker.reset(m, d, reference, ix)
     res = RootResidual(residual, m, reference, ix, env.gravity)
     n_sub = int(round(reference.dt / m.opt.timestep))

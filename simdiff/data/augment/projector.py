@@ -18,6 +18,7 @@ from simdiff.sim.pool import PoolConfig, ProjectionPool, Projector, Result
 from simdiff.sim.residual import ResidualConfig
 from simdiff.sim.retime import RetimeConfig
 from simdiff.sim.retarget.config import finish_retarget
+from simdiff.sim.tracker import finish_tracker_config
 
 __all__ = ["Projector", "Result", "SimProjector"]
 
@@ -36,8 +37,10 @@ class SimProjector:
         retime: under |g_z| < 9.81, a second try on the source slowed to the same Froude number
             when the first rollout fell or strayed (:mod:`simdiff.sim.retime`; the augmentation's
             default); None: one try (PhysDiff, the evaluation's re-tracking).
-        anchor_stance: the simulated finish's retargeting (:func:`simdiff.sim.retarget.finish_retarget`:
-            planted feet stay put, swing feet clear the floor; off for augmentation and PhysDiff).
+        anchor_stance: the simulated finish's retargeting and tracker
+            (:func:`simdiff.sim.retarget.finish_retarget`: planted feet stay put, swing feet clear the
+            floor; :func:`simdiff.sim.tracker.finish_tracker_config`: a longer lead); off for
+            augmentation and PhysDiff.
     Raises:
         SimdiffError: an unknown backend.
     """
@@ -54,7 +57,8 @@ class SimProjector:
         self._pool = ProjectionPool(PoolConfig(workers=self.workers, backend=self.backend, stats_dir=self.stats_dir,
                                                residual=ResidualConfig(max_force=self.max_force), flight=self.flight,
                                                retime=self.retime,
-                                               retarget=finish_retarget(self.anchor_stance)))
+                                               retarget=finish_retarget(self.anchor_stance),
+                                               tracker_config=finish_tracker_config() if self.anchor_stance else None))
 
     def __call__(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:
         return self._pool.imap(motions, envs)
