@@ -25,8 +25,6 @@ Without it the clock is the reference's own (one frame per control step).
 
 from __future__ import annotations
 
-import dataclasses
-
 import copy
 import time
 from dataclasses import dataclass, field, replace
@@ -206,7 +204,7 @@ def rollout(
     mujoco.mj_forward(m, d)
     clock = FlightClock(reference.contact, 1.0 / reference.dt, flight) if flight is not None else None
     s_bal = s if strength is not None and strength.balance else 1.0
-    base = dataclasses.replace(tracker_config or PDTrackerConfig(), landing_sync=clock is None)
+    base = replace(tracker_config or PDTrackerConfig(), landing_sync=clock is None)
     tracker = tracker or PDTracker(scale_balance(base, s_bal))
     tracker.reset(m, d, reference, ix)
     res = RootResidual(residual, m, reference, ix, env.gravity)
