@@ -2,25 +2,19 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from simdiff.errors import SimdiffError
 from simdiff.sim.synthetic import standing
-
-ROOT = Path(__file__).resolve().parents[1]
+from benchmark_fixtures import load_benchmark
 
 
 @pytest.fixture(scope="module")
 def bench():
-    spec = importlib.util.spec_from_file_location("bench_flight_sample", ROOT / "benchmarks" / "bench_flight_sample.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_benchmark("bench_flight_sample")
 
 
 def test_keep_rule_scales_the_residual_budget_only_above_earth(bench):

@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import pytest
 
 from simdiff.errors import SimdiffError
 from simdiff.eval.testing import write_tiny_corpus
 from simdiff.train.curves import DESIGNS, design_config
-
-ROOT = Path(__file__).resolve().parent.parent
+from benchmark_fixtures import load_benchmark
 
 
 pytestmark = pytest.mark.usefixtures("one_torch_thread")
@@ -20,9 +17,7 @@ pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 def test_train_curves_script_writes_json_and_png(tmp_path) -> None:
     corpus = write_tiny_corpus(tmp_path / "c", n_train=8, n_val=4, n_test=4, frames=48)
-    spec = importlib.util.spec_from_file_location("train_curves", ROOT / "benchmarks" / "train_curves.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_benchmark("train_curves")
     out = tmp_path / "reports"
     argv = ["--corpus", str(corpus), "--design", "tiny_plain", "--minutes", "0.02", "--points", "2",
             "--text-encoder", "hash", "--out", str(out), "--heldout", "4", "--sample-steps", "2"]
@@ -49,9 +44,7 @@ def test_designs_are_mdm_transformers_with_optional_geometric_losses() -> None:
 
 def test_curve_run_continues_from_its_folder_and_rescores_saved_samples(tmp_path) -> None:
     corpus = write_tiny_corpus(tmp_path / "c", n_train=8, n_val=4, n_test=4, frames=48)
-    spec = importlib.util.spec_from_file_location("train_curves", ROOT / "benchmarks" / "train_curves.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_benchmark("train_curves")
     out, run = tmp_path / "reports", tmp_path / "run"
     base = ["--corpus", str(corpus), "--design", "tiny_plain", "--points", "1", "--text-encoder", "hash",
             "--out", str(out), "--heldout", "4", "--sample-steps", "2", "--run-dir", str(run)]

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,8 +13,7 @@ from simdiff.eval.testing import write_tiny_corpus
 from simdiff.motion.features import process_joints
 from simdiff.motion.synthetic import walk
 from simdiff.train.lowfps import build_lowfps_corpus, downsample_features, upsample_features, upsample_joints
-
-ROOT = Path(__file__).resolve().parent.parent
+from benchmark_fixtures import load_benchmark
 
 
 pytestmark = pytest.mark.usefixtures("one_torch_thread")
@@ -59,9 +56,7 @@ def test_lowfps_corpus_is_built_resumably(tmp_path) -> None:
 
 def test_lowfps_learning_curve_is_measured_at_20_fps(tmp_path) -> None:
     corpus = write_tiny_corpus(tmp_path / "c", n_train=8, n_val=4, n_test=4, frames=48)
-    spec = importlib.util.spec_from_file_location("train_curves", ROOT / "benchmarks" / "train_curves.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_benchmark("train_curves")
     out = tmp_path / "reports"
     argv = ["--corpus", str(corpus), "--design", "tiny_lowfps2", "--minutes", "0.01", "--points", "1",
             "--text-encoder", "hash", "--out", str(out), "--heldout", "4", "--sample-steps", "2"]

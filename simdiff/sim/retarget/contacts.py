@@ -7,6 +7,7 @@ Heights in metres (world Z-up), speeds in m/s, schedules (T, 4) bool per foot bo
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import gaussian_filter1d, maximum_filter1d
 from scipy.spatial.transform import Rotation
 
 from simdiff.motion.flight import runs
@@ -83,13 +84,8 @@ def swing_lift(contact: np.ndarray, height: np.ndarray, xy: np.ndarray, fps: flo
     speed = _box_speed(xy, fps)
     ramp = np.clip((speed - speed_lo) / max(speed_hi - speed_lo, 1e-9), 0.0, 1.0)
     need = np.where(contact, 0.0, np.maximum(0.0, clearance * ramp - height)).reshape(T, 2, 2).max(axis=2)
-    wide = need.copy()
-    wide[1:] = np.maximum(wide[1:], need[:-1])
-    wide[:-1] = np.maximum(wide[:-1], need[1:])
-    kernel = np.exp(-0.5 * np.arange(-3, 4) ** 2)
-    kernel /= kernel.sum()
-    padded = np.pad(wide, ((3, 3), (0, 0)))
-    lift = np.stack([np.convolve(padded[:, f], kernel, mode="valid") for f in range(2)], axis=1)
+    wide = maximum_filter1d(need, 3, axis=0, mode="constant")
+    lift = gaussian_filter1d(wide, 1.0, axis=0, mode="constant", truncate=3.0)
     planted = contact.reshape(T, 2, 2).any(axis=2)
     return lift * np.clip(_frames_to(planted) / taper, 0.0, 1.0)
 
