@@ -447,6 +447,7 @@ def test_the_simulated_finish_anchors_planted_feet_and_physdiff_does_not(setup: 
         assert runner.finish_sim._pool.cfg.retarget.anchor_stance is True
         assert runner.sim._pool.cfg.tracker_config is None  # PhysDiff and re-tracking: the augmentation's tracker
         assert runner.finish_sim._pool.cfg.tracker_config.lead == FINISH_LEAD
+        assert runner.finish_sim._pool.cfg.tracker_config.balance.moving_kp_xy == 0.0
         assert runner.serial_projector(anchor_stance=True)._pool.cfg.retarget.anchor_stance is True
     finally:
         runner.close()

@@ -263,18 +263,53 @@ def test_the_finish_tracker_config_reaches_the_default_tracker(monkeypatch):
     import simdiff.sim.rollout as rollout_module
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
-    from simdiff.sim.tracker import FINISH_LEAD, PDTracker, finish_tracker_config
+    from simdiff.sim.tracker import FINISH_LEAD, FINISH_MOVING_KP_XY, BalanceConfig, PDTracker, finish_tracker_config
 
     seen = []
+
+    gains = []
 
     class Recording(PDTracker):
         def __init__(self, config):
             seen.append(config)
             super().__init__(config)
 
+        def kp_xy(self, k):
+            gains.append(super().kp_xy(k))
+            return gains[-1]
+
     monkeypatch.setattr(rollout_module, "PDTracker", Recording)
     stand = synthetic.standing(12)
     project(stand, Environment(), tracker_config=finish_tracker_config(), flight=FlightConfig())
     project(stand, Environment())
     assert seen[0].lead == FINISH_LEAD and seen[0].landing_sync is False  # the flight clock syncs landings
+    assert seen[0].balance.moving_kp_xy == FINISH_MOVING_KP_XY == 0.0  # no position pull while moving (skids)
+    assert seen[0].balance.kp_xy == 20.0 and seen[0].balance.kd_xy == BalanceConfig().kd_xy > 0
     assert seen[1].lead == 1.5 and seen[1].landing_sync is True
+    assert seen[1].balance == BalanceConfig() and seen[1].balance.moving_kp_xy is None  # the augmentation's
+    assert gains and set(gains) == {20.0}  # the balance layer asks for its gain (a stand: never moving)
+
+
+def test_the_balance_position_gain_fades_while_the_reference_moves():
+    """moving_kp_xy: kp_xy below moving_speed[0], moving_kp_xy above moving_speed[1], linear between;
+    the finish's setting, and gravity scaling keeps it proportional."""
+    from types import SimpleNamespace
+
+    from simdiff.sim.strength import scale_balance
+    from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig, finish_tracker_config
+
+    vel = np.zeros((5, 3))
+    vel[:, 0] = [0.0, 0.3, 0.45, 0.6, 2.0]
+    vel[2, :2] = [0.27, 0.36]  # 0.45 m/s diagonally
+    ref = SimpleNamespace(com_vel=vel)
+    t = PDTracker(finish_tracker_config())
+    t.ref = ref
+    np.testing.assert_allclose([t.kp_xy(k) for k in range(5)], [20.0, 20.0, 10.0, 0.0, 0.0], atol=1e-9)
+    t = PDTracker(PDTrackerConfig(balance=BalanceConfig(moving_kp_xy=4.0, moving_speed=(1.0, 3.0))))
+    t.ref = ref
+    np.testing.assert_allclose([t.kp_xy(k) for k in range(5)], [20.0, 20.0, 20.0, 20.0, 12.0], atol=1e-9)
+    t = PDTracker(PDTrackerConfig())  # the augmentation's: one gain throughout
+    t.ref = ref
+    assert [t.kp_xy(k) for k in range(5)] == [20.0] * 5
+    half = scale_balance(PDTrackerConfig(balance=BalanceConfig(moving_kp_xy=4.0)), 0.5).balance
+    assert (half.kp_xy, half.moving_kp_xy) == (10.0, 2.0)

@@ -117,8 +117,9 @@ def scale_balance(config: PDTrackerConfig, s: float) -> PDTrackerConfig:
         return config
     b = config.balance
     r = math.sqrt(s)
+    moving = None if b.moving_kp_xy is None else b.moving_kp_xy * s
     return replace(config, balance=replace(b, kp_xy=b.kp_xy * s, kd_xy=b.kd_xy * r, kp_rot=b.kp_rot * s,
-                                           kd_rot=b.kd_rot * r))
+                                           kd_rot=b.kd_rot * r, moving_kp_xy=moving))
 
 
 def scale_residual(config: ResidualConfig, s: float, *, torque: bool = True, gains: bool = False) -> ResidualConfig:
