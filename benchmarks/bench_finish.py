@@ -46,14 +46,10 @@ def generate(prompt: str, gravity: float, seed: int, args: argparse.Namespace, o
     return joints
 
 
-def finish_one(joints: Path, gravity: float, args: argparse.Namespace) -> dict:
-    """Tracking status and simulated sliding of one sample under the asked finish settings."""
-    import numpy as np
-
+def apply_settings(args: argparse.Namespace) -> None:
+    """Set the asked finish settings (module constants the finish reads at each call) for this process."""
     import simdiff.sim.retarget.config as retarget_config
     import simdiff.sim.tracker as tracker
-    from simdiff.product.simulate import simulate_finish
-    from simdiff.sim.env import Environment
 
     if args.no_lift:
         retarget_config.FINISH_SWING_CLEARANCE = 0.0
@@ -61,6 +57,15 @@ def finish_one(joints: Path, gravity: float, args: argparse.Namespace) -> dict:
         tracker.FINISH_LEAD = args.lead
     if args.moving_kp_xy is not None:
         tracker.FINISH_MOVING_KP_XY = args.moving_kp_xy
+
+
+def finish_one(joints: Path, gravity: float) -> dict:
+    """Tracking status and simulated sliding of one sample under the finish settings in force."""
+    import numpy as np
+
+    from simdiff.product.simulate import simulate_finish
+    from simdiff.sim.env import Environment
+
     t = simulate_finish(np.load(joints), Environment(gravity=gravity)).tracking
     phys = t.get("physics_simulated") or {}
     return {"status": t["status"], "fall_frame": t.get("fall_frame"), "frames_out": t["n_out"],
@@ -99,6 +104,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--lead must be ≥ 0, got {args.lead:g}")
     if args.moving_kp_xy is not None and not args.moving_kp_xy >= 0:
         ap.error(f"--moving-kp-xy must be ≥ 0, got {args.moving_kp_xy:g}")
+    apply_settings(args)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         work = args.work or Path(tmp)
@@ -107,7 +113,7 @@ def main(argv: list[str] | None = None) -> int:
                 for j, g in enumerate(args.gravities):
                     joints = generate(prompt, g, seed, args, work / f"s{seed}_p{i}_g{j}")
                     r = {"prompt": prompt, "kind": (prompt.split() + ["?", "?", "?"])[2], "gravity": g, "seed": seed,
-                         **finish_one(joints, g, args)}
+                         **finish_one(joints, g)}
                     rows.append(r)
                     slide = "—" if r["sliding_simulated"] is None else f"{r['sliding_simulated']:.2f}"
                     print(f"seed {seed} {prompt!r:30} g={g:6.2f}  {r['status']:4} {r['frames_out']:4} frames  "

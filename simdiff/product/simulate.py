@@ -96,8 +96,8 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     from simdiff.sim.project import project
     from simdiff.sim.residual import ResidualConfig
     from simdiff.sim.retarget import finish_retarget
-    from simdiff.sim.tracker import finish_tracker_config
     from simdiff.sim.retarget.contacts import ANCHOR_VERSION
+    from simdiff.sim.tracker import finish_tracker_config
 
     arr = np.asarray(joints, dtype=np.float64)
     if arr.ndim != 3 or arr.shape[1:] != (22, 3) or arr.shape[0] < 2:

@@ -7,7 +7,7 @@ Heights in metres (world Z-up), speeds in m/s, schedules (T, 4) bool per foot bo
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d, maximum_filter1d
+from scipy.ndimage import distance_transform_edt, gaussian_filter1d, maximum_filter1d
 from scipy.spatial.transform import Rotation
 
 from simdiff.motion.flight import runs
@@ -93,12 +93,10 @@ def swing_lift(contact: np.ndarray, height: np.ndarray, xy: np.ndarray, fps: flo
 
 def _frames_to(mask: np.ndarray) -> np.ndarray:
     """(T, F) frames from each frame to the nearest True of its column of ``mask`` (T, F) (T when none)."""
-    T = mask.shape[0]
-    dist = np.full(mask.shape, float(T))
+    dist = np.full(mask.shape, float(mask.shape[0]))
     for f in range(mask.shape[1]):
-        hits = np.flatnonzero(mask[:, f])
-        if hits.size:
-            dist[:, f] = np.abs(np.arange(T)[:, None] - hits[None, :]).min(axis=1)
+        if mask[:, f].any():
+            dist[:, f] = distance_transform_edt(~mask[:, f])  # 1-D: |frame − nearest True|
     return dist
 
 
