@@ -441,13 +441,14 @@ def test_the_simulated_finish_anchors_planted_feet_and_physdiff_does_not(setup: 
 
     runner = Runner(load_config(write(setup, "table1", name="t1_anchor")))
     try:
-        from simdiff.sim.tracker import FINISH_LEAD
+        from simdiff.sim.tracker import FINISH_LATE_FOOT, FINISH_LEAD
 
         assert runner.sim._pool.cfg.retarget.anchor_stance is False
         assert runner.finish_sim._pool.cfg.retarget.anchor_stance is True
         assert runner.sim._pool.cfg.tracker_config is None  # PhysDiff and re-tracking: the augmentation's tracker
         assert runner.finish_sim._pool.cfg.tracker_config.lead == FINISH_LEAD
         assert runner.finish_sim._pool.cfg.tracker_config.balance.moving_kp_xy == 0.0
+        assert runner.finish_sim._pool.cfg.tracker_config.balance.late_foot == FINISH_LATE_FOOT != "release"
         assert runner.serial_projector(anchor_stance=True)._pool.cfg.retarget.anchor_stance is True
     finally:
         runner.close()

@@ -263,7 +263,8 @@ def test_the_finish_tracker_config_reaches_the_default_tracker(monkeypatch):
     import simdiff.sim.rollout as rollout_module
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
-    from simdiff.sim.tracker import FINISH_LEAD, FINISH_MOVING_KP_XY, BalanceConfig, PDTracker, finish_tracker_config
+    from simdiff.sim.tracker import (FINISH_LATE_FOOT, FINISH_LEAD, FINISH_MOVING_KP_XY, BalanceConfig, PDTracker,
+                                     finish_tracker_config)
 
     seen = []
 
@@ -285,8 +286,10 @@ def test_the_finish_tracker_config_reaches_the_default_tracker(monkeypatch):
     assert seen[0].lead == FINISH_LEAD and seen[0].landing_sync is False  # the flight clock syncs landings
     assert seen[0].balance.moving_kp_xy == FINISH_MOVING_KP_XY == 0.0  # no position pull while moving (skids)
     assert seen[0].balance.kp_xy == 20.0 and seen[0].balance.kd_xy == BalanceConfig().kd_xy > 0
+    assert seen[0].balance.late_foot == FINISH_LATE_FOOT != "release"  # a late foot lands where it was placed
     assert seen[1].lead == 1.5 and seen[1].landing_sync is True
     assert seen[1].balance == BalanceConfig() and seen[1].balance.moving_kp_xy is None  # the augmentation's
+    assert seen[1].balance.late_foot == "release"
     assert gains and set(gains) == {20.0}  # the balance layer asks for its gain (a stand: never moving)
 
 
@@ -313,3 +316,48 @@ def test_the_balance_position_gain_fades_while_the_reference_moves():
     assert [t.kp_xy(k) for k in range(5)] == [20.0] * 5
     half = scale_balance(PDTrackerConfig(balance=BalanceConfig(moving_kp_xy=4.0)), 0.5).balance
     assert (half.kp_xy, half.moving_kp_xy) == (10.0, 2.0)
+
+
+@pytest.mark.parametrize("mode", ["release", "hold", "place"])
+def test_a_late_swing_foot_drops_holds_or_keeps_placing(mode):
+    """late_foot: the reference has the right foot down at frame 2 while the simulated one is still
+    in the air. "release" stops placing it, "hold" repeats the last capture-point shift (whatever the
+    error now), "place" goes on computing it (twice the error: twice the shift, below step_max); a
+    foot that touches the floor ends its placement."""
+    import mujoco
+
+    from simdiff.sim.humanoid import model_index
+    from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig
+
+    model = load_model()
+    ref = make_reference(model, synthetic.standing(20))
+    ref.contact = ref.contact.copy()
+    ref.contact[1, 2:] = False  # frame 1: the reference's right foot in swing
+    ref.contact[2, 2:] = True  # frame 2: down
+    data = mujoco.MjData(model)
+    data.qpos[:] = ref.qpos[0]
+    mujoco.mj_forward(model, data)
+    t = PDTracker(PDTrackerConfig(balance=BalanceConfig(late_foot=mode)))
+    t.reset(model, data, ref, model_index(model))
+    e, ev = np.array([0.05, 0.02, 0.0]), np.zeros(3)
+    swing = np.zeros(69)
+    t._place_swing_foot(data, 0, 1, e, ev, 0.9, swing)  # aims at frame 1: in swing, placed
+    assert np.abs(swing).max() > 1e-3 and np.count_nonzero(swing) == 4  # right hip xyz + knee
+    late = np.zeros(69)
+    t._place_swing_foot(data, 1, 1, 2 * e, ev, 0.9, late)  # aims at frame 2: the reference has it down
+    expected = {"release": np.zeros(69), "hold": swing, "place": 2 * swing}[mode]
+    np.testing.assert_allclose(late, expected, atol=1e-12)
+    t._balance(data, 1, np.array([True, True, True, True]), np.zeros(69))  # both feet on the floor
+    assert t.placed == [None, None]
+    after = np.zeros(69)
+    t._place_swing_foot(data, 1, 1, e, ev, 0.9, after)
+    expected = {"release": np.zeros(69), "hold": np.zeros(69), "place": swing}[mode]
+    np.testing.assert_allclose(after, expected, atol=1e-12)
+
+
+def test_late_foot_rejects_an_unknown_mode():
+    from simdiff.errors import SimdiffError
+    from simdiff.sim.tracker import BalanceConfig
+
+    with pytest.raises(SimdiffError, match="late_foot must be one of release, hold, place, got 'stay'"):
+        BalanceConfig(late_foot="stay")

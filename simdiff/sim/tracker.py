@@ -13,6 +13,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from simdiff.errors import SimdiffError
 from simdiff.motion.quaternion import cross3, quat_error, wxyz_to_xyzw
 
 from simdiff.sim.retarget.config import Reference
@@ -29,6 +30,10 @@ class Tracker(Protocol):
 
     def act(self, data, k: int) -> np.ndarray:
         """PD targets (69,) in radians held during control period k, i.e. [k·dt, (k+1)·dt)."""
+
+
+LATE_FOOT: tuple[str, ...] = ("release", "hold", "place")
+"""Choices of :attr:`BalanceConfig.late_foot`."""
 
 
 @dataclass(frozen=True)
@@ -57,6 +62,11 @@ class BalanceConfig:
             goes from ``kp_xy`` to this as the reference COM's horizontal speed rises through
             ``moving_speed`` (m/s; linear). None: ``kp_xy`` throughout.
         moving_speed: (start, full) of that blend (m/s).
+        late_foot: the placement of a swing foot that is still in the air when the reference has
+            it down (the simulation lags): ``"release"`` stops placing it (the PD pose alone brings
+            it to the reference's footprint), ``"hold"`` keeps the last placement until the
+            simulated foot touches the floor, ``"place"`` goes on placing it by the capture
+            point until then.
     """
 
     kp_xy: float = 20.0
@@ -72,6 +82,11 @@ class BalanceConfig:
     step_max: float = 0.25
     moving_kp_xy: float | None = None
     moving_speed: tuple[float, float] = (0.3, 0.6)
+    late_foot: str = "release"
+
+    def __post_init__(self) -> None:
+        if self.late_foot not in LATE_FOOT:
+            raise SimdiffError(f"late_foot must be one of {', '.join(LATE_FOOT)}, got {self.late_foot!r}")
 
 
 @dataclass(frozen=True)
@@ -135,13 +150,31 @@ R@3 within 0.02 of kp_xy 20 (the rule fixed before the val runs). Mocap (the aug
 20 throughout."""
 
 
+FINISH_LATE_FOOT: str = "place"
+"""``BalanceConfig.late_foot`` of the simulated finish: a swing foot still in the air when the generated
+motion has it down goes on being placed by the capture point until it lands. With ``"release"`` (the
+augmentation's; sessions 31–33's finish) the placement stopped the moment the reference's foot landed
+and the PD pose swung the late foot back to the reference's footprint: it came down moving backwards
+and skidded (the bench walk at Earth: the toe travelled 22 cm back in its last 5 frames of descent and
+slid 36 mm at touchdown, half of that walk's sliding).
+
+Measured (session 34). Val split, finish row, 288 × 2 (rule fixed before the runs: lowest CLoSD sliding
+among settings tracking as many and with R@3 within 0.02 of ``"release"``): release R@3 0.523, FID 24.0,
+sliding 0.58 mm/frame, 566 of 576 tracked; ``"hold"`` (repeat the last placement) 0.524, 24.3, 0.52, 565;
+``"place"`` 0.521, 24.3, 0.52, 566. On the 48 bench samples (4 bench prompts × g −9.81/−3.7 × seeds 0–5,
+``benchmarks/bench_finish.py``) place: tracked to the end 43 → 45, tracked and ≤ 0.5 mm/frame 34 → 37, the
+walks' mean sliding 0.51 → 0.31. Mocap (the augmentation) keeps ``"release"``."""
+
+
 def finish_tracker_config() -> PDTrackerConfig:
     """The default tracker's settings for the simulated finish of generated motion.
 
-    A longer lead (:data:`FINISH_LEAD`) and no horizontal position term in the balance layer while the
-    reference moves (:data:`FINISH_MOVING_KP_XY`).
+    A longer lead (:data:`FINISH_LEAD`), no horizontal position term in the balance layer while the
+    reference moves (:data:`FINISH_MOVING_KP_XY`), and a late swing foot keeps its placement until it
+    lands (:data:`FINISH_LATE_FOOT`).
     """
-    return PDTrackerConfig(lead=FINISH_LEAD, balance=replace(BalanceConfig(), moving_kp_xy=FINISH_MOVING_KP_XY))
+    balance = replace(BalanceConfig(), moving_kp_xy=FINISH_MOVING_KP_XY, late_foot=FINISH_LATE_FOOT)
+    return PDTrackerConfig(lead=FINISH_LEAD, balance=balance)
 
 
 class LandingSync:
@@ -259,6 +292,7 @@ class PDTracker:
             np.array([names.index(f"{side}_Hip_{a}") for a in "xyz"] + [names.index(f"{side}_Knee_y")])
             for side in ("L", "R")
         ]
+        self.placed: list[np.ndarray | None] = [None, None]  # last swing placement per leg (late_foot)
 
     def _contacts(self, data) -> np.ndarray:
         """(4,) whether each foot box (LF, LT, RF, RT) touches the floor now."""
@@ -311,6 +345,8 @@ class PDTracker:
         """Add the stance-leg balance torques and the swing-foot placement to ``target``."""
         mj, b, ix = self.mj, self.cfg.balance, self.ix
         legs = [s for s in (0, 1) if on[2 * s] or on[2 * s + 1]]
+        for s in legs:
+            self.placed[s] = None  # a foot on the floor has landed: its placement is over
         if not legs:
             return
         mj.mj_subtreeVel(self.model, data)
@@ -374,16 +410,27 @@ class PDTracker:
 
     def _place_swing_foot(self, data, k: int, s: int, e: np.ndarray, ev: np.ndarray, h: float,
                           target: np.ndarray) -> None:
-        """Shift the swing foot of leg ``s`` by the capture-point error (capture-point stepping)."""
+        """Shift the swing foot of leg ``s`` by the capture-point error (capture-point stepping).
+
+        Once the reference has that foot down while the simulated one is still in the air, what
+        happens follows :attr:`BalanceConfig.late_foot`.
+        """
         b = self.cfg.balance
         kn = min(k + 1, self.ref.num_frames - 1)
-        if self.ref.contact[kn, 2 * s] or self.ref.contact[kn, 2 * s + 1]:
-            return  # the reference has this foot down: nothing to place
-        w0 = np.sqrt(abs(self.model.opt.gravity[2]) / max(h, 0.3))
-        delta = -b.step_gain * (e[:2] + ev[:2] / w0)
-        n = np.linalg.norm(delta)
-        if n > b.step_max:
-            delta *= b.step_max / n
+        late = bool(self.ref.contact[kn, 2 * s] or self.ref.contact[kn, 2 * s + 1])  # the reference has it down
+        if late and b.late_foot == "release":
+            return
+        if late and b.late_foot == "hold":
+            delta = self.placed[s]
+            if delta is None:
+                return  # never placed in this swing
+        else:
+            w0 = np.sqrt(abs(self.model.opt.gravity[2]) / max(h, 0.3))
+            delta = -b.step_gain * (e[:2] + ev[:2] / w0)
+            n = np.linalg.norm(delta)
+            if n > b.step_max:
+                delta *= b.step_max / n
+            self.placed[s] = delta
         self.mj.mj_jacBody(self.model, data, self.jacp, None, self.foot_body[s])
         dofs = self.swing_dofs[s]
         J = self.jacp[:2, 6 + dofs]
