@@ -47,3 +47,5 @@ def test_a_kept_sample_is_finished_without_generating_again(bench, tmp_path: Pat
         bench.main(["--moving-kp-xy", "nan", "--work", str(work)])
     with pytest.raises(SystemExit):
         bench.main(["--late-foot", "stay", "--work", str(work)])
+    with pytest.raises(SystemExit):
+        bench.main(["--moving-rot-scale", "1.5", "--work", str(work)])

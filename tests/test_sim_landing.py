@@ -263,12 +263,12 @@ def test_the_finish_tracker_config_reaches_the_default_tracker(monkeypatch):
     import simdiff.sim.rollout as rollout_module
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
-    from simdiff.sim.tracker import (FINISH_LATE_FOOT, FINISH_LEAD, FINISH_MOVING_KP_XY, BalanceConfig, PDTracker,
-                                     finish_tracker_config)
+    from simdiff.sim.tracker import (FINISH_LATE_FOOT, FINISH_LEAD, FINISH_MOVING_KP_XY, FINISH_MOVING_ROT_SCALE,
+                                     BalanceConfig, PDTracker, finish_tracker_config)
 
     seen = []
 
-    gains = []
+    gains, scales = [], []
 
     class Recording(PDTracker):
         def __init__(self, config):
@@ -279,6 +279,10 @@ def test_the_finish_tracker_config_reaches_the_default_tracker(monkeypatch):
             gains.append(super().kp_xy(k))
             return gains[-1]
 
+        def rot_scale(self, k):
+            scales.append(super().rot_scale(k))
+            return scales[-1]
+
     monkeypatch.setattr(rollout_module, "PDTracker", Recording)
     stand = synthetic.standing(12)
     project(stand, Environment(), tracker_config=finish_tracker_config(), flight=FlightConfig())
@@ -287,10 +291,12 @@ def test_the_finish_tracker_config_reaches_the_default_tracker(monkeypatch):
     assert seen[0].balance.moving_kp_xy == FINISH_MOVING_KP_XY == 0.0  # no position pull while moving (skids)
     assert seen[0].balance.kp_xy == 20.0 and seen[0].balance.kd_xy == BalanceConfig().kd_xy > 0
     assert seen[0].balance.late_foot == FINISH_LATE_FOOT != "release"  # a late foot lands where it was placed
+    assert seen[0].balance.moving_rot_scale == FINISH_MOVING_ROT_SCALE  # (None: full gains; measured, not adopted)
     assert seen[1].lead == 1.5 and seen[1].landing_sync is True
     assert seen[1].balance == BalanceConfig() and seen[1].balance.moving_kp_xy is None  # the augmentation's
-    assert seen[1].balance.late_foot == "release"
+    assert seen[1].balance.late_foot == "release" and seen[1].balance.moving_rot_scale is None
     assert gains and set(gains) == {20.0}  # the balance layer asks for its gain (a stand: never moving)
+    assert scales and set(scales) == {1.0}  # and for its orientation-gain factor (full gains when standing)
 
 
 def test_the_balance_position_gain_fades_while_the_reference_moves():
@@ -316,6 +322,56 @@ def test_the_balance_position_gain_fades_while_the_reference_moves():
     assert [t.kp_xy(k) for k in range(5)] == [20.0] * 5
     half = scale_balance(PDTrackerConfig(balance=BalanceConfig(moving_kp_xy=4.0)), 0.5).balance
     assert (half.kp_xy, half.moving_kp_xy) == (10.0, 2.0)
+
+
+def test_the_pelvis_orientation_gains_soften_while_the_reference_moves():
+    """moving_rot_scale: factor 1 below moving_speed[0], the setting above moving_speed[1], linear between;
+    the torque the balance layer asks of the stance legs scales with it; out-of-range values are refused."""
+    from types import SimpleNamespace
+
+    from simdiff.errors import SimdiffError
+    from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig
+
+    vel = np.zeros((5, 3))
+    vel[:, 1] = [0.0, 0.3, 0.45, 0.6, 2.0]
+    ref = SimpleNamespace(com_vel=vel)
+    t = PDTracker(PDTrackerConfig(balance=BalanceConfig(moving_rot_scale=0.4)))
+    t.ref = ref
+    np.testing.assert_allclose([t.rot_scale(k) for k in range(5)], [1.0, 1.0, 0.7, 0.4, 0.4], atol=1e-12)
+    t = PDTracker(PDTrackerConfig())  # the augmentation's: full gains throughout
+    t.ref = ref
+    assert [t.rot_scale(k) for k in range(5)] == [1.0] * 5
+    for bad in (-0.1, 1.5, float("nan")):
+        with pytest.raises(SimdiffError, match="moving_rot_scale must be in"):
+            BalanceConfig(moving_rot_scale=bad)
+
+
+def test_the_orientation_factor_scales_the_stance_torque():
+    """A slightly tilted pelvis on a standing reference: the stance-leg torque the balance layer adds for
+    the orientation error scales with rot_scale (the COM terms held at zero; the tilt small enough that
+    the feet's centre-of-pressure bounds do not clip the moment)."""
+    import mujoco
+
+    from simdiff.sim.humanoid import model_index
+    from simdiff.sim.tracker import BalanceConfig, PDTracker, PDTrackerConfig
+
+    model = load_model()
+    ref = make_reference(model, synthetic.standing(20))
+    data = mujoco.MjData(model)
+    data.qpos[:] = ref.qpos[0]
+    data.qpos[3:7] = [np.cos(0.005), np.sin(0.005), 0.0, 0.0]  # 0.01 rad roll
+    mujoco.mj_forward(model, data)
+    cfg = BalanceConfig(kp_xy=0.0, kd_xy=0.0, kp_z=0.0, kd_z=0.0, kd_rot=0.0, step_gain=0.0)
+    t = PDTracker(PDTrackerConfig(balance=cfg))
+    t.reset(model, data, ref, model_index(model))
+    on = np.ones(4, dtype=bool)
+    full = np.zeros(69)
+    t._balance(data, 5, on, full)
+    t.rot_scale = lambda k: 0.5
+    half = np.zeros(69)
+    t._balance(data, 5, on, half)
+    assert np.abs(full).max() > 1e-4
+    np.testing.assert_allclose(half, 0.5 * full, atol=1e-12)
 
 
 @pytest.mark.parametrize("mode", ["release", "hold", "place"])
