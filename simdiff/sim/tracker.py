@@ -164,8 +164,9 @@ prompts: on the 48 bench samples (4 bench prompts × g −9.81/−3.7 × seeds 0
 37 → 42 (seeds 0–2, where it was chosen among 0 / 0.3 / 0.5 / 0.7: 16 → 19; seeds 3–5: 21 → 23), and
 every seed-0 sample ≤ 0.5. On the val split's finish row (288 × 2) it did not: sliding 0.519 → 0.513
 (0.3: 0.525), R@3 0.521 → 0.524, 566 → 565 tracked; the rule fixed before those runs (track at least as
-many, R@3 within 0.02, then lowest sliding) keeps the full gains. ``benchmarks/bench_finish.py
---moving-rot-scale`` measures it."""
+many, R@3 within 0.02, then lowest sliding) keeps the full gains, and a paired re-test declared before
+its runs (val, 288 × 5, the same generated motions) found no effect: sliding +0.000 ± 0.012 mm/frame.
+``benchmarks/bench_finish.py --moving-rot-scale`` measures it."""
 
 FINISH_LATE_FOOT: str = "place"
 """``BalanceConfig.late_foot`` of the simulated finish: a swing foot still in the air when the generated
