@@ -15,8 +15,8 @@ tracked to the end, how many slide ≤ 0.5 mm/frame (issue 15's bar), and the me
 tracked to the end. ``--no-lift`` (no swing-foot clearance), ``--lead`` (the tracker's lead) and
 ``--moving-kp-xy`` (the balance layer's horizontal position gain while the motion moves), ``--late-foot``
 (the placement of a swing foot that lands after the reference's) and ``--moving-rot-scale`` (the factor on
-the pelvis-orientation gains while the motion moves) measure other finish settings on the same samples. The experiments README's 48-sample table is this benchmark's default run (4 prompts × 2 g ×
-seeds 0–5).
+the pelvis-orientation gains while the motion moves) measure other finish settings on the same samples.
+The experiments README's 48-sample table is this benchmark's default run (4 prompts × 2 g × seeds 0–5).
 """
 
 from __future__ import annotations
@@ -137,8 +137,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         args.json.write_text(json.dumps({"rows": rows, "summary": summary, "seeds": args.seeds, "length_s": args.length,
                                          "no_lift": args.no_lift, "lead": args.lead, "moving_kp_xy": args.moving_kp_xy,
-                                         "late_foot": args.late_foot, "moving_rot_scale": args.moving_rot_scale, "machine": platform.platform(),
-                                         "cpus": os.cpu_count()}, indent=1))
+                                         "late_foot": args.late_foot, "moving_rot_scale": args.moving_rot_scale,
+                                         "machine": platform.platform(), "cpus": os.cpu_count()}, indent=1))
     return 0
 
 
