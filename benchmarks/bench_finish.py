@@ -62,7 +62,7 @@ def apply_settings(args: argparse.Namespace) -> None:
     if args.late_foot is not None:
         tracker.FINISH_LATE_FOOT = args.late_foot
     if args.moving_rot_scale is not None:
-        tracker.FINISH_MOVING_ROT_SCALE = None if args.moving_rot_scale == 1.0 else args.moving_rot_scale
+        tracker.FINISH_MOVING_ROT_SCALE = args.moving_rot_scale
 
 
 def finish_one(joints: Path, gravity: float) -> dict:
@@ -92,6 +92,8 @@ def summarize(rows: list[dict]) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from simdiff.sim.tracker import LATE_FOOT
+
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--model", default=None, help="model folder (default: the shipped default model)")
     ap.add_argument("--prompts", nargs="+", default=PROMPTS)
@@ -104,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--moving-kp-xy", type=float, default=None,
                     help="the finish balance layer's horizontal position gain while the motion moves, 1/s² "
                          "(default: shipped, 0; 20 = as when standing, session 32's finish)")
-    ap.add_argument("--late-foot", choices=["release", "hold", "place"], default=None,
+    ap.add_argument("--late-foot", choices=LATE_FOOT, default=None,
                     help="the finish tracker's placement of a swing foot that lands after the reference's "
                          "(default: shipped; release = sessions 31–33's finish)")
     ap.add_argument("--moving-rot-scale", type=float, default=None,
