@@ -12,7 +12,8 @@ back to back; ``--repeats R`` pairs, medians compared), and times both from outs
 in a worker process started before the model (:mod:`simdiff.product.finisher`; on a thread on a
 one-CPU machine; ``--compare-in-process`` also times that, with ``SIMDIFF_FINISH_WORKERS=0``), so the ``simulate`` stage of ``generation.json`` alone would misstate the cost
 (and the CPU the worker adds); it is reported beside it. From
-``sample0_tracking.json``: tracked or fell, and the sliding of the generated and the simulated
+``sample0_tracking.json``: tracked or fell, whether a second try was made (``attempts``) and kept
+(``fallback``; :mod:`simdiff.sim.fallback`), and the sliding of the generated and the simulated
 motion (mm/frame; CLoSD's definition, which counts only feet within 5 mm of y = 0, and on the
 generated motion's own floor, :func:`simdiff.motion.metrics.own_floor_metrics`, which a hovering
 sample cannot dodge). Targets (issue 15): ``--simulate`` adds ≤ 2 s per 6-s motion on 2 cores and
@@ -83,7 +84,8 @@ def run_one(prompt: str, gravity: float, args: argparse.Namespace, out: Path) ->
     own = {k: own_floor_metrics(np.load(out / "sim" / f"sample0_{k}joints.npy"))["sliding_own_floor"]
            for k in ("", "simulated_")}
     return {"prompt": prompt, "gravity": gravity, "status": track["status"], "frames_out": track.get("n_out"),
-            "fall_frame": track.get("fall_frame"),
+            "fall_frame": track.get("fall_frame"), "attempts": track.get("attempts", 1),
+            "fallback": bool(track.get("fallback", False)),
             "added_wall_s": sim_wall - plain_wall, "added_cpu_s": sim_cpu - plain_cpu,
             "plain_wall_s": plain_wall, "simulate_stage_wall_s": meta["timings_s"]["simulate"],
             "simulate_stage_cpu_s": meta["cpu_s"]["simulate"], "sample_wall_s": meta["timings_s"]["sample"],
@@ -108,6 +110,7 @@ def summarize(rows: list[dict]) -> dict:
             f"sliding_within_{TARGET_SLIDING:g}": sum(s <= TARGET_SLIDING for s in slides),
             "sliding_simulated_max": max(slides) if slides else None,
             "tracked": sum(r["status"] == "ok" for r in rows),
+            "second_tries": sum(r.get("attempts", 1) > 1 for r in rows), "fallback_kept": sum(bool(r.get("fallback")) for r in rows),
             **({"added_wall_s_in_process_median": statistics.median(r["added_wall_s_in_process"] for r in rows),
                 f"added_within_{TARGET_S:g}_s_in_process": sum(r["added_wall_s_in_process"] <= TARGET_S for r in rows)}
                if rows and "added_wall_s_in_process" in rows[0] else {})}
@@ -137,7 +140,9 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"{prompt!r:30} g={g:6.2f}  {r['status']:4} {r['frames_out']:4} frames  adds {r['added_wall_s']:.2f} s "
                       f"wall / {r['added_cpu_s']:.2f} s CPU{here_note(r)} (stage {r['simulate_stage_wall_s']:.2f} s; without: "
                       f"{r['plain_wall_s']:.2f} s)  sliding {slide} (own floor {r['sliding_own_floor_generated']:.2f} → "
-                      f"{r['sliding_own_floor_simulated']:.2f}) mm/frame", flush=True)
+                      f"{r['sliding_own_floor_simulated']:.2f}) mm/frame"
+                      f"{'' if r['attempts'] == 1 else '  (second try' + (' kept)' if r['fallback'] else ' not kept)')}",
+                      flush=True)
     summary = summarize(rows)
     print(json.dumps(summary, indent=1))
     if args.json:

@@ -130,4 +130,5 @@ def test_hook_keeps_prediction_beyond_a_fall() -> None:
     out = hook(x0, 0, x0)
     assert torch.equal(out[0, 5:], x0[0, 5:])
     assert not torch.equal(out[0, :5], x0[0, :5])
-    assert hook.log[0]["samples"][0] == {"success": False, "frames_replaced": 5, "error": None}
+    assert hook.log[0]["samples"][0] == {"success": False, "frames_replaced": 5, "attempts": 1, "fallback": False,
+                                         "error": None}

@@ -419,12 +419,14 @@ def test_simulated_finish_rows_in_table1_and_fig4(setup: dict[str, Path]) -> Non
     sizes = [n for frames, _ in sim.calls for n in [len(frames)]]
     falls = sum(len(range(0, n, 4)) for n in sizes)
     assert row["finish"] == {"motions": sum(sizes), "tracked": sum(sizes) - falls,
-                             "tracked_frac": pytest.approx((sum(sizes) - falls) / sum(sizes))}
+                             "tracked_frac": pytest.approx((sum(sizes) - falls) / sum(sizes)),
+                             "second_tries": falls, "fallback_kept": 0}
     # one re-tracking per generated batch: 2 replications × 1 batch + 2 MultiModality prompts each, under Earth
     assert len(sim.calls) == 2 * (1 + 2) and {e for _, envs in sim.calls for e in envs} == {(-9.81, 0.0, 0.0)}
     md = (setup["root"] / "reports/t1_sim/report.md").read_text()
     assert "SimDiff + simulated finish" in md and "Student-t" in md and "|floating − ground truth's floating|" in md
     assert f"the simulator tracked {sum(sizes) - falls} of {sum(sizes)} final samples to the end" in md
+    assert f"{falls} had a second try under the slip guard" in md
     timing = {"text": "a person jumps", "length": 24, "repeats": 2, "ddpm_repeats": 1, "warmup": 0}
     fig = run_experiment(write(setup, "fig4", name="f4_sim", samplers=["ddim"], timing=timing,
                                models=[{"name": "MDM", "model": "backbone", **FAST}, finish]),

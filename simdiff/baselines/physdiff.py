@@ -108,7 +108,8 @@ class ProjectionHook:
         projector: ``(joints list, env list) -> iterable of (rollout | None, info)``.
         refloor: see :class:`PhysDiffConfig`.
     Attributes:
-        log: one entry per projection call: t, per-sample success/frames, wall seconds.
+        log: one entry per projection call: t, per-sample success/frames/rollouts simulated/whether the
+            fallback's rollout was kept (:mod:`simdiff.sim.fallback`), wall seconds.
     """
 
     normalizer: Normalizer
@@ -140,8 +141,11 @@ class ProjectionHook:
                 n_rows = min(len(feats), int(self.lengths[i]))
                 sub = self.normalizer.normalize(torch.from_numpy(feats[:n_rows]))
                 out[i, :n_rows] = sub.to(out.device, out.dtype)
-            success = bool(info.get("success") if isinstance(info, dict) else getattr(info, "success", False))
-            entries.append({"success": success, "frames_replaced": n_rows,
+            def got(name: str, default: Any, info: Any = info) -> Any:
+                return info.get(name, default) if isinstance(info, dict) else getattr(info, name, default)
+
+            entries.append({"success": bool(got("success", False)), "frames_replaced": n_rows,
+                            "attempts": int(got("attempts", 1)), "fallback": bool(got("fallback", False)),
                             "error": info if isinstance(info, str) else None})
         self.log.append({"t": int(t), "samples": entries, "wall_s": time.perf_counter() - start})
         return out

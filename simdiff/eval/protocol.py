@@ -246,16 +246,20 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
 
 
 def finish_summary(log: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """How many of the finished samples of a :func:`generator_fn` ``finish_log`` tracked to the end."""
+    """How many of the finished samples of a :func:`generator_fn` ``finish_log`` tracked to the end, had a
+    second try (:mod:`simdiff.sim.fallback`) and kept its rollout."""
     tracked = sum(bool(e["success"]) for e in log)
-    return {"motions": len(log), "tracked": tracked, "tracked_frac": tracked / max(1, len(log))}
+    return {"motions": len(log), "tracked": tracked, "tracked_frac": tracked / max(1, len(log)),
+            "second_tries": sum(int(e.get("attempts", 1)) > 1 for e in log),
+            "fallback_kept": sum(bool(e.get("fallback", False)) for e in log)}
 
 
 def simulated_finish(generator: Any, features: Tensor, lengths: Sequence[int], env: Sequence[float] | None,
                      projector: Any, log: list[dict[str, Any]] | None = None) -> Tensor:
     """(B, T, 263) raw features → the same with each motion replaced by its re-tracked rollout under φ.
 
-    ``log``, when given, gets one entry per motion: ``success`` (tracked to the end) and ``frames_replaced``.
+    ``log``, when given, gets one entry per motion: ``success`` (tracked to the end), ``frames_replaced``,
+    ``attempts`` (rollouts simulated) and ``fallback`` (the second try's rollout was kept).
     """
     from simdiff.baselines.physdiff import ProjectionHook
     from simdiff.motion.normalize import Normalizer
@@ -269,6 +273,7 @@ def simulated_finish(generator: Any, features: Tensor, lengths: Sequence[int], e
     x0 = norm.normalize(features.float())
     out = norm.denormalize(hook(x0, 0, x0))
     if log is not None:
-        log.extend({"success": e["success"], "frames_replaced": e["frames_replaced"]} for e in hook.log[-1]["samples"])
+        log.extend({"success": e["success"], "frames_replaced": e["frames_replaced"], "attempts": e["attempts"],
+                    "fallback": e["fallback"]} for e in hook.log[-1]["samples"])
     mask = (torch.arange(out.shape[1])[None, :] < torch.as_tensor([int(n) for n in lengths])[:, None]).to(out.dtype)
     return out * mask[..., None]

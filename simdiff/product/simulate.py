@@ -89,9 +89,12 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
         anchor_stance: the finish's retargeting (:func:`simdiff.sim.retarget.finish_retarget`):
             planted feet stay where they touched down, the body's skating drift taken out of the
             reference before tracking, and fast swing feet lifted clear of the floor; and the
-            finish's tracker lead (:func:`simdiff.sim.tracker.finish_tracker_config`). False: the
-            augmentation's plain retargeting and tracker.
+            finish's tracker (:func:`simdiff.sim.tracker.finish_tracker_config`), with a second try
+            under the slip guard when the rollout fell or slid more than 0.5 mm/frame
+            (:func:`simdiff.sim.fallback.finish_fallback`). False: the augmentation's plain
+            retargeting and tracker, one try.
     """
+    from simdiff.sim.fallback import finish_fallback
     from simdiff.sim.flight import FlightConfig
     from simdiff.sim.project import project
     from simdiff.sim.residual import ResidualConfig
@@ -107,7 +110,8 @@ def simulate_finish(joints: np.ndarray, env: Environment | None, *, normalizer: 
     out, info = project(arr, phi, residual=ResidualConfig(max_force=max_force), normalizer=normalizer, force=force,
                         flight=FlightConfig() if follow_flights else None,
                         retarget=finish_retarget(anchor_stance),
-                        tracker_config=finish_tracker_config() if anchor_stance else None)
+                        tracker_config=finish_tracker_config() if anchor_stance else None,
+                        fallback=finish_fallback() if anchor_stance else None)
     wall = time.perf_counter() - start
     out = np.asarray(out, dtype=np.float32)
     tracking = info.to_dict()

@@ -26,6 +26,7 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.sim.retarget.config import RetargetConfig
 from simdiff.sim.env import Environment
+from simdiff.sim.fallback import FallbackConfig
 from simdiff.sim.flight import FlightConfig
 from simdiff.sim.project import ProjectionInfo, project
 from simdiff.sim.residual import ResidualConfig
@@ -47,6 +48,7 @@ class PoolConfig:
         flight: the flight clock passed to :func:`project` (None: the reference's own clock).
         retime: the weak-gravity second try passed to :func:`project` (None: one try).
         tracker_config: the default tracker's settings passed to :func:`project` (None: its defaults).
+        fallback: the second try with other tracker settings passed to :func:`project` (None: none).
     """
 
     workers: int = 0
@@ -60,6 +62,7 @@ class PoolConfig:
     flight: FlightConfig | None = None
     retime: RetimeConfig | None = None
     tracker_config: PDTrackerConfig | None = None
+    fallback: FallbackConfig | None = None
 
 
 Result = tuple[np.ndarray | None, Any]
@@ -132,7 +135,7 @@ def _run_one(args: tuple[np.ndarray, tuple[float, float, float], PoolConfig]) ->
         return project(
             joints, Environment(*phi), residual=cfg.residual, retarget=cfg.retarget,
             normalizer=_normalizer(cfg.stats_dir), force=cfg.force, flight=cfg.flight, retime=cfg.retime,
-            tracker_config=cfg.tracker_config,
+            tracker_config=cfg.tracker_config, fallback=cfg.fallback,
         )
     except Exception as exc:  # one bad motion must not stop the batch
         return None, f"{type(exc).__name__}: {exc}"

@@ -18,6 +18,7 @@ import numpy as np
 
 from simdiff.sim.retarget import RetargetConfig, make_reference, qpos_to_world
 from simdiff.sim.env import Environment
+from simdiff.sim.fallback import FallbackConfig, better_rollout, rollout_sliding
 from simdiff.sim.faithfulness import feature_distance, normalized_features, pose_feature_mask
 from simdiff.sim.flight import FlightConfig, aligned_source
 from simdiff.sim.humanoid import TOE_JOINT_HEIGHT, HumanoidConfig, load_model, model_index, world_to_hml
@@ -62,8 +63,9 @@ class ProjectionInfo:
         time_warp: rollout length / source length (1 without a flight clock).
         retime_scale: slow-down of the source this rollout tracked (1: as given; > 1: the
             second, dynamically similar try of :mod:`simdiff.sim.retime`).
-        attempts: rollouts simulated (2 when a re-timed try was made, whichever was kept);
-            ``cpu_s`` and ``sim_cpu_s`` count both.
+        attempts: rollouts simulated (2 when a re-timed or a fallback try was made, 3 with both;
+            whichever was kept); ``cpu_s`` and ``sim_cpu_s`` count them all.
+        fallback: the rollout returned is the fallback tracker's (:mod:`simdiff.sim.fallback`).
     """
 
     success: bool
@@ -85,6 +87,7 @@ class ProjectionInfo:
     time_warp: float = 1.0
     retime_scale: float = 1.0
     attempts: int = 1
+    fallback: bool = False
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -133,6 +136,7 @@ def project(
     strength: StrengthConfig | None = StrengthConfig(),
     retime: RetimeConfig | None = None,
     tracker_config: PDTrackerConfig | None = None,
+    fallback: FallbackConfig | None = None,
 ) -> tuple[np.ndarray, ProjectionInfo]:
     """P_φ,π(τ): replay ``joints`` in MuJoCo under ``env`` and return the rollout.
 
@@ -153,6 +157,9 @@ def project(
             better rollout (:mod:`simdiff.sim.retime`); None (default): one try.
         tracker_config: settings of the default tracker (None: the default's; the simulated
             finish's: :func:`simdiff.sim.tracker.finish_tracker_config`).
+        fallback: when the rollout kept so far fell or its feet slid, a second rollout of the
+            motion as given with other tracker settings, and the better of the two is kept
+            (:mod:`simdiff.sim.fallback`; None, the default: no second try).
     Returns:
         (rollout joints (T', 22, 3) float32, :class:`ProjectionInfo`).
     """
@@ -163,16 +170,26 @@ def project(
               audit=audit, flight=flight, strength=strength, tracker_config=tracker_config)
     out, info = _project_once(joints, env, **kw)
     scale = 1.0 if retime is None else retime.scale(env.gravity)
-    if scale == 1.0 or not retime.should_retry(info.status, info.d_l2_pose):
+    if scale != 1.0 and retime.should_retry(info.status, info.d_l2_pose):
+        out2, info2 = _project_once(stretch(joints, scale).astype(np.float64), env, **kw)
+        cpu, sim_cpu = info.cpu_s + info2.cpu_s, info.sim_cpu_s + info2.sim_cpu_s
+        if better((info.status, info.d_l2_pose), (info2.status, info2.d_l2_pose)):
+            out, info = out2, info2
+            info.n_frames = int(joints.shape[0])
+            info.time_warp = float(info.n_out / max(joints.shape[0], 1))
+            info.retime_scale = float(scale)
+        info.cpu_s, info.sim_cpu_s, info.attempts = cpu, sim_cpu, 2
+    if fallback is None:
         return out, info
-    out2, info2 = _project_once(stretch(joints, scale).astype(np.float64), env, **kw)
-    cpu, sim_cpu = info.cpu_s + info2.cpu_s, info.sim_cpu_s + info2.sim_cpu_s
-    if better((info.status, info.d_l2_pose), (info2.status, info2.d_l2_pose)):
+    sliding = rollout_sliding(out)
+    if not fallback.should_retry(info.status, sliding):
+        return out, info
+    out2, info2 = _project_once(joints, env, **{**kw, "tracker_config": fallback.tracker_config})
+    cpu, sim_cpu, attempts = info.cpu_s + info2.cpu_s, info.sim_cpu_s + info2.sim_cpu_s, info.attempts + 1
+    if better_rollout((info.status, sliding), (info2.status, rollout_sliding(out2))):
         out, info = out2, info2
-        info.n_frames = int(joints.shape[0])
-        info.time_warp = float(info.n_out / max(joints.shape[0], 1))
-        info.retime_scale = float(scale)
-    info.cpu_s, info.sim_cpu_s, info.attempts = cpu, sim_cpu, 2
+        info.fallback = True
+    info.cpu_s, info.sim_cpu_s, info.attempts = cpu, sim_cpu, attempts
     return out, info
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simdiff.sim.env import Environment
+from simdiff.sim.fallback import finish_fallback
 from simdiff.sim.flight import FlightConfig
 from simdiff.sim.pool import PoolConfig, ProjectionPool, Projector, Result
 from simdiff.sim.residual import ResidualConfig
@@ -39,8 +40,9 @@ class SimProjector:
             default); None: one try (PhysDiff, the evaluation's re-tracking).
         anchor_stance: the simulated finish's retargeting and tracker
             (:func:`simdiff.sim.retarget.finish_retarget`: planted feet stay put, swing feet clear the
-            floor; :func:`simdiff.sim.tracker.finish_tracker_config`: a longer lead); off for
-            augmentation and PhysDiff.
+            floor; :func:`simdiff.sim.tracker.finish_tracker_config`: a longer lead; a second try with
+            the slip guard when the rollout fell or slid, :func:`simdiff.sim.fallback.finish_fallback`);
+            off for augmentation and PhysDiff.
     Raises:
         SimdiffError: an unknown backend.
     """
@@ -58,7 +60,8 @@ class SimProjector:
                                                residual=ResidualConfig(max_force=self.max_force), flight=self.flight,
                                                retime=self.retime,
                                                retarget=finish_retarget(self.anchor_stance),
-                                               tracker_config=finish_tracker_config() if self.anchor_stance else None))
+                                               tracker_config=finish_tracker_config() if self.anchor_stance else None,
+                                               fallback=finish_fallback() if self.anchor_stance else None))
 
     def __call__(self, motions: Sequence[np.ndarray], envs: Sequence[Environment]) -> Iterator[Result]:
         return self._pool.imap(motions, envs)

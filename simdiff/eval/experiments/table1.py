@@ -104,8 +104,11 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     for row in report["rows"]:
         if row.get("finish"):
             f = row["finish"]
+            second = (f"; {f['second_tries']} had a second try under the slip guard (fell or slid > 0.5 mm/frame), "
+                      f"whose rollout was kept for {f['fallback_kept']}") if "second_tries" in f else ""
             lines.append(f"* {row['method']} {row['sampler'].upper()}: the simulator tracked {f['tracked']} of {f['motions']} "
-                         f"final samples to the end ({100 * f['tracked_frac']:.0f} %); after a fall the generated frames stay")
+                         f"final samples to the end ({100 * f['tracked_frac']:.0f} %){second}; after a fall the generated "
+                         f"frames stay")
     lines.append("* s/motion: generation time per motion in the protocol's batches of 32 (PhysDiff: with projection); "
                  "see fig4 for batch-1 latency")
     lines += speed_comparison(report["rows"], "s_per_motion")

@@ -21,7 +21,8 @@ class EchoProjector:
     """A fake simulator: returns each motion unchanged.
 
     Args:
-        fail_every: every k-th motion of a call (k ≥ 1) is reported as a fall (0: never).
+        fail_every: every k-th motion of a call (k ≥ 1) is reported as a fall (0: never), after a second
+            try (``attempts`` 2) whose rollout was not kept.
     Attributes:
         calls: one ``(frames per motion, φ per motion)`` entry per call.
     """
@@ -35,7 +36,7 @@ class EchoProjector:
         for i, m in enumerate(motions):
             ok = not (self.fail_every and i % self.fail_every == 0)
             yield np.asarray(m, dtype=np.float32), {"success": ok, "status": "ok" if ok else "fell", "d_l2": float(i),
-                                                    "err_mm": 10.0 * i}
+                                                    "err_mm": 10.0 * i, "attempts": 1 if ok else 2, "fallback": False}
 
 
 def write_tiny_setup(root: str | Path, n_test: int = 16, frames: int = 44, seed: int = 0) -> dict[str, Path]:

@@ -16,14 +16,15 @@ from simdiff.sim.retarget.ik import IKTask
 from simdiff.sim.retarget.kinematics import box_bottom_corners, foot_geoms
 
 
-ANCHOR_VERSION: int = 6
+ANCHOR_VERSION: int = 7
 """Version of the simulated finish's retargeting rules (``RetargetConfig.anchor_stance`` and
 ``swing_clearance``), recorded with simulated finishes and in the experiments' row inputs: 1 planted
 feet only, 2 also the lowest foot where every foot on the floor glides (:func:`skating_support`),
 3 also swing feet lifted clear of the floor (:func:`swing_lift`, :data:`~simdiff.sim.retarget.config.FINISH_SWING_CLEARANCE`),
 4 also the tracker's longer lead (:data:`simdiff.sim.tracker.FINISH_LEAD`), 5 also no horizontal
 position term in the tracker's balance layer while the reference moves (:data:`simdiff.sim.tracker.FINISH_MOVING_KP_XY`),
-6 also a swing foot that lands after the reference's keeps its placement (:data:`simdiff.sim.tracker.FINISH_LATE_FOOT`)."""
+6 also a swing foot that lands after the reference's keeps its placement (:data:`simdiff.sim.tracker.FINISH_LATE_FOOT`),
+7 also a second try under the slip guard when the rollout fell or slid (:func:`simdiff.sim.fallback.finish_fallback`)."""
 
 
 def _box_speed(xy: np.ndarray, fps: float) -> np.ndarray:
