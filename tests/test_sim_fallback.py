@@ -53,7 +53,8 @@ def test_the_finish_fallback_is_the_finish_tracker_with_the_slip_guard(monkeypat
     from dataclasses import replace
 
     import simdiff.sim.fallback as fallback
-    from simdiff.sim.tracker import FINISH_SLIP_GUARD, finish_tracker_config
+    from simdiff.sim.slip_guard import FINISH_SLIP_GUARD
+    from simdiff.sim.tracker import finish_tracker_config
 
     f = fallback.finish_fallback()
     assert f.tracker_config == replace(finish_tracker_config(), slip_guard=FINISH_SLIP_GUARD)

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from simdiff.errors import SimdiffError
-from simdiff.sim.tracker import FINISH_SLIP_GUARD, PDTrackerConfig, finish_tracker_config
+from simdiff.sim.slip_guard import FINISH_SLIP_GUARD
+from simdiff.sim.tracker import PDTrackerConfig, finish_tracker_config
 
 
 @dataclass(frozen=True)
@@ -74,7 +75,7 @@ finish's output; a rollout at or below it is kept without a second try."""
 
 def finish_fallback() -> FallbackConfig | None:
     """The simulated finish's second try: the finish's tracker with the slip guard
-    (:data:`simdiff.sim.tracker.FINISH_SLIP_GUARD`), when the first rollout fell or slid more than
+    (:data:`simdiff.sim.slip_guard.FINISH_SLIP_GUARD`), when the first rollout fell or slid more than
     :data:`FINISH_FALLBACK_SLIDING`; None when :data:`FINISH_FALLBACK` is off."""
     if not FINISH_FALLBACK:
         return None

@@ -19,6 +19,7 @@ from simdiff.motion.quaternion import cross3, quat_error, wxyz_to_xyzw
 from simdiff.sim.retarget.config import Reference
 from simdiff.sim.retarget.kinematics import foot_geoms
 from simdiff.sim.humanoid import ModelIndex
+from simdiff.sim.slip_guard import SlipGuardConfig, stance_forces
 
 
 @runtime_checkable
@@ -93,40 +94,6 @@ class BalanceConfig:
             raise SimdiffError(f"moving_rot_scale must be in [0, 1], got {self.moving_rot_scale}")
         if self.late_foot not in LATE_FOOT:
             raise SimdiffError(f"late_foot must be one of {', '.join(LATE_FOOT)}, got {self.late_foot!r}")
-
-
-@dataclass(frozen=True)
-class SlipGuardConfig:
-    """Give up swing speed to keep the stance foot where it is.
-
-    With one foot on the floor, the floor force on it is the body's momentum change; a swing leg
-    whipped forward fast can ask for more horizontal force than friction gives (``|F_t| > μ·F_n``)
-    and the stance foot slides. When the stance foot's force ratio ``|F_t| / F_n`` (summed over its
-    contacts, as the solver found them in the last physics step) passes ``start·μ``, the swing
-    leg's hip and knee targets are pulled toward their current angles: the PD pull that is left is
-    ``λ = 1 − (r − start·μ) / ((1 − start)·μ)``, at least ``floor`` (μ: the contact's friction
-    coefficient). Damping is untouched, so the swing slows.
-
-    Attributes:
-        start: fraction of μ at which the guard begins, in [0, 1).
-        floor: smallest fraction of the swing leg's PD pull kept (reached at ``r = μ``), in [0, 1].
-    """
-
-    start: float = 0.5
-    floor: float = 0.0
-
-    def __post_init__(self) -> None:
-        if not 0.0 <= self.start < 1.0:
-            raise SimdiffError(f"slip guard start must be in [0, 1), got {self.start}")
-        if not 0.0 <= self.floor <= 1.0:
-            raise SimdiffError(f"slip guard floor must be in [0, 1], got {self.floor}")
-
-    def pull(self, ratio: float, mu: float) -> float:
-        """The fraction of the swing leg's PD pull kept at force ratio ``ratio`` under friction ``mu``."""
-        lo = self.start * mu
-        if ratio <= lo or mu <= 0.0:
-            return 1.0
-        return max(self.floor, 1.0 - (ratio - lo) / ((1.0 - self.start) * mu))
 
 
 @dataclass(frozen=True)
@@ -219,18 +186,6 @@ sliding 0.58 mm/frame, 566 of 576 tracked; ``"hold"`` (repeat the last placement
 ``"place"`` 0.521, 24.3, 0.52, 566. On the 48 bench samples (4 bench prompts × g −9.81/−3.7 × seeds 0–5,
 ``benchmarks/bench_finish.py``) place: tracked to the end 43 → 45, tracked and ≤ 0.5 mm/frame 34 → 37, the
 walks' mean sliding 0.51 → 0.31. Mocap (the augmentation) keeps ``"release"``."""
-
-
-FINISH_SLIP_GUARD: SlipGuardConfig = SlipGuardConfig(start=0.5, floor=0.0)
-"""The slip guard of the simulated finish's second try (:func:`simdiff.sim.fallback.finish_fallback`): the
-swing leg's PD pull falls from full at a stance-foot force ratio of 0.5·μ to none at μ.
-
-Chosen (session 35) on the 48 bench samples' seeds 0–2 (4 bench prompts × g −9.81/−3.7, 24 samples)
-among start 0.3 / 0.4 / 0.5 / 0.6 / 0.7 with floor 0, start 0.4 / 0.5 / 0.7 with floor 0.3 and start 0.5 with
-floor 0.5: as the only tracker, tracked and ≤ 0.5 mm/frame 16 → 20 of 24 (the others 14–19; four variants
-triggered by the stance foot's measured slip speed instead of the force: 13–16), and as the second try of the
-finish 16 → 21 (others 17–20). Seeds 3–5, not used to choose: alone 21 → 19, as the second try 21 → 23
-(``reports/experiments/s35_fallback/probes/``)."""
 
 
 def finish_tracker_config() -> PDTrackerConfig:
@@ -413,19 +368,7 @@ class PDTracker:
 
     def stance_forces(self, data) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per leg (L, R): the floor's normal force (N), its horizontal force (N) and the contacts' largest μ."""
-        fn, ft, mu = np.zeros(2), np.zeros((2, 2)), np.zeros(2)
-        f6 = np.zeros(6)
-        for i in range(data.ncon):
-            c = data.contact[i]
-            s = max(self.geom_side[c.geom1], self.geom_side[c.geom2])
-            if s < 0:
-                continue
-            self.mj.mj_contactForce(self.model, data, i, f6)
-            f = f6[:3] @ c.frame.reshape(3, 3)  # world frame
-            fn[s] += f[2]
-            ft[s] += f[:2]
-            mu[s] = max(mu[s], float(c.friction[0]))
-        return np.abs(fn), np.linalg.norm(ft, axis=1), mu
+        return stance_forces(self.model, data, self.geom_side)
 
     def _guard_slip(self, data, target: np.ndarray) -> None:
         """Pull the swing leg's hip and knee targets toward their angles when the single stance foot nears sliding."""
