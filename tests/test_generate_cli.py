@@ -160,6 +160,12 @@ def test_generate_simulate_writes_the_simulated_motion_and_tracking(tiny_model: 
     assert set(tracking["physics_generated"]) >= {"penetration", "floating", "sliding"}
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
     assert meta["samples"][0]["simulated"]["status"] == tracking["status"] and meta["timings_s"]["simulate"] > 0
+    # the finish's second try: made exactly when the first rollout fell or slid > 0.5 mm/frame, and recorded
+    first_ok = tracking["attempts"] == 1
+    assert first_ok == (tracking["status"] == "ok" and tracking["physics_simulated"]["sliding"] <= 0.5)
+    assert not (first_ok and tracking["fallback"])
+    summary = meta["samples"][0]["simulated"]
+    assert (summary["attempts"], summary["fallback"]) == (tracking["attempts"], tracking["fallback"])
 
 
 def test_generate_simulate_in_a_worker_equals_in_process(tiny_model: Path, tmp_path: Path, capsys,

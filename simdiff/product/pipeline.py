@@ -254,7 +254,7 @@ def _simulated_summary(sim: SimulatedMotion) -> dict:
     """The tracking result's headline numbers for ``generation.json``."""
     t = sim.tracking
     keys = ("success", "status", "fall_frame", "n_frames", "n_out", "err_mm", "err_local_mm", "d_l2", "time_warp",
-            "wall_s", "cpu_s", "env_assumed")
+            "wall_s", "cpu_s", "env_assumed", "attempts", "fallback")
     return {**{k: t.get(k) for k in keys}, "physics_simulated": t.get("physics_simulated")}
 
 

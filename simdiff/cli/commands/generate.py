@@ -186,8 +186,11 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
             print(f"simdiff: warning: the simulated finish of {name} {sim['status']} at frame "
                   f"{sim['fall_frame']}; its simulated motion ends there ({sim['n_out']} of {sim['n_frames']} frames)",
                   file=sys.stderr)
-        _note(args, f"{name} simulated: {sim['status']} ({sim['n_out']} frames, joint error "
-                    f"{sim['err_mm']:.0f} mm, {sim['wall_s']:.2f} s)")
+        slide = (sim.get("physics_simulated") or {}).get("sliding")
+        second = ("" if (sim.get("attempts") or 1) < 2 else
+                  "; second try under the slip guard " + ("kept" if sim.get("fallback") else "not kept"))
+        _note(args, f"{name} simulated: {sim['status']} ({sim['n_out']} frames, joint error {sim['err_mm']:.0f} mm"
+                    f"{'' if slide is None else f', sliding {slide:.2f} mm/frame'}, {sim['wall_s']:.2f} s{second})")
     for path in paths:
         print(path)
     n = len(meta["samples"])
