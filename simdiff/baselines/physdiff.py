@@ -97,6 +97,12 @@ def reencode(rollout: np.ndarray, refloor: bool = False) -> np.ndarray:
     return process_joints(np.asarray(rollout, dtype=np.float64), canonical=refloor).features.astype(np.float32)
 
 
+def _info_field(info: Any, name: str, default: Any) -> Any:
+    """A field of a projector's per-motion info: a dict, a :class:`~simdiff.sim.project.ProjectionInfo`, or an
+    error string (``default``)."""
+    return info.get(name, default) if isinstance(info, dict) else getattr(info, name, default)
+
+
 @dataclass
 class ProjectionHook:
     """The x̂₀ hook ``(x0 (B,T,263) normalised, t, x_t) -> x0'`` that projects through the simulator.
@@ -141,11 +147,9 @@ class ProjectionHook:
                 n_rows = min(len(feats), int(self.lengths[i]))
                 sub = self.normalizer.normalize(torch.from_numpy(feats[:n_rows]))
                 out[i, :n_rows] = sub.to(out.device, out.dtype)
-            def got(name: str, default: Any, info: Any = info) -> Any:
-                return info.get(name, default) if isinstance(info, dict) else getattr(info, name, default)
-
-            entries.append({"success": bool(got("success", False)), "frames_replaced": n_rows,
-                            "attempts": int(got("attempts", 1)), "fallback": bool(got("fallback", False)),
+            entries.append({"success": bool(_info_field(info, "success", False)), "frames_replaced": n_rows,
+                            "attempts": int(_info_field(info, "attempts", 1)),
+                            "fallback": bool(_info_field(info, "fallback", False)),
                             "error": info if isinstance(info, str) else None})
         self.log.append({"t": int(t), "samples": entries, "wall_s": time.perf_counter() - start})
         return out

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.sim.retime import better
 from simdiff.sim.slip_guard import FINISH_SLIP_GUARD
 from simdiff.sim.tracker import PDTrackerConfig, finish_tracker_config
 
@@ -56,13 +57,9 @@ def rollout_sliding(joints: np.ndarray) -> float:
     return float(physics_metrics(np.asarray(joints, dtype=np.float32))["sliding"])
 
 
-def better_rollout(first: tuple[str, float], second: tuple[str, float]) -> bool:
-    """True when ``second`` (status, sliding) beats ``first``: tracked to the end first, then lower sliding."""
-
-    def key(r: tuple[str, float]) -> tuple[bool, float]:
-        return (r[0] != "ok", r[1] if np.isfinite(r[1]) else math.inf)
-
-    return key(second) < key(first)
+better_rollout = better
+"""True when ``second`` (status, sliding) beats ``first``: tracked to the end first, then lower sliding
+(:func:`simdiff.sim.retime.better`, the re-timed try's rule)."""
 
 
 FINISH_FALLBACK: bool = True

@@ -18,7 +18,7 @@ import numpy as np
 
 from simdiff.sim.retarget import RetargetConfig, make_reference, qpos_to_world
 from simdiff.sim.env import Environment
-from simdiff.sim.fallback import FallbackConfig, better_rollout, rollout_sliding
+from simdiff.sim.fallback import FallbackConfig, rollout_sliding
 from simdiff.sim.faithfulness import feature_distance, normalized_features, pose_feature_mask
 from simdiff.sim.flight import FlightConfig, aligned_source
 from simdiff.sim.humanoid import TOE_JOINT_HEIGHT, HumanoidConfig, load_model, model_index, world_to_hml
@@ -186,7 +186,7 @@ def project(
         return out, info
     out2, info2 = _project_once(joints, env, **{**kw, "tracker_config": fallback.tracker_config})
     cpu, sim_cpu, attempts = info.cpu_s + info2.cpu_s, info.sim_cpu_s + info2.sim_cpu_s, info.attempts + 1
-    if better_rollout((info.status, sliding), (info2.status, rollout_sliding(out2))):
+    if better((info.status, sliding), (info2.status, rollout_sliding(out2))):
         out, info = out2, info2
         info.fallback = True
     info.cpu_s, info.sim_cpu_s, info.attempts = cpu, sim_cpu, attempts

@@ -98,7 +98,8 @@ def stretch(joints: np.ndarray, scale: float) -> np.ndarray:
 
 
 def better(first: tuple[str, float], second: tuple[str, float]) -> bool:
-    """True when the second try (status, pose d_L2) beats the first: finished over fell, then lower pose d_L2."""
+    """True when the second try (status, cost) beats the first: finished over fell, then the lower cost (pose d_L2
+    for the re-timed try, CLoSD sliding for :mod:`simdiff.sim.fallback`'s); a NaN cost loses, a tie keeps the first."""
     ok1, ok2 = first[0] == "ok", second[0] == "ok"
     if ok1 != ok2:
         return ok2

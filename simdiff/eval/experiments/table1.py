@@ -84,6 +84,8 @@ def ddpm_note(runner: Runner) -> str:
 
 
 def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
+    from simdiff.sim.fallback import FINISH_FALLBACK_SLIDING
+
     c = runner.config
     value, source = best_alpha(runner)
     report["best_alpha"] = {"alpha": value, "source": source}
@@ -104,7 +106,8 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     for row in report["rows"]:
         if row.get("finish"):
             f = row["finish"]
-            second = (f"; {f['second_tries']} had a second try under the slip guard (fell or slid > 0.5 mm/frame), "
+            second = (f"; {f['second_tries']} had a second try under the slip guard (fell or slid > "
+                      f"{FINISH_FALLBACK_SLIDING:g} mm/frame), "
                       f"whose rollout was kept for {f['fallback_kept']}") if "second_tries" in f else ""
             lines.append(f"* {row['method']} {row['sampler'].upper()}: the simulator tracked {f['tracked']} of {f['motions']} "
                          f"final samples to the end ({100 * f['tracked_frac']:.0f} %){second}; after a fall the generated "
