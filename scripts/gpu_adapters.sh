@@ -15,7 +15,7 @@
 #     RUNS="plain:0 pair10:10" bash scripts/gpu_adapters.sh
 # RUNS: space-separated NAME:LAMBDA (λ of --env-pairs; 0 = the paper's plain loss).
 # Overrides: CONFIG (configs/adapters_paired_gpu.json) SPLIT (all) MINUTES (7) LOADER_WORKERS (cores / runs)
-#   DEVICE (cuda) PYTHON (python)
+#   DEVICE (cuda) PYTHON (python) ADAPTERS_INIT (a SimDiff folder to warm-start the adapters from) SEED
 set -uo pipefail
 : "${OUT:?set OUT to the output folder}"
 : "${AUG_PACK:?set AUG_PACK to an augmented pack folder}"
@@ -53,7 +53,8 @@ for r in $RUNS; do
   log "train $n: --env-pairs $lam --max-minutes $MINUTES --loader-workers $LOADER_WORKERS"
   "$PY" -m simdiff train adapters --data "${data[@]}" --split "$SPLIT" --init "$BACKBONE" --out "$WORK/$n" \
     --config "$CONFIG" --env-pairs "$lam" --device "$DEVICE" --text-table "$TEXT_TABLE" --max-minutes "$MINUTES" \
-    --loader-workers "$LOADER_WORKERS" --no-progress > "$WORK/logs/$n.log" 2>&1 &
+    --loader-workers "$LOADER_WORKERS" --no-progress ${ADAPTERS_INIT:+--adapters-init "$ADAPTERS_INIT"} \
+    ${SEED:+--seed "$SEED"} > "$WORK/logs/$n.log" 2>&1 &
   pids+=($!)
 done
 status=0

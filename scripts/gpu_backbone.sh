@@ -9,6 +9,7 @@
 #   OUT=$OUT PACK=.gpu/corpus TEXT_TABLE=.gpu/captions.safetensors bash scripts/gpu_backbone.sh
 # Overrides: CONFIG (configs/backbone_small_gpu.json) SPLIT (train) MINUTES (7) LOADER_WORKERS (12) DEVICE (cuda)
 #   DEADLINE_S (480: seconds from the start by which training must have stopped, a retry included) PYTHON (python)
+#   INIT (a model folder to warm-start from: `train backbone --init`) SEED (the config's)
 set -uo pipefail
 : "${OUT:?set OUT to the output folder}"
 : "${PACK:?set PACK to a corpus pack folder}"
@@ -34,6 +35,7 @@ train() {  # $1 minutes, $2 loader workers
   log "train backbone: --max-minutes $1 --loader-workers $2"
   "$PY" -m simdiff train backbone --data "$WORK/corpus" --split "$SPLIT" --out "$WORK/run" --config "$CONFIG" \
     --device "$DEVICE" --text-table "$TEXT_TABLE" --max-minutes "$1" --loader-workers "$2" --no-progress \
+    ${INIT:+--init "$INIT"} ${SEED:+--seed "$SEED"} \
     2>&1 | tee -a "$OUT/run.log"
   return "${PIPESTATUS[0]}"
 }

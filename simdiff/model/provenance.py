@@ -293,15 +293,15 @@ def training_provenance(what: str, data: Iterable[str | Path] = (), split: str =
         what: ``backbone`` or ``adapters``.
         data: the ``--data`` folders (each through :func:`provenance_from_corpus`).
         split: the split read from them.
-        init: adapters only: the backbone model folder; its ``provenance.json`` backbone entries come
-            first (an ``unknown`` backbone entry when it has none; a SimDiff folder's adapter entries
-            are left out: only its backbone is loaded).
+        init: the backbone model folder (adapters: trained on frozen; backbone: a warm start); its
+            ``provenance.json`` backbone entries come first (an ``unknown`` backbone entry when it has none;
+            a SimDiff folder's adapter entries are left out: only its backbone is loaded).
         source: ``--source``: a corpus whose clips are also trained on (and the fallback
             source of augmented folders that record none).
         synthetic: ``--synthetic N``: N synthetic clips instead of ``data``.
     """
     parts: list[TrainingData] = []
-    if what == "adapters" and init is not None:
+    if init is not None:
         base = read_provenance(init)
         parts += [p for p in base.trained_on if p.what == "backbone"] if base is not None else [
             unknown_data("backbone", init, f"the backbone folder {init} has no {PROVENANCE_NAME}")]

@@ -56,7 +56,11 @@ class Trainer:
         text_encoder: anything with ``name``, ``dim`` and ``encode(list[str]) -> (B, dim)``;
             default: the encoder named in the model config.
         device: where to train (passed explicitly; float32).
-        init_model: a backbone model folder (``model.safetensors`` + ``config.json``), adapters mode.
+        init_model: a backbone model folder (``model.safetensors`` + ``config.json``; a SimDiff folder gives its
+            backbone): adapters mode trains on it frozen; backbone mode starts from its weights (a warm start
+            with a fresh optimiser; ignored when ``run_dir`` already holds a checkpoint to resume).
+        init_adapters: adapters mode: a SimDiff model folder whose Sim Encoder and Motion Adapters the run starts
+            from (same sim and backbone config) instead of zero-initialised ones; ignored when resuming.
         mean, std: (263,) normaliser saved with the model (default: ``dataset.normalizer`` or init model's).
         resume: continue from ``run_dir``'s latest checkpoint when there is one.
         rank, world_size: DDP process (``torch.distributed`` must already be initialised when > 1).
@@ -68,6 +72,7 @@ class Trainer:
 
     def __init__(self, run_dir: str | Path, config: RunConfig, dataset: MotionDataset, *, text_encoder: Any = None,
                  device: torch.device | str = "cpu", init_model: str | Path | None = None,
+                 init_adapters: str | Path | None = None,
                  mean: Tensor | None = None, std: Tensor | None = None, resume: bool = True,
                  rank: int = 0, world_size: int = 1, provenance: Provenance | None = None,
                  loader_workers: int = 0) -> None:
@@ -98,9 +103,15 @@ class Trainer:
                 raise SimdiffError("adapter training needs a backbone checkpoint (--init MODEL_DIR)")
             if init_model is not None:
                 init_mean, init_std = self._load_backbone(Path(init_model))
+            if init_adapters is not None and latest_checkpoint(self.run_dir) is None:
+                self._load_adapters(Path(init_adapters))
             self.network.backbone.requires_grad_(False)
         elif config.model.sim is not None:
             raise SimdiffError("backbone training takes no sim config; train adapters afterwards")
+        elif init_adapters is not None:
+            raise SimdiffError("init_adapters needs adapters mode")
+        elif init_model is not None and latest_checkpoint(self.run_dir) is None:
+            init_mean, init_std = self._load_backbone(Path(init_model))
         self.mean, self.std = self._normalizer(mean, std, init_mean, init_std)
         self.network.to(self.device)
         self.trainable = {n: p for n, p in self.network.named_parameters() if p.requires_grad}
@@ -141,9 +152,24 @@ class Trainer:
         backbone = network.backbone if isinstance(network, SimDiffNet) else network
         if dataclasses.asdict(init_config.backbone) != dataclasses.asdict(self.config.model.backbone):
             raise SimdiffError(f"{folder}: backbone config differs from this run's model config")
-        assert isinstance(self.network, SimDiffNet)
-        self.network.backbone.load_state_dict(backbone.state_dict())
+        if init_config.text_encoder != self.config.model.text_encoder:
+            raise SimdiffError(f"{folder}: text encoder {init_config.text_encoder!r} differs from this run's "
+                               f"{self.config.model.text_encoder!r}")
+        target = self.network.backbone if isinstance(self.network, SimDiffNet) else self.network
+        target.load_state_dict(backbone.state_dict())
         return extra.get("normalizer.mean"), extra.get("normalizer.std")
+
+    def _load_adapters(self, folder: Path) -> None:
+        network, init_config, _ = load_pretrained(folder, "cpu")
+        if not isinstance(network, SimDiffNet) or init_config.sim is None:
+            raise SimdiffError(f"{folder}: not a SimDiff model (no Sim Encoder or adapters to start from)")
+        if dataclasses.asdict(init_config.sim) != dataclasses.asdict(self.config.model.sim):
+            raise SimdiffError(f"{folder}: sim config differs from this run's ({init_config.sim} vs {self.config.model.sim})")
+        if dataclasses.asdict(init_config.backbone) != dataclasses.asdict(self.config.model.backbone):
+            raise SimdiffError(f"{folder}: backbone config differs from this run's model config")
+        own = self.network.state_dict()
+        own.update({k: v for k, v in network.state_dict().items() if not k.startswith("backbone.")})
+        self.network.load_state_dict(own)
 
     def _normalizer(self, mean: Tensor | None, std: Tensor | None, init_mean: Tensor | None,
                     init_std: Tensor | None) -> tuple[Tensor, Tensor]:

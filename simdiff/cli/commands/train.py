@@ -53,12 +53,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     b.add_argument("--text-encoder", choices=["minilm", "clip"], help="text encoder (default minilm)")
     b.add_argument("--mask-frames", action=argparse.BooleanOptionalAction, default=None,
                    help="mask padded frames in attention (off reproduces MDM)")
+    b.add_argument("--init", type=Path,
+                   help="warm start: begin from this model folder's backbone weights (a SimDiff folder gives its "
+                        "backbone) with a fresh optimiser; its architecture and text encoder are used")
     b.set_defaults(func=run, mode="backbone")
     a = group.add_parser("adapters", help="train the Sim Encoder and Motion Adapters on a frozen backbone",
                          description="Train SimDiff's Sim Encoder + Motion Adapters; the backbone stays frozen. "
                                      "Dataset items must carry φ ('env' (3,) or 'env_index').")
     _common(a)
     a.add_argument("--init", type=Path, help="backbone model folder (model.safetensors + config.json)")
+    a.add_argument("--adapters-init", type=Path,
+                   help="warm start: begin from this SimDiff model folder's Sim Encoder and Motion Adapters (same "
+                        "sim config) instead of zero-initialised adapters")
     a.add_argument("--sim-mode", choices=["continuous", "categorical"], help="φ as (g_z, w_x, w_y) floats or a category")
     a.add_argument("--num-categories", type=int, help="number of environment categories (categorical)")
     a.add_argument("--env-pairs", type=float, metavar="WEIGHT",
@@ -118,6 +124,12 @@ def _run_config(args: argparse.Namespace):
         raise SimdiffError(f"--max-minutes must be >= 0, got {args.max_minutes}")
     if args.mode == "backbone":
         model = config.model
+        if args.init is not None:
+            if args.size is not None or args.text_encoder is not None or args.mask_frames is not None:
+                raise SimdiffError("--init takes the architecture from the model folder; drop --size, "
+                                   "--text-encoder and --mask-frames")
+            init = read_config(args.init)
+            model.backbone, model.text_encoder = init.backbone, init.text_encoder
         if args.size is not None:
             model.backbone = backbone_preset(args.size, mask_frames=model.backbone.mask_frames)
         assert args.size is None or args.size in PRESETS
@@ -131,6 +143,8 @@ def _run_config(args: argparse.Namespace):
         if args.init is not None:
             init = read_config(args.init)
             config.model.backbone, config.model.text_encoder = init.backbone, init.text_encoder
+        if args.adapters_init is not None and args.config is None and config.model.sim is None:
+            config.model.sim = read_config(args.adapters_init).sim  # the warm start's sim part, unless a config says
         sim = config.model.sim or SimConfig()
         if args.sim_mode is not None:
             sim.mode = args.sim_mode
@@ -170,6 +184,12 @@ def _provenance(args: argparse.Namespace):
         backbone = [p for p in earlier.trained_on if p.what == "backbone"] if earlier is not None else []
         prov = Provenance((backbone or [unknown_data("backbone", args.out / "model", "resumed without --init")])
                           + prov.trained_on)
+    warm = getattr(args, "adapters_init", None)
+    if warm is not None:  # the warm start's adapters were trained on their own data: it counts for the licence
+        base = read_provenance(warm)
+        earlier = [p for p in base.trained_on if p.what == "adapters"] if base is not None else [
+            unknown_data("adapters", warm, f"the warm start {warm} has no provenance.json")]
+        prov = Provenance(list(prov.trained_on) + earlier)
     return prov
 
 
@@ -201,7 +221,8 @@ def run(args: argparse.Namespace) -> int:
             encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
         dataset = _dataset(args, config.train.seed)
         trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
-                          init_model=getattr(args, "init", None), rank=dist.rank, world_size=dist.world_size,
+                          init_model=getattr(args, "init", None),
+                          init_adapters=getattr(args, "adapters_init", None), rank=dist.rank, world_size=dist.world_size,
                           provenance=_provenance(args), loader_workers=args.loader_workers)
         losses = trainer.train_for(args.max_minutes, progress=not args.no_progress)
         if dist.is_main:
