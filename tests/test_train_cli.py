@@ -83,6 +83,10 @@ def test_train_errors(tmp_path, capsys) -> None:
     assert "--init" in capsys.readouterr().err
     assert main(["sample", "--model", str(tmp_path / "none"), "--text", "x"]) == 2
     assert "config.json" in capsys.readouterr().err
+    assert main(["train", "backbone", "--synthetic", "2", "--init", str(tmp_path / "none"), "--size", "mdm",
+                 "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err
+    assert "--init takes the architecture" in err and err.count("\n") == 1
 
 
 @pytest.mark.slow

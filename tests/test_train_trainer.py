@@ -177,3 +177,65 @@ def test_train_for_stops_at_the_first_checkpoint_past_the_wall_clock_cap(tmp_pat
     assert trainer.step == 3 and latest_checkpoint(tmp_path).name == "step_000000003"
     trainer.train_for(0.0, progress=False)  # no cap: to the configured steps
     assert trainer.step == 9
+
+
+def test_backbone_warm_start_begins_from_the_init_weights(tmp_path) -> None:
+    """``init_model`` in backbone mode: step 0 holds the init's weights (a SimDiff folder gives its backbone), the
+    optimiser starts fresh, and a run folder with a checkpoint resumes it instead."""
+    ds = synthetic_dataset(4, 20, max_frames=20)
+    Trainer(tmp_path / "bb", run_config(3), ds, text_encoder=HashText()).train(progress=False)
+    start, _, _ = load_pretrained(tmp_path / "bb" / "model")
+    warm = Trainer(tmp_path / "warm", run_config(2, seed=5), ds, text_encoder=HashText(),
+                   init_model=tmp_path / "bb" / "model")
+    assert warm.step == 0 and not warm.optimizer.state
+    assert all(torch.equal(v, start.state_dict()[k]) for k, v in warm.network.state_dict().items())
+    cold = Trainer(tmp_path / "cold", run_config(2, seed=5), ds, text_encoder=HashText())
+    assert not all(torch.equal(v, start.state_dict()[k]) for k, v in cold.network.state_dict().items())
+    warm.train(progress=False)
+    resumed = Trainer(tmp_path / "warm", run_config(4, seed=5), ds, text_encoder=HashText(),
+                      init_model=tmp_path / "bb" / "model")
+    assert resumed.step == 2
+    assert all(torch.equal(v, warm.network.state_dict()[k]) for k, v in resumed.network.state_dict().items())
+    # A SimDiff folder gives its backbone; a different architecture is refused in one line.
+    env_ds = synthetic_dataset(4, 20, max_frames=20, with_env=True)
+    Trainer(tmp_path / "ad", run_config(1, mode="adapters", sim=True), env_ds, text_encoder=HashText(),
+            init_model=tmp_path / "bb" / "model").train(progress=False)
+    again = Trainer(tmp_path / "again", run_config(1), ds, text_encoder=HashText(),
+                    init_model=tmp_path / "ad" / "model")
+    assert all(torch.equal(v, start.state_dict()[k]) for k, v in again.network.state_dict().items())
+    other = run_config(1)
+    other.model.backbone.latent_dim *= 2
+    with pytest.raises(SimdiffError, match="backbone config differs"):
+        Trainer(tmp_path / "x", other, ds, text_encoder=HashText(), init_model=tmp_path / "bb" / "model")
+
+
+def test_adapters_warm_start_from_a_simdiff_folder(tmp_path) -> None:
+    """``init_adapters``: the Sim Encoder and adapters begin as the folder's, the backbone comes from ``init_model``;
+    a backbone-only folder, a different sim config or backbone mode are refused."""
+    ds = synthetic_dataset(4, 20, max_frames=20)
+    env_ds = synthetic_dataset(4, 20, max_frames=20, with_env=True)
+    Trainer(tmp_path / "bb", run_config(2), ds, text_encoder=HashText()).train(progress=False)
+    Trainer(tmp_path / "ad", run_config(3, mode="adapters", sim=True), env_ds, text_encoder=HashText(),
+            init_model=tmp_path / "bb" / "model").train(progress=False)
+    trained = load_file(tmp_path / "ad" / "model" / "model.safetensors")
+    assert trained["adapters.0.up.weight"].abs().max() > 0
+    Trainer(tmp_path / "bb2", run_config(1, seed=9), ds, text_encoder=HashText()).train(progress=False)
+    bb2 = load_file(tmp_path / "bb2" / "model" / "model.safetensors")
+    warm = Trainer(tmp_path / "warm", run_config(2, mode="adapters", sim=True), env_ds, text_encoder=HashText(),
+                   init_model=tmp_path / "bb2" / "model", init_adapters=tmp_path / "ad" / "model")
+    state = warm.network.state_dict()
+    for key, value in state.items():
+        if key.startswith("backbone."):
+            assert torch.equal(value, bb2[key[len("backbone."):]]), key
+        else:
+            assert torch.equal(value, trained[key]), key
+    with pytest.raises(SimdiffError, match="not a SimDiff model"):
+        Trainer(tmp_path / "y", run_config(2, mode="adapters", sim=True), env_ds, text_encoder=HashText(),
+                init_model=tmp_path / "bb" / "model", init_adapters=tmp_path / "bb" / "model")
+    other = run_config(2, mode="adapters", sim=True)
+    other.model.sim.hidden *= 2
+    with pytest.raises(SimdiffError, match="sim config differs"):
+        Trainer(tmp_path / "z", other, env_ds, text_encoder=HashText(), init_model=tmp_path / "bb" / "model",
+                init_adapters=tmp_path / "ad" / "model")
+    with pytest.raises(SimdiffError, match="needs adapters mode"):
+        Trainer(tmp_path / "w", run_config(2), ds, text_encoder=HashText(), init_adapters=tmp_path / "ad" / "model")
