@@ -56,6 +56,12 @@ def test_sampling_defaults(tmp_path: Path) -> None:
     assert (mine.alpha, mine.steps, mine.guidance) == (0.2, 10, 3.0)
     ddpm = with_model_defaults(build_request("walk", sampler="ddpm"), stored, given={"sampler"})
     assert (ddpm.sampler, ddpm.steps) == ("ddpm", 1000)  # the stored steps belong to the stored sampler
+    (tmp_path / "sampling.json").write_text('{"alpha": 0.5, "foot_lock": 1}')
+    stored = sampling_defaults(tmp_path)
+    assert with_model_defaults(build_request("walk"), stored, given=set()).foot_lock == 1.0
+    assert with_model_defaults(build_request("walk", foot_lock=0), stored, given={"foot_lock"}).foot_lock == 0.0
+    with pytest.raises(SimdiffError, match=r"foot_lock must be in \[0, 1\], got 2"):
+        with_model_defaults(build_request("walk"), {"foot_lock": 2.0}, given=set())
 
 
 @pytest.mark.parametrize("text, needle", [

@@ -12,6 +12,7 @@ import pytest
 import torch
 
 from simdiff.cli.main import main
+from simdiff.motion.foot_lock import lock_feet_numpy
 from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network
 
 
@@ -35,7 +36,7 @@ def tiny_model(tmp_path_factory) -> Path:
 
 
 def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
-    (tiny_model / "sampling.json").write_text('{"alpha": 0.5}')
+    (tiny_model / "sampling.json").write_text('{"alpha": 0.5, "foot_lock": 1.0}')
     try:
         code = main(["generate", "a person jumps forward", "--gravity", "-3.7", "--wind", "2", "0", "--frames", "10",
                      "--steps", "2", "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1",
@@ -52,6 +53,7 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     assert np.load(tmp_path / "o" / "sample0_joints.npy").shape == (10, 22, 3)
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
     assert (meta["alpha"], meta["alpha_source"], meta["steps"], meta["frames"]) == (0.5, "sampling.json", 2, 10)
+    assert meta["foot_lock"] == 1.0
     assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
     assert meta["threads"] == 1
     assert (meta["model"]["trained_on"], meta["model"]["weights_licence"]) == ("unknown", "unknown")  # no provenance.json
@@ -197,3 +199,31 @@ def test_a_failed_finish_still_writes_the_generated_motion(tiny_model: Path, tmp
     assert len(err.strip().splitlines()) == 1
     assert (tmp_path / "o" / "sample0_joints.npy").is_file() and not (tmp_path / "o" / "sample0_tracking.json").exists()
     assert json.loads((tmp_path / "o" / "generation.json").read_text())["simulate_error"] == "the simulator broke"
+
+
+def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path: Path, capsys) -> None:
+    from simdiff.motion.features import SLICES
+
+    import shutil
+
+    from safetensors.torch import load_file, save_file
+
+    model = tmp_path / "planted"  # the tiny model with every contact channel's mean at 1: its feet are planted
+    shutil.copytree(tiny_model, model)
+    tensors = load_file(model / "model.safetensors")
+    tensors["normalizer.mean"][SLICES["contacts"]] = 1.0
+    tensors["normalizer.mean"][SLICES["root_lin_vel"]] = 0.02
+    save_file(tensors, model / "model.safetensors")
+    argv = ["generate", "a person walks", "--frames", "12", "--steps", "2", "--model", str(model), "--threads",
+            "1", "--format", "npy", "--no-video", "-q"]
+    assert main([*argv, "--out", str(tmp_path / "off")]) == 0, capsys.readouterr().err
+    assert main([*argv, "--foot-lock", "1", "--out", str(tmp_path / "on")]) == 0, capsys.readouterr().err
+    off, on = (np.load(tmp_path / d / "sample0_features.npy") for d in ("off", "on"))
+    expected = lock_feet_numpy(off)
+    assert np.allclose(on, expected, atol=1e-5) and not np.allclose(on, off, atol=1e-4)  # something was planted
+    for name in ("root_rot_vel", "root_y", "ric", "rot6d", "contacts"):
+        assert np.allclose(on[:, SLICES[name]], off[:, SLICES[name]], atol=1e-5), name
+    assert json.loads((tmp_path / "on" / "generation.json").read_text())["foot_lock"] == 1.0
+    assert main([*argv, "--foot-lock", "2", "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "--foot-lock must be in [0, 1], got 2" in err and err.count("\n") == 1

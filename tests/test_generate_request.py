@@ -96,6 +96,11 @@ def test_steps_and_other_numbers() -> None:
         build_request("walk", guidance=-1.0)
     with pytest.raises(SimdiffError, match="--alpha must be a finite number"):
         build_request("walk", alpha=math.inf)
+    with pytest.raises(SimdiffError, match=r"--foot-lock must be in \[0, 1\], got 1.5"):
+        build_request("walk", foot_lock=1.5)
+    with pytest.raises(SimdiffError, match="--foot-lock must be ≥ 0"):
+        build_request("walk", foot_lock=-0.5)
+    assert build_request("walk").foot_lock == 0.0 and build_request("walk", foot_lock=1).foot_lock == 1.0
     with pytest.raises(SimdiffError, match="--num-samples must be 1..64, got 0"):
         build_request("walk", num_samples=0)
     with pytest.raises(SimdiffError, match="--seed must be ≥ 0, got -2"):

@@ -215,14 +215,15 @@ def _multimodality(evaluator: Evaluator, batches: list[dict[str, Any]], generate
 def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_index: int | None = None, alpha: float = 1.0,
                  sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5,
                  physdiff: Any = None, projector: Any = None, simulate: bool = False,
-                 finish_projector: Any = None) -> GenerateFn:
+                 finish_projector: Any = None, foot_lock: float = 0.0) -> GenerateFn:
     """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
 
     ``simulate``: the simulated finish: every final sample is re-tracked by ``finish_projector``
     (default ``projector``) under φ (``env``, Earth when None) and its features are replaced by the
     rollout's where it tracked (frames after a fall keep the generated ones, as a PhysDiff
     projection does). The returned function's ``finish_log`` lists one entry per finished sample
-    (``success``: tracked to the end; ``frames_replaced``), in generation order.
+    (``success``: tracked to the end; ``frames_replaced``), in generation order. ``foot_lock``: the
+    generator's foot lock strength (0: off; not with ``physdiff``).
     """
     finish_log: list[dict[str, Any]] = []
 
@@ -235,7 +236,8 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
 
             out, _ = physdiff_generate(generator, captions, lengths, physdiff, projector=projector, seed=seed, **kwargs)
         else:
-            out = generator.generate(captions, lengths, sampler=sampler, steps=steps, guidance=guidance, seed=seed, **kwargs)
+            out = generator.generate(captions, lengths, sampler=sampler, steps=steps, guidance=guidance, seed=seed,
+                                     foot_lock=foot_lock, **kwargs)
         feats = out.features.detach().cpu()
         if simulate:
             feats = simulated_finish(generator, feats, lengths, env, finish_projector or projector, log=finish_log)

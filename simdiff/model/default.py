@@ -68,14 +68,15 @@ def load_default(model: str | os.PathLike[str] | None = None, device: "torch.dev
 
 SAMPLING_NAME = "sampling.json"
 """Optional file beside ``config.json`` with the model's recommended sampling settings."""
-SAMPLING_KEYS: dict[str, type] = {"alpha": float, "guidance": float, "steps": int, "sampler": str}
+SAMPLING_KEYS: dict[str, type] = {"alpha": float, "guidance": float, "steps": int, "sampler": str, "foot_lock": float}
 
 
 def sampling_defaults(model: str | os.PathLike[str] | None = None) -> dict[str, float | int | str]:
     """Recommended sampling settings stored with a model (``sampling.json``), or ``{}`` when it has none.
 
-    The file is a JSON object with any of ``alpha`` (adapter strength), ``guidance``, ``steps`` and
-    ``sampler``, e.g. ``{"alpha": 0.8}``; values the user gives on the command line win.
+    The file is a JSON object with any of ``alpha`` (adapter strength), ``guidance``, ``steps``,
+    ``sampler`` and ``foot_lock`` (:mod:`simdiff.motion.foot_lock`'s strength), e.g. ``{"alpha": 0.8}``;
+    values the user gives on the command line win.
 
     Raises:
         SimdiffError: the file is not valid JSON or holds an unknown key or a value of the wrong type.

@@ -106,6 +106,7 @@ class MotionGenerator:
         x0_hook: X0Hook | None = None,
         hook_timesteps: Iterable[int] | None = None,
         progress: Callable[[Iterable[Tensor]], Iterable[Tensor]] | None = None,
+        foot_lock: float = 0.0,
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -120,6 +121,8 @@ class MotionGenerator:
             seed: noise seed (None: nondeterministic).
             text_embeddings: (B, text_dim) precomputed text vectors instead of encoding ``texts``.
             x0_hook, hook_timesteps: replace x̂₀ at chosen t (PhysDiff projection).
+            foot_lock: strength in [0, 1] of :func:`simdiff.motion.foot_lock.lock_feet` applied to the final
+                sample (0: off): the root is moved so the joints the sample marks in contact do not slide.
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -142,6 +145,11 @@ class MotionGenerator:
                    batched_cfg=batched_cfg, generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps,
                    progress=progress)
         features = (x * self.std + self.mean) * mask[..., None]
+        if foot_lock and frames >= 2:  # one frame has no step to correct
+            from simdiff.motion.foot_lock import lock_feet
+
+            features = lock_feet(features, lens, foot_lock) * mask[..., None]
+            x = torch.where(mask[..., None], (features - self.mean) / self.std, x)
         return Generation(features=features, normalized=x, lengths=lens)
 
     def _env(self, b: int, env: Sequence[float] | Tensor | None,

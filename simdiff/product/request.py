@@ -44,6 +44,7 @@ class GenerationRequest:
         steps: diffusion steps.
         guidance: classifier-free guidance scale (1 = off).
         alpha: adapter strength α (0 = backbone only).
+        foot_lock: foot-lock strength in [0, 1] (0: off; :mod:`simdiff.motion.foot_lock`).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
     """
@@ -58,6 +59,7 @@ class GenerationRequest:
     steps: int = 50
     guidance: float = 2.5
     alpha: float = 1.0
+    foot_lock: float = 0.0
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
 
@@ -199,9 +201,10 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     """Apply a model's stored sampling settings (``sampling.json``) to the options the user did not give.
 
     Args:
-        stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha`` (see
+        stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock`` (see
             :func:`simdiff.model.default.sampling_defaults`).
-        given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``).
+        given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
+            ``foot_lock``).
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -214,14 +217,24 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
         request, sampler=sampler, steps=steps,
         guidance=request.guidance if "guidance" in given else check_finite("guidance", stored.get("guidance", request.guidance), 0.0),
         alpha=request.alpha if "alpha" in given else check_finite("alpha", stored.get("alpha", request.alpha)),
+        foot_lock=(request.foot_lock if "foot_lock" in given
+                   else check_unit("foot_lock", stored.get("foot_lock", request.foot_lock))),
     )
+
+
+def check_unit(name: str, value: object) -> float:
+    """``value`` as a float in [0, 1], else a one-line error naming it."""
+    number = check_finite(name, value, 0.0)
+    if number > 1.0:
+        raise SimdiffError(f"{name} must be in [0, 1], got {number:g}")
+    return number
 
 
 def build_request(text: str, *, gravity: float | None = None, wind: tuple[float, float] | None = None,
                   length_s: float | None = None, frames: int | None = None, seed: int = 0, num_samples: int = 1,
                   sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
-                  compare: str | None = None, formats: str | None = None, no_video: bool = False,
-                  force: bool = False) -> GenerationRequest:
+                  foot_lock: float = 0.0, compare: str | None = None, formats: str | None = None,
+                  no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
     if seed < 0:
         raise SimdiffError(f"--seed must be ≥ 0, got {seed}")
@@ -240,6 +253,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         steps=steps_for(sampler, steps),
         guidance=check_finite("--guidance", guidance, 0.0),
         alpha=check_finite("--alpha", alpha),
+        foot_lock=check_unit("--foot-lock", foot_lock),
         formats=parse_formats(formats, no_video),
         force=bool(force),
     )

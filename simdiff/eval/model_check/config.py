@@ -87,7 +87,8 @@ class CheckConfig:
             :func:`simdiff.eval.evaluator.save_evaluator` output).
         out: report folder (``check.json``, ``check.md``, ``parts/``).
         seeds: one protocol replication per seed; the prompt checks split their samples over them.
-        steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models.
+        steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models; foot_lock: the
+            generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`).
         device: torch device; quick: the smoke preset was applied (reported).
     """
 
@@ -99,6 +100,7 @@ class CheckConfig:
     steps: int = 50
     guidance: float = 2.5
     alpha: float = 1.0
+    foot_lock: float = 0.0
     device: str = "cpu"
     quick: bool = False
     split: SplitOptions = field(default_factory=SplitOptions)
@@ -119,6 +121,8 @@ class CheckConfig:
                                  ("--speed-samples", self.prompts.speed_samples, 1), ("--length", self.prompts.length, 8)):
             if value < low:
                 raise SimdiffError(f"{name} must be at least {low}, got {value}")
+        if not 0.0 <= self.foot_lock <= 1.0:
+            raise SimdiffError(f"--foot-lock must be in [0, 1], got {self.foot_lock}")
         if self.prompts.length > 196:
             raise SimdiffError(f"--length must be at most 196 frames, got {self.prompts.length}")
         model, corpus, evaluator = Path(self.model), Path(self.corpus), Path(self.evaluator)

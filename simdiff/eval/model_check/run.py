@@ -113,7 +113,7 @@ class ModelCheck:
     def base_inputs(self) -> dict[str, Any]:
         c = self.config
         return {"schema": SCHEMA, "model": _stamp(c.model), "seeds": c.seeds, "steps": c.steps, "guidance": c.guidance,
-                "alpha": c.alpha, "device": c.device}
+                "alpha": c.alpha, "device": c.device, **({"foot_lock": c.foot_lock} if c.foot_lock else {})}
 
     def part(self, name: str, inputs: dict[str, Any], measure: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         """The stored result of section ``name`` when its fingerprint matches, else measured and stored."""
@@ -143,7 +143,8 @@ class ModelCheck:
         if key not in self._sets:
             c = self.config
             self._sets[key] = generate_set(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
-                                           steps=c.steps, guidance=c.guidance, progress=self.progress)
+                                           steps=c.steps, guidance=c.guidance, progress=self.progress,
+                                           foot_lock=c.foot_lock)
         return self._sets[key]
 
     # --- sections ---------------------------------------------------------------------------
@@ -161,7 +162,7 @@ class ModelCheck:
             dataset = HumanML3D(c.corpus, c.split.split, seed=c.seeds[0])
             env = self.env(EARTH)
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
-                              steps=c.steps, guidance=c.guidance)
+                              steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock)
             return measure_split(evaluator, dataset, fn, c.split, c.seeds, self.progress)
 
         return self.part("test_split", {"corpus": _stamp(c.corpus, f"{c.split.split}.txt"), "evaluator": _stamp(c.evaluator),

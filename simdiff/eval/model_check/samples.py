@@ -40,7 +40,8 @@ def units(batches: Sequence[PromptBatch]) -> list[str]:
 
 
 def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *, env: Sequence[float] | None,
-                 alpha: float, steps: int, guidance: float, progress: bool = False) -> np.ndarray:
+                 alpha: float, steps: int, guidance: float, progress: bool = False,
+                 foot_lock: float = 0.0) -> np.ndarray:
     """Generate every batch; returns joints (N, length, 22, 3) float32, metres, Y-up, 20 fps.
 
     ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone.
@@ -53,6 +54,6 @@ def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *,
     out = []
     for b in tqdm(batches, desc="prompts", disable=not progress, dynamic_ncols=True, leave=False):
         gen = generator.generate([b.prompt] * b.count, length, sampler="ddim", steps=steps, guidance=guidance,
-                                 seed=b.noise_seed, **kwargs)
+                                 seed=b.noise_seed, foot_lock=foot_lock, **kwargs)
         out.append(np.asarray(features_to_joints(gen.features.detach().cpu().double()), dtype=np.float32))
     return np.concatenate(out)
