@@ -133,6 +133,12 @@ def test_generate_matches_direct_sampling(server, model_dir):
     clip = gen.generate(["a person jumps forward"], 40, env=(-5.0, 3.0, -2.0), alpha=1.5, steps=STEPS, seed=7).clips()[0]
     expected = features_to_joints(clip.numpy())
     np.testing.assert_allclose(joints, expected, atol=1e-4)  # rounded to 0.1 mm on the wire
+    assert meta["foot_lock"] == 0.0  # no sampling.json: off, as `simdiff generate`
+    status, out, _ = call(server, "/api/generate", {**body, "foot_lock": 1.0})
+    assert status == 200 and out["meta"]["foot_lock"] == 1.0
+    locked = gen.generate(["a person jumps forward"], 40, env=(-5.0, 3.0, -2.0), alpha=1.5, steps=STEPS, seed=7,
+                          foot_lock=1.0).clips()[0]
+    np.testing.assert_allclose(np.asarray(out["joints"]), features_to_joints(locked.numpy()), atol=1e-4)
 
 
 def test_generate_with_simulated_finish(server):
@@ -188,6 +194,8 @@ def test_generation_requests_are_serialised(server):
     ({"text": "walk", "steps": 0}, "steps must be in [1, 200], got 0"),
     ({"text": "walk", "windx": 1}, "unknown field 'windx'"),
     ({"text": "walk", "simulate": "yes"}, "simulate must be true or false, got 'yes'"),
+    ({"text": "walk", "foot_lock": 2}, "foot_lock must be in [0, 1], got 2"),
+    ({"text": "walk", "foot_lock": "on"}, "foot_lock must be a finite number, got 'on'"),
     (["walk"], "request body must be a JSON object"),
 ])
 def test_bad_generate_request_is_a_400_with_one_line(server, body, needle):
@@ -311,3 +319,18 @@ def test_cli_rejects_bad_port_and_steps(capsys):
     assert "--port must be 0..65535, got 70000" in capsys.readouterr().err
     assert main(["serve", "--steps", "0", "--no-browser"]) == 2
     assert "--steps must be 1..1000, got 0" in capsys.readouterr().err
+
+
+def test_generate_takes_the_models_foot_lock_unless_given(server, model_dir):
+    body = {"text": "a person walks", "seconds": 1.0, "seed": 3}
+    (model_dir / "sampling.json").write_text('{"foot_lock": 1.0}')
+    try:
+        status, stored, _ = call(server, "/api/generate", body)
+        assert status == 200 and stored["meta"]["foot_lock"] == 1.0
+        status, off, _ = call(server, "/api/generate", {**body, "foot_lock": 0})
+        assert status == 200 and off["meta"]["foot_lock"] == 0.0
+        (model_dir / "sampling.json").write_text('{"foot_lock": 3}')
+        status, out, _ = call(server, "/api/generate", body)
+        assert status == 503 and "foot_lock must be in [0, 1], got 3" in out["error"]
+    finally:
+        (model_dir / "sampling.json").unlink()

@@ -43,6 +43,8 @@ class GenerateParams:
         guidance: classifier-free guidance scale.
         simulate: simulated finish: re-track the motion in the simulator under φ; the answer shows the
             simulated motion and carries the generated one and the tracking result in ``meta``.
+        foot_lock: foot-lock strength in [0, 1] (:mod:`simdiff.motion.foot_lock`), or None for the model's
+            ``sampling.json`` value (0 without one), as ``simdiff generate``.
     """
 
     text: str
@@ -55,6 +57,7 @@ class GenerateParams:
     steps: int | None = None
     guidance: float = 2.5
     simulate: bool = False
+    foot_lock: float | None = None
 
     @property
     def frames(self) -> int:
@@ -102,7 +105,7 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
-            simulate}``;
+            simulate, foot_lock}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -140,5 +143,9 @@ def parse_generate(body: Any) -> GenerateParams:
     simulate = body.get("simulate", False)
     if not isinstance(simulate, bool):
         raise SimdiffError(f"simulate must be true or false, got {simulate!r}")
+    foot_lock = body.get("foot_lock")
+    if foot_lock is not None:
+        foot_lock = _number(body, "foot_lock", 0.0)
+        _check_range("foot_lock", foot_lock, 0.0, 1.0)
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
-                          guidance=guidance, simulate=simulate, **wind)
+                          guidance=guidance, simulate=simulate, foot_lock=foot_lock, **wind)

@@ -144,6 +144,16 @@ class MotionService:
             return "backbone"
         return "simdiff" if config.sim.mode == "continuous" else "categorical"
 
+    def _stored_foot_lock(self) -> float:
+        """The model's ``sampling.json`` foot lock (0 without one; a bad file is the model's error)."""
+        from simdiff.model.default import sampling_defaults
+        from simdiff.product.request import check_unit
+
+        try:
+            return check_unit("foot_lock", sampling_defaults(self.model_dir).get("foot_lock", 0.0))
+        except SimdiffError as exc:
+            raise ModelUnavailable(str(exc)) from None
+
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
         if self._generator is None:
@@ -211,17 +221,20 @@ class MotionService:
             uses_env = generator.is_simdiff
             start = time.perf_counter()
             waited = start - queued
+            foot_lock = params.foot_lock if params.foot_lock is not None else self._stored_foot_lock()
             out = generator.generate([params.text], params.frames,
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
-                                     guidance=params.guidance, seed=params.seed, progress=self._progress)
+                                     guidance=params.guidance, seed=params.seed, progress=self._progress,
+                                     foot_lock=foot_lock)
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count
         features = out.clips()[0].detach().cpu().numpy().astype(np.float32)
         joints = features_to_joints(features)
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
-                "kind": self._kind(generator.config), "env_used": uses_env, "elapsed_s": round(elapsed, 3),
+                "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": foot_lock,
+                "elapsed_s": round(elapsed, 3),
                 "queue_position": position, "waited_s": round(waited, 3)}
         if params.simulate:
             from simdiff.product.pipeline import normalizer_of
