@@ -97,8 +97,8 @@ def test_generator_applies_the_lock_to_the_final_sample() -> None:
     a = gen.generate(["walk"] * 2, [24, 16], steps=3, seed=1)
     b = gen.generate(["walk"] * 2, [24, 16], steps=3, seed=1, foot_lock=1.0)
     lens = torch.tensor([24, 16])
-    assert torch.allclose(b.features, lock_feet(a.features, lens) * (torch.arange(24)[None, :, None] < lens[:, None, None]),
-                          atol=1e-5)
+    valid = torch.arange(24)[None, :, None] < lens[:, None, None]
+    assert torch.allclose(b.features, lock_feet(a.features, lens) * valid, atol=1e-5)
     mask = torch.arange(24)[None] < lens[:, None]
     assert torch.allclose((b.normalized * gen.std + gen.mean)[mask], b.features[mask], atol=1e-4)
     assert torch.equal(b.normalized[~mask], a.normalized[~mask])

@@ -1,13 +1,13 @@
 """Foot lock: move the root so that the feet a motion says are planted stay where they are.
 
 A generated motion carries its own foot-contact channels (HumanML3D features 259–262: left ankle, left toe,
-right ankle, right toe). Where foot joints are marked in contact on two consecutive frames, the lowest of them (the
-pivot: a heel at a strike, a toe at a push-off) should not move horizontally; the whole body is shifted back by
-the pivot's displacement, frame by frame, so it keeps its place and the rest of the body travels over it. Only the root's
-horizontal velocity changes (and, to keep the features consistent, the joint-velocity channels by the same
-amount); poses, heights, the root's yaw and the contact channels are untouched, so a flight or a crouch is exactly
-as generated. It is the classic root-trajectory part of foot-skate cleanup, not inverse kinematics: two planted
-feet that slide apart (a split) keep the lower one in place, not both.
+right ankle, right toe). Where foot joints are marked in contact on two consecutive frames, the lowest of them
+(the pivot: a heel at a strike, a toe at a push-off) should not move horizontally; the whole body is shifted back
+by the pivot's displacement, frame by frame, so it keeps its place and the rest of the body travels over it. Only
+the root's horizontal velocity changes (and, to keep the features consistent, the joint-velocity channels by the
+same amount); poses, heights, the root's yaw and the contact channels are untouched, so a flight or a crouch is
+exactly as generated. It is the classic root-trajectory part of foot-skate cleanup, not inverse kinematics: two
+planted feet that slide apart (a split) keep the lower one in place, not both.
 """
 
 from __future__ import annotations

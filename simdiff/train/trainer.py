@@ -164,7 +164,8 @@ class Trainer:
         if not isinstance(network, SimDiffNet) or init_config.sim is None:
             raise SimdiffError(f"{folder}: not a SimDiff model (no Sim Encoder or adapters to start from)")
         if dataclasses.asdict(init_config.sim) != dataclasses.asdict(self.config.model.sim):
-            raise SimdiffError(f"{folder}: sim config differs from this run's ({init_config.sim} vs {self.config.model.sim})")
+            raise SimdiffError(f"{folder}: sim config differs from this run's "
+                               f"({init_config.sim} vs {self.config.model.sim})")
         if dataclasses.asdict(init_config.backbone) != dataclasses.asdict(self.config.model.backbone):
             raise SimdiffError(f"{folder}: backbone config differs from this run's model config")
         own = self.network.state_dict()

@@ -222,7 +222,8 @@ def run(args: argparse.Namespace) -> int:
         dataset = _dataset(args, config.train.seed)
         trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
                           init_model=getattr(args, "init", None),
-                          init_adapters=getattr(args, "adapters_init", None), rank=dist.rank, world_size=dist.world_size,
+                          init_adapters=getattr(args, "adapters_init", None), rank=dist.rank,
+                          world_size=dist.world_size,
                           provenance=_provenance(args), loader_workers=args.loader_workers)
         losses = trainer.train_for(args.max_minutes, progress=not args.no_progress)
         if dist.is_main:
