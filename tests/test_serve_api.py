@@ -321,16 +321,22 @@ def test_cli_rejects_bad_port_and_steps(capsys):
     assert "--steps must be 1..1000, got 0" in capsys.readouterr().err
 
 
-def test_generate_takes_the_models_foot_lock_unless_given(server, model_dir):
+def test_generate_takes_the_models_alpha_and_foot_lock_unless_given(server, model_dir):
     body = {"text": "a person walks", "seconds": 1.0, "seed": 3}
-    (model_dir / "sampling.json").write_text('{"foot_lock": 1.0}')
+    assert call(server, "/api/info")[1]["defaults"]["alpha"] == 1.0  # no sampling.json: α 1, no lock
+    (model_dir / "sampling.json").write_text('{"alpha": 0.5, "foot_lock": 1.0}')
     try:
+        defaults = call(server, "/api/info")[1]["defaults"]
+        assert (defaults["alpha"], defaults["foot_lock"]) == (0.5, 1.0)  # the page starts where `generate` does
         status, stored, _ = call(server, "/api/generate", body)
-        assert status == 200 and stored["meta"]["foot_lock"] == 1.0
+        assert status == 200 and stored["meta"]["foot_lock"] == 1.0 and stored["meta"]["params"]["alpha"] == 0.5
+        status, given, _ = call(server, "/api/generate", {**body, "alpha": 0.5, "foot_lock": 1})
+        assert given["joints"] == stored["joints"]
         status, off, _ = call(server, "/api/generate", {**body, "foot_lock": 0})
         assert status == 200 and off["meta"]["foot_lock"] == 0.0
         (model_dir / "sampling.json").write_text('{"foot_lock": 3}')
         status, out, _ = call(server, "/api/generate", body)
         assert status == 503 and "foot_lock must be in [0, 1], got 3" in out["error"]
+        assert call(server, "/api/info")[0] == 200  # the page still loads its defaults
     finally:
         (model_dir / "sampling.json").unlink()

@@ -36,7 +36,8 @@ class GenerateParams:
         text: the prompt (stripped, non-empty).
         gravity: g_z in m/s² (Earth −9.81).
         wind_x, wind_y: horizontal wind force in newtons (HumanML3D +X, +Z).
-        alpha: adapter strength α.
+        alpha: adapter strength α, or None for the model's ``sampling.json`` value (1 without one), as
+            ``simdiff generate``.
         seconds: motion length in seconds (20 fps).
         seed: noise seed (≥ 0).
         steps: DDIM steps, or None for the sampler's default (50).
@@ -51,7 +52,7 @@ class GenerateParams:
     gravity: float = EARTH_GRAVITY
     wind_x: float = 0.0
     wind_y: float = 0.0
-    alpha: float = 1.0
+    alpha: float | None = None
     seconds: float = 6.0
     seed: int = 0
     steps: int | None = None
@@ -127,8 +128,10 @@ def parse_generate(body: Any) -> GenerateParams:
     for key in ("wind_x", "wind_y"):
         wind[key] = _number(body, key, 0.0)
         _check_range(key, wind[key], -MAX_WIND, MAX_WIND, " N")
-    alpha = _number(body, "alpha", defaults.alpha)
-    _check_range("alpha", alpha, *ALPHA_RANGE)
+    alpha = body.get("alpha")
+    if alpha is not None:
+        alpha = _number(body, "alpha", 1.0)
+        _check_range("alpha", alpha, *ALPHA_RANGE)
     seconds = _number(body, "seconds", defaults.seconds)
     if not 1.0 / FPS <= seconds <= MAX_SECONDS:
         raise SimdiffError(f"seconds must be in [{1.0 / FPS:g}, {MAX_SECONDS:g}], got {seconds:g}")

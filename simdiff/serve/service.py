@@ -144,15 +144,23 @@ class MotionService:
             return "backbone"
         return "simdiff" if config.sim.mode == "continuous" else "categorical"
 
-    def _stored_foot_lock(self) -> float:
-        """The model's ``sampling.json`` foot lock (0 without one; a bad file is the model's error)."""
+    def _resolved(self, params: GenerateParams, strict: bool) -> GenerateParams:
+        """``params`` with the fields left None (α, foot lock) taken from the model's ``sampling.json``, as
+        ``simdiff generate`` does (α 1 and no foot lock without one). A bad file is the model's error when
+        ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import check_unit
+        from simdiff.product.request import check_finite, check_unit
 
         try:
-            return check_unit("foot_lock", sampling_defaults(self.model_dir).get("foot_lock", 0.0))
+            stored = sampling_defaults(self.model_dir)
+            alpha = params.alpha if params.alpha is not None else check_finite("alpha", stored.get("alpha", 1.0))
+            lock = params.foot_lock if params.foot_lock is not None else check_unit("foot_lock",
+                                                                                   stored.get("foot_lock", 0.0))
         except SimdiffError as exc:
-            raise ModelUnavailable(str(exc)) from None
+            if strict:
+                raise ModelUnavailable(str(exc)) from None
+            alpha, lock = (1.0 if params.alpha is None else params.alpha), (params.foot_lock or 0.0)
+        return replace(params, alpha=float(alpha), foot_lock=float(lock))
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -180,7 +188,7 @@ class MotionService:
             "files": [{"index": i, "name": f.name, "frames": int(f.joints.shape[0])} for i, f in enumerate(self.files)],
             "limits": limits(),
             "queue": self.queue_status(),
-            "defaults": GenerateParams(text=DEFAULT_PROMPT).as_dict(),
+            "defaults": self._resolved(GenerateParams(text=DEFAULT_PROMPT), strict=False).as_dict(),
             "skeleton": skeleton_info(),
         }
 
@@ -221,7 +229,8 @@ class MotionService:
             uses_env = generator.is_simdiff
             start = time.perf_counter()
             waited = start - queued
-            foot_lock = params.foot_lock if params.foot_lock is not None else self._stored_foot_lock()
+            params = self._resolved(params, strict=True)
+            foot_lock = float(params.foot_lock or 0.0)
             out = generator.generate([params.text], params.frames,
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,

@@ -86,6 +86,7 @@ function readParams() {
     gravity: value("gravity"), wind_x: value("wind_x"), wind_y: value("wind_y"), alpha: value("alpha"),
     seconds: value("seconds"), seed: Math.round(value("seed")),
     simulate: Boolean($("simulate") && $("simulate").checked),
+    foot_lock: $("foot_lock") && $("foot_lock").checked ? 1 : 0,
   };
 }
 
@@ -140,6 +141,7 @@ function configure(info) {
   $("prompt").value = defaults.text;
   Object.assign($("seconds"), { min: String(1 / limits.fps), max: String(limits.seconds), value: String(defaults.seconds) });
   $("seed").value = String(defaults.seed);
+  $("foot_lock").checked = Number(defaults.foot_lock) > 0;
   $("version").textContent = `v${info.version}`;
   const m = info.model;
   $("model-info").textContent = m.error ? m.error : `Model: ${m.path} (${m.kind})`;
