@@ -133,6 +133,17 @@ def test_viewer_generates_regenerates_plays_and_opens(browser, server, tmp_path)
     assert page.text_content("#gravity-value") == "-3.00"
     page.screenshot(path=str(screenshot_dir(tmp_path) / "viewer_generate.png"))
 
+    # the foot-lock box starts at the model's sampling.json (none here: off) and is sent with the request
+    assert third["params"]["foot_lock"] == 0 and not page.is_checked("#foot_lock")
+    page.check("#foot_lock")
+    page.click("#generate")
+    locked = wait_for_new_motion(page, third["generation_id"])
+    assert locked["params"]["foot_lock"] == 1 and locked["meta"]["foot_lock"] == 1
+    page.uncheck("#foot_lock")
+    page.click("#generate")
+    third = wait_for_new_motion(page, locked["generation_id"])
+    assert third["params"]["foot_lock"] == 0
+
     # timeline: pause, scrub
     assert page.evaluate(f"{STATE}.playing") is True
     page.click("#play")
