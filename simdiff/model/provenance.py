@@ -286,7 +286,7 @@ def provenance_from_corpus(corpus_dir: str | Path, what: str = "backbone", split
 
 def training_provenance(what: str, data: Iterable[str | Path] = (), split: str = "train",
                         init: str | Path | None = None, source: str | Path | None = None,
-                        synthetic: int | None = None) -> Provenance:
+                        synthetic: int | None = None, adapters_init: str | Path | None = None) -> Provenance:
     """Provenance of a ``simdiff train backbone|adapters`` run.
 
     Args:
@@ -299,6 +299,9 @@ def training_provenance(what: str, data: Iterable[str | Path] = (), split: str =
         source: ``--source``: a corpus whose clips are also trained on (and the fallback
             source of augmented folders that record none).
         synthetic: ``--synthetic N``: N synthetic clips instead of ``data``.
+        adapters_init: ``--adapters-init``: a SimDiff folder whose adapters the run starts from; its
+            ``provenance.json`` adapter entries come last (an ``unknown`` one when it has none): the data
+            they were trained on counts for the licence.
     """
     parts: list[TrainingData] = []
     if init is not None:
@@ -311,6 +314,10 @@ def training_provenance(what: str, data: Iterable[str | Path] = (), split: str =
         parts += provenance_from_corpus(folder, what, split, source=source).trained_on
     if source is not None:
         parts += provenance_from_corpus(source, what, split).trained_on
+    if adapters_init is not None:
+        base = read_provenance(adapters_init)
+        parts += [p for p in base.trained_on if p.what == "adapters"] if base is not None else [
+            unknown_data("adapters", adapters_init, f"the warm start {adapters_init} has no {PROVENANCE_NAME}")]
     return Provenance(parts)
 
 

@@ -230,19 +230,18 @@ class MotionService:
             start = time.perf_counter()
             waited = start - queued
             params = self._resolved(params, strict=True)
-            foot_lock = float(params.foot_lock or 0.0)
             out = generator.generate([params.text], params.frames,
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
                                      guidance=params.guidance, seed=params.seed, progress=self._progress,
-                                     foot_lock=foot_lock)
+                                     foot_lock=params.foot_lock)
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count
         features = out.clips()[0].detach().cpu().numpy().astype(np.float32)
         joints = features_to_joints(features)
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
-                "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": foot_lock,
+                "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": params.foot_lock,
                 "elapsed_s": round(elapsed, 3),
                 "queue_position": position, "waited_s": round(waited, 3)}
         if params.simulate:

@@ -20,11 +20,9 @@ from simdiff.errors import SimdiffError
 
 @dataclass(frozen=True)
 class SlipGuardConfig:
-    """Give up swing speed to keep the stance foot where it is.
+    """Give up swing speed to keep the stance foot where it is (the module docstring says why).
 
-    With one foot on the floor, the floor force on it is the body's momentum change; a swing leg
-    whipped forward fast can ask for more horizontal force than friction gives (``|F_t| > μ·F_n``)
-    and the stance foot slides. When the stance foot's force ratio ``|F_t| / F_n`` (summed over its
+    When the stance foot's force ratio ``|F_t| / F_n`` (summed over its
     contacts, as the solver found them in the last physics step) passes ``start·μ``, the swing
     leg's hip and knee targets are pulled toward their current angles: the PD pull that is left is
     ``λ = 1 − (r − start·μ) / ((1 − start)·μ)``, at least ``floor`` (μ: the contact's friction

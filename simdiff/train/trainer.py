@@ -96,21 +96,22 @@ class Trainer:
             torch.manual_seed(tc.seed)  # the initial weights depend on the seed only
             self.network = build_network(config.model)
         init_mean, init_std = None, None
+        existing = latest_checkpoint(self.run_dir)  # a run to resume: warm starts are ignored
         if tc.mode == "adapters":
             if config.model.sim is None or not isinstance(self.network, SimDiffNet):
                 raise SimdiffError("adapter training needs a sim config (the SimDiff part)")
-            if init_model is None and latest_checkpoint(self.run_dir) is None:
+            if init_model is None and existing is None:
                 raise SimdiffError("adapter training needs a backbone checkpoint (--init MODEL_DIR)")
             if init_model is not None:
                 init_mean, init_std = self._load_backbone(Path(init_model))
-            if init_adapters is not None and latest_checkpoint(self.run_dir) is None:
+            if init_adapters is not None and existing is None:
                 self._load_adapters(Path(init_adapters))
             self.network.backbone.requires_grad_(False)
         elif config.model.sim is not None:
             raise SimdiffError("backbone training takes no sim config; train adapters afterwards")
         elif init_adapters is not None:
             raise SimdiffError("init_adapters needs adapters mode")
-        elif init_model is not None and latest_checkpoint(self.run_dir) is None:
+        elif init_model is not None and existing is None:
             init_mean, init_std = self._load_backbone(Path(init_model))
         self.mean, self.std = self._normalizer(mean, std, init_mean, init_std)
         self.network.to(self.device)
@@ -131,7 +132,7 @@ class Trainer:
         self.batcher = StepBatcher(len(dataset), tc.batch_size, tc.seed, world_size, rank)
         self.step = 0
         ema_state = None
-        checkpoint = latest_checkpoint(self.run_dir) if resume else None
+        checkpoint = existing if resume else None
         if checkpoint is not None:
             ema_state = self._restore(checkpoint)
         self.model: nn.Module = self.network

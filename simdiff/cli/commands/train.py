@@ -178,18 +178,12 @@ def _provenance(args: argparse.Namespace):
 
     init = getattr(args, "init", None)
     prov = training_provenance(args.mode, args.data or (), args.split, init=init, source=getattr(args, "source", None),
-                               synthetic=args.synthetic)
+                               synthetic=args.synthetic, adapters_init=getattr(args, "adapters_init", None))
     if args.mode == "adapters" and init is None:  # resuming: keep the backbone entries written before
         earlier = read_provenance(args.out / "model")
         backbone = [p for p in earlier.trained_on if p.what == "backbone"] if earlier is not None else []
         prov = Provenance((backbone or [unknown_data("backbone", args.out / "model", "resumed without --init")])
                           + prov.trained_on)
-    warm = getattr(args, "adapters_init", None)
-    if warm is not None:  # the warm start's adapters were trained on their own data: it counts for the licence
-        base = read_provenance(warm)
-        earlier = [p for p in base.trained_on if p.what == "adapters"] if base is not None else [
-            unknown_data("adapters", warm, f"the warm start {warm} has no provenance.json")]
-        prov = Provenance(list(prov.trained_on) + earlier)
     return prov
 
 
