@@ -63,3 +63,22 @@ def test_generate_rejects_bad_input() -> None:
 def test_load_pretrained_missing_folder(tmp_path) -> None:
     with pytest.raises(SimdiffError, match="config.json"):
         load_pretrained(tmp_path / "nope")
+
+
+def test_env_guidance_changes_only_motions_off_earth_and_is_validated() -> None:
+    config = tiny(True)
+    torch.manual_seed(0)
+    net = build_network(config)
+    for a in net.adapters:
+        torch.nn.init.normal_(a.up.weight, std=0.3)
+    gen = MotionGenerator(net, config, HashText())
+    envs = [[-9.81, 0.0, 0.0], [-1.6, 0.0, 0.0]]
+    plain = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1).features
+    pushed = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1, env_guidance=3.0).features
+    assert torch.equal(plain[0], pushed[0]) and not torch.allclose(plain[1], pushed[1], atol=1e-4)
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(SimdiffError, match="env guidance must be"):
+            gen.generate(["walk"], 12, env=envs[1], steps=2, env_guidance=bad)
+    backbone = MotionGenerator(build_network(tiny()), tiny(), HashText())
+    with pytest.raises(SimdiffError, match="continuous Sim Encoder"):
+        backbone.generate(["walk"], 12, steps=2, env_guidance=2.0)

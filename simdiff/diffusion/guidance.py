@@ -1,17 +1,30 @@
-"""Classifier-free guidance on the x₀ prediction: x̃₀ = x₀(∅) + s·(x₀(c) − x₀(∅))."""
+"""Guidance on the x₀ prediction.
+
+* Classifier-free guidance on the text: x̃₀ = x₀(∅, φ) + s·(x₀(c, φ) − x₀(∅, φ)).
+* Environment guidance (continuous SimDiff models): x̃₀ += (s_e − 1)·(x₀(c, φ) − x₀(c, φ_ref)), the
+  adapters' answer to φ against the reference environment (Earth, no wind) pushed ``s_e`` times as far.
+  Rows whose φ equals the reference are left exactly as without it.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable
+from dataclasses import replace
+from typing import TYPE_CHECKING, Callable, Sequence
 
 import torch
 from torch import Tensor
 
+from simdiff.errors import SimdiffError
+
 if TYPE_CHECKING:
     from simdiff.model.condition import Condition
 
+
 Denoiser = Callable[[Tensor, Tensor, "Condition"], Tensor]
 """``denoiser(x_t (B,T,F), t (B,) int64, cond) -> x̂₀ (B,T,F)``."""
+
+REFERENCE_ENV: tuple[float, float, float] = (-9.81, 0.0, 0.0)
+"""φ_ref of environment guidance: Earth's gravity (m/s², along z) and no wind (N)."""
 
 
 class GuidedDenoiser:
@@ -22,21 +35,56 @@ class GuidedDenoiser:
         scale: s; 1 disables guidance (one conditional pass).
         batched: run the conditional and unconditional passes as one 2B forward (default)
             instead of two B forwards. The text is dropped in the second half only; φ/α are kept.
+        env_scale: s_e of environment guidance; 1 disables it. Needs ``cond.env`` (a continuous
+            Sim Encoder); costs one more conditional forward over the rows whose φ is not ``reference_env``
+            (a separate one: the other rows are computed bit for bit as without it).
+        reference_env: φ_ref = (g_z m/s², w_x N, w_y N).
     """
 
-    def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True) -> None:
+    def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True, env_scale: float = 1.0,
+                 reference_env: Sequence[float] = REFERENCE_ENV) -> None:
         self.denoiser = denoiser
         self.scale = float(scale)
         self.batched = batched
+        self.env_scale = float(env_scale)
+        self.reference_env = tuple(float(v) for v in reference_env)
+        if len(self.reference_env) != 3:
+            raise SimdiffError(f"reference_env must be 3 numbers (g_z, w_x, w_y), got {len(self.reference_env)}")
 
     def __call__(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
         """x: (B, T, F), timesteps: (B,) → guided x̂₀ (B, T, F)."""
+        rows = self._env_rows(cond)
         if self.scale == 1.0:
-            return self.denoiser(x, timesteps, cond)
-        if self.batched:
-            out = self.denoiser(torch.cat([x, x]), torch.cat([timesteps, timesteps]), cond.with_guidance_pair())
-            cond_out, uncond_out = out.chunk(2)
+            cond_out = guided = self.denoiser(x, timesteps, cond)
         else:
-            cond_out = self.denoiser(x, timesteps, cond)
-            uncond_out = self.denoiser(x, timesteps, cond.unconditional())
-        return uncond_out + self.scale * (cond_out - uncond_out)
+            if self.batched:
+                out = self.denoiser(torch.cat([x, x]), torch.cat([timesteps, timesteps]), cond.with_guidance_pair())
+                cond_out, uncond_out = out.chunk(2)
+            else:
+                cond_out = self.denoiser(x, timesteps, cond)
+                uncond_out = self.denoiser(x, timesteps, cond.unconditional())
+            guided = uncond_out + self.scale * (cond_out - uncond_out)
+        if rows is None:
+            return guided
+        # a pass of its own, so that the rows above are computed exactly as without environment guidance
+        ref_out = self.denoiser(x[rows], timesteps[rows], self._reference(cond, rows))
+        guided = guided.clone()
+        guided[rows] += (self.env_scale - 1.0) * (cond_out[rows] - ref_out)
+        return guided
+
+    def _env_rows(self, cond: Condition) -> Tensor | None:
+        """(K,) indices of the rows environment guidance changes; None when it changes none."""
+        if self.env_scale == 1.0:
+            return None
+        if cond.env is None:
+            raise SimdiffError("environment guidance needs a SimDiff model with a continuous Sim Encoder (φ as numbers)")
+        ref = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
+        rows = torch.nonzero((cond.env != ref).any(dim=-1)).flatten()
+        return rows if rows.numel() else None
+
+    def _reference(self, cond: Condition, rows: Tensor) -> Condition:
+        """The conditional condition of ``rows`` with φ set to the reference."""
+        sub = cond.select(rows)
+        ref = torch.tensor(self.reference_env, dtype=sub.env.dtype, device=sub.env.device)  # type: ignore[union-attr]
+        return replace(sub, env=ref.expand_as(sub.env).clone())  # type: ignore[arg-type]
+

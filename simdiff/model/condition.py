@@ -56,6 +56,16 @@ class Condition:
             alpha=alpha,
         )
 
+    def select(self, rows: Tensor) -> "Condition":
+        """The condition of the batch rows ``rows`` ((K,) int64 indices)."""
+
+        def pick(value: Tensor | None) -> Tensor | None:
+            return None if value is None else value[rows]
+
+        alpha = self.alpha[rows] if isinstance(self.alpha, Tensor) else self.alpha
+        return Condition(self.text[rows], pick(self.uncond), pick(self.frame_mask), pick(self.env),
+                         pick(self.env_index), alpha)
+
     def unconditional(self) -> "Condition":
         """The same condition with every text dropped."""
         return replace(self, uncond=torch.ones(self.batch_size, dtype=torch.bool, device=self.text.device))
@@ -68,3 +78,4 @@ class Condition:
 
         alpha = self.alpha.to(device) if isinstance(self.alpha, Tensor) else self.alpha
         return Condition(mv(self.text), mv(self.uncond), mv(self.frame_mask), mv(self.env), mv(self.env_index), alpha)
+

@@ -107,6 +107,7 @@ class MotionGenerator:
         hook_timesteps: Iterable[int] | None = None,
         progress: Callable[[Iterable[Tensor]], Iterable[Tensor]] | None = None,
         foot_lock: float = 0.0,
+        env_guidance: float = 1.0,
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -123,6 +124,9 @@ class MotionGenerator:
             x0_hook, hook_timesteps: replace x̂₀ at chosen t (PhysDiff projection).
             foot_lock: strength in [0, 1] of :func:`simdiff.motion.foot_lock.lock_feet` applied to the final
                 sample (0: off): the root is moved so the joints the sample marks in contact do not slide.
+            env_guidance: s_e ≥ 0 (1 = off): the adapters' answer to φ against Earth without wind is pushed s_e
+                times as far (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only. Motions under
+                Earth without wind are unchanged; the others cost one more network pass per step.
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -136,6 +140,13 @@ class MotionGenerator:
         text = text_embeddings.float().to(self.device) if text_embeddings is not None else self.encode_text(texts)
         frames = int(lens.max())
         mask = (torch.arange(frames)[None] < lens[:, None]).to(self.device)
+        env_guidance = float(env_guidance)
+        if env_guidance != 1.0:
+            if not (env_guidance >= 0.0 and env_guidance < float("inf")):
+                raise SimdiffError(f"env guidance must be a finite number ≥ 0, got {env_guidance}")
+            if self.config.sim is None or self.config.sim.mode != "continuous":
+                raise SimdiffError("env guidance needs a SimDiff model with a continuous Sim Encoder; "
+                                   "this model has none (leave it at 1)")
         cond = Condition(text=text, frame_mask=mask, alpha=float(alpha), **self._env(b, env, env_index))
         generator = None
         if seed is not None:
@@ -143,7 +154,7 @@ class MotionGenerator:
         scheduler = make_scheduler(sampler, steps, eta)
         x = sample(self.network, scheduler, cond, frames, nfeats=self.config.backbone.nfeats, guidance=guidance,
                    batched_cfg=batched_cfg, generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps,
-                   progress=progress)
+                   progress=progress, env_guidance=env_guidance)
         features = (x * self.std + self.mean) * mask[..., None]
         if foot_lock and frames >= 2:  # one frame has no step to correct
             from simdiff.motion.foot_lock import lock_feet

@@ -1,0 +1,100 @@
+"""Environment guidance: x̃₀ = CFG(φ) + (s_e − 1)·(x₀(c, φ) − x₀(c, φ_ref)); Earth rows untouched."""
+
+from __future__ import annotations
+
+import pytest
+import torch
+
+from simdiff.diffusion import GuidedDenoiser, make_scheduler, sample
+from simdiff.diffusion.guidance import REFERENCE_ENV
+from simdiff.errors import SimdiffError
+from simdiff.model import Condition, MDMBackbone, SimConfig, SimDiffNet, backbone_preset
+
+ENVS = torch.tensor([[-1.6, 0.0, 0.0], [-9.81, 0.0, 0.0], [-9.81, 10.0, 0.0]])
+
+
+def simdiff_net() -> SimDiffNet:
+    torch.manual_seed(0)
+    sd = SimDiffNet(backbone_preset("tiny"), SimConfig()).eval()
+    for a in sd.adapters:  # zero-initialised adapters would make φ invisible
+        torch.nn.init.normal_(a.up.weight, std=0.3)
+    return sd
+
+
+def cond(alpha: float | torch.Tensor = 0.5) -> Condition:
+    return Condition(text=torch.randn(3, 384, generator=torch.Generator().manual_seed(2)), env=ENVS.clone(), alpha=alpha)
+
+
+def earth(c: Condition) -> Condition:
+    return Condition(text=c.text, env=torch.tensor([REFERENCE_ENV] * c.batch_size), alpha=c.alpha)
+
+
+@pytest.mark.parametrize("batched", [True, False])
+@pytest.mark.parametrize("scale", [2.5, 1.0])
+def test_formula_and_reference_rows_unchanged(batched: bool, scale: float) -> None:
+    sd, c = simdiff_net(), cond()
+    x, t = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(1)), torch.tensor([900, 500, 20])
+    with torch.no_grad():
+        cfg = GuidedDenoiser(sd, scale, batched)(x, t, c)
+        out = GuidedDenoiser(sd, scale, batched, env_scale=3.0)(x, t, c)
+        push = sd(x, t, c) - sd(x, t, earth(c))
+    expected = cfg + 2.0 * push
+    assert torch.allclose(out, expected, atol=1e-4)
+    assert torch.equal(out[1], cfg[1])  # φ = φ_ref: bit-identical
+    assert (out[0] - cfg[0]).abs().max() > 1e-3 and (out[2] - cfg[2]).abs().max() > 1e-3
+    with torch.no_grad():  # s_e = 1 is the plain guided denoiser
+        assert torch.equal(GuidedDenoiser(sd, scale, batched, env_scale=1.0)(x, t, c), cfg)
+
+
+def test_one_more_forward_over_the_changed_rows_only() -> None:
+    sd, c = simdiff_net(), cond()
+    calls: list[int] = []
+
+    def counting(x, t, cc):
+        calls.append(x.shape[0])
+        return sd(x, t, cc)
+
+    x, t = torch.randn(3, 8, 263), torch.zeros(3, dtype=torch.long)
+    with torch.no_grad():
+        GuidedDenoiser(counting, 2.5, env_scale=2.0)(x, t, c)
+        assert calls == [6, 2]  # the CFG pair as before, then the two rows off Earth
+        calls.clear()
+        GuidedDenoiser(counting, 2.5, env_scale=2.0)(x, t, earth(c))  # nothing off Earth: no extra pass
+        assert calls == [6]
+
+
+def test_per_row_alpha_and_text_drop_are_kept() -> None:
+    sd = simdiff_net()
+    c = cond(alpha=torch.tensor([0.2, 0.5, 1.0]))
+    c.uncond = torch.tensor([False, False, True])
+    x, t = torch.randn(3, 8, 263), torch.tensor([300, 300, 300])
+    with torch.no_grad():
+        batched = GuidedDenoiser(sd, 2.5, True, env_scale=4.0)(x, t, c)
+        unbatched = GuidedDenoiser(sd, 2.5, False, env_scale=4.0)(x, t, c)
+    assert torch.allclose(batched, unbatched, atol=1e-4)
+
+
+def test_needs_a_continuous_env() -> None:
+    torch.manual_seed(0)
+    backbone = MDMBackbone(backbone_preset("tiny")).eval()
+    c = Condition(text=torch.randn(2, 384))
+    with pytest.raises(SimdiffError, match="continuous Sim Encoder"):
+        GuidedDenoiser(backbone, 2.5, env_scale=2.0)(torch.randn(2, 8, 263), torch.zeros(2, dtype=torch.long), c)
+    with pytest.raises(SimdiffError, match="3 numbers"):
+        GuidedDenoiser(backbone, 2.5, env_scale=2.0, reference_env=(0.0, 1.0))
+
+
+def test_sampling_keeps_earth_samples_and_moves_the_others() -> None:
+    sd, c = simdiff_net(), cond()
+    s = make_scheduler("ddim", 8)
+    plain = sample(sd, s, c, 10, generator=torch.Generator().manual_seed(0))
+    guided = sample(sd, s, c, 10, generator=torch.Generator().manual_seed(0), env_guidance=3.0)
+    assert torch.equal(plain[1], guided[1])
+    assert not torch.allclose(plain[0], guided[0], atol=1e-3)
+
+
+def test_condition_select_picks_rows() -> None:
+    a = cond(alpha=torch.tensor([1.0, 0.0, 0.5]))
+    picked = a.select(torch.tensor([2, 0]))
+    assert torch.equal(picked.env, ENVS[[2, 0]]) and torch.equal(picked.text, a.text[[2, 0]])
+    assert picked.alpha.tolist() == [0.5, 1.0] and picked.uncond is None
