@@ -62,6 +62,11 @@ def test_sampling_defaults(tmp_path: Path) -> None:
     assert with_model_defaults(build_request("walk", foot_lock=0), stored, given={"foot_lock"}).foot_lock == 0.0
     with pytest.raises(SimdiffError, match=r"foot_lock must be in \[0, 1\], got 2"):
         with_model_defaults(build_request("walk"), {"foot_lock": 2.0}, given=set())
+    assert with_model_defaults(build_request("walk"), {"env_guidance": 3.0}, given=set()).env_guidance == 3.0
+    assert with_model_defaults(build_request("walk", env_guidance=1), {"env_guidance": 3.0},
+                               given={"env_guidance"}).env_guidance == 1.0
+    with pytest.raises(SimdiffError, match="env_guidance must be ≥ 0, got -2"):
+        with_model_defaults(build_request("walk"), {"env_guidance": -2.0}, given=set())
 
 
 @pytest.mark.parametrize("text, needle", [

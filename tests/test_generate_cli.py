@@ -227,3 +227,36 @@ def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path:
     assert main([*argv, "--foot-lock", "2", "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
     assert "--foot-lock must be in [0, 1], got 2" in err and err.count("\n") == 1
+
+
+def test_generate_env_guidance_changes_only_motions_off_earth(tmp_path: Path, capsys) -> None:
+    from simdiff.serve.testing import write_tiny_model
+
+    model = write_tiny_model(tmp_path / "reacting")  # jittered weights: the adapters answer φ
+    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
+            "--format", "npy", "--no-video", "-q"]
+
+    def run(name: str, *extra: str) -> np.ndarray:
+        assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
+        return np.load(tmp_path / name / "sample0_features.npy")
+
+    assert np.array_equal(run("earth1"), run("earth3", "--env-guidance", "3"))
+    moon1, moon3 = run("moon1", "--gravity", "-1.6"), run("moon3", "--gravity", "-1.6", "--env-guidance", "3")
+    assert not np.allclose(moon1, moon3, atol=1e-4)
+    assert json.loads((tmp_path / "moon3" / "generation.json").read_text())["env_guidance"] == 3.0
+    assert json.loads((tmp_path / "moon1" / "generation.json").read_text())["env_guidance"] == 1.0
+    (model / "sampling.json").write_text('{"env_guidance": 3}')
+    assert np.array_equal(run("stored", "--gravity", "-1.6"), moon3)  # sampling.json's value, unless given
+    assert np.array_equal(run("given", "--gravity", "-1.6", "--env-guidance", "1"), moon1)
+    assert main([*argv, "--env-guidance", "-1", "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "--env-guidance must be ≥ 0, got -1" in err and err.count("\n") == 1
+
+
+def test_generate_env_guidance_on_a_backbone_is_one_line(tmp_path: Path, capsys) -> None:
+    model = save_tiny(tmp_path / "backbone", sim=False)
+    code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--model", str(model), "--threads", "1",
+                 "--env-guidance", "2", "--format", "npy", "--out", str(tmp_path / "o"), "-q"])
+    err = capsys.readouterr().err
+    assert code == 2 and "env guidance needs a SimDiff model with a continuous Sim Encoder" in err
+    assert err.count("\n") == 1

@@ -101,6 +101,11 @@ def test_steps_and_other_numbers() -> None:
     with pytest.raises(SimdiffError, match="--foot-lock must be ≥ 0"):
         build_request("walk", foot_lock=-0.5)
     assert build_request("walk").foot_lock == 0.0 and build_request("walk", foot_lock=1).foot_lock == 1.0
+    with pytest.raises(SimdiffError, match="--env-guidance must be ≥ 0, got -1"):
+        build_request("walk", env_guidance=-1)
+    with pytest.raises(SimdiffError, match="--env-guidance must be a finite number"):
+        build_request("walk", env_guidance=float("inf"))
+    assert build_request("walk").env_guidance == 1.0 and build_request("walk", env_guidance=3).env_guidance == 3.0
     with pytest.raises(SimdiffError, match="--num-samples must be 1..64, got 0"):
         build_request("walk", num_samples=0)
     with pytest.raises(SimdiffError, match="--seed must be ≥ 0, got -2"):

@@ -340,3 +340,24 @@ def test_generate_takes_the_models_alpha_and_foot_lock_unless_given(server, mode
         assert call(server, "/api/info")[0] == 200  # the page still loads its defaults
     finally:
         (model_dir / "sampling.json").unlink()
+
+
+def test_generate_env_guidance_from_sampling_json_or_the_request(server, model_dir):
+    moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "gravity": -1.6}
+    status, plain, _ = call(server, "/api/generate", moon)
+    assert status == 200 and plain["meta"]["env_guidance"] == 1.0
+    status, pushed, _ = call(server, "/api/generate", {**moon, "env_guidance": 3})
+    assert status == 200 and pushed["meta"]["env_guidance"] == 3.0 and pushed["joints"] != plain["joints"]
+    earth = {**moon, "gravity": -9.81}
+    assert call(server, "/api/generate", {**earth, "env_guidance": 3})[1]["joints"] == \
+        call(server, "/api/generate", earth)[1]["joints"]  # Earth without wind: unchanged
+    (model_dir / "sampling.json").write_text('{"env_guidance": 3}')
+    try:
+        assert call(server, "/api/info")[1]["defaults"]["env_guidance"] == 3.0
+        status, stored, _ = call(server, "/api/generate", moon)
+        assert status == 200 and stored["joints"] == pushed["joints"]
+    finally:
+        (model_dir / "sampling.json").unlink()
+    for bad in (-1, 11, "x"):
+        status, out, _ = call(server, "/api/generate", {**moon, "env_guidance": bad})
+        assert status == 400 and "env_guidance" in out["error"]

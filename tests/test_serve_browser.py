@@ -144,6 +144,16 @@ def test_viewer_generates_regenerates_plays_and_opens(browser, server, tmp_path)
     third = wait_for_new_motion(page, locked["generation_id"])
     assert third["params"]["foot_lock"] == 0
 
+    # the environment-guidance slider starts at the model's value (none here: 1, off); moving it regenerates
+    assert third["params"]["env_guidance"] == 1 and page.input_value("#env_guidance") == "1"
+    page.fill("#env_guidance", "3")
+    pushed = wait_for_new_motion(page, third["generation_id"])
+    assert pushed["params"]["env_guidance"] == 3 and pushed["meta"]["env_guidance"] == 3
+    assert pushed["digest"] != third["digest"]  # g = −3: off Earth, so the motion changes
+    page.fill("#env_guidance", "1")
+    third = wait_for_new_motion(page, pushed["generation_id"])
+    assert third["params"]["env_guidance"] == 1
+
     # timeline: pause, scrub
     assert page.evaluate(f"{STATE}.playing") is True
     page.click("#play")

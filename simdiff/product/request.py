@@ -45,6 +45,7 @@ class GenerationRequest:
         guidance: classifier-free guidance scale (1 = off).
         alpha: adapter strength α (0 = backbone only).
         foot_lock: foot-lock strength in [0, 1] (0: off; :mod:`simdiff.motion.foot_lock`).
+        env_guidance: environment guidance s_e ≥ 0 (1: off; :mod:`simdiff.diffusion.guidance`).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
     """
@@ -60,6 +61,7 @@ class GenerationRequest:
     guidance: float = 2.5
     alpha: float = 1.0
     foot_lock: float = 0.0
+    env_guidance: float = 1.0
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
 
@@ -201,10 +203,10 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     """Apply a model's stored sampling settings (``sampling.json``) to the options the user did not give.
 
     Args:
-        stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock`` (see
+        stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance`` (see
             :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
-            ``foot_lock``).
+            ``foot_lock``, ``env_guidance``).
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -219,6 +221,8 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
         alpha=request.alpha if "alpha" in given else check_finite("alpha", stored.get("alpha", request.alpha)),
         foot_lock=(request.foot_lock if "foot_lock" in given
                    else check_unit("foot_lock", stored.get("foot_lock", request.foot_lock))),
+        env_guidance=(request.env_guidance if "env_guidance" in given
+                      else check_finite("env_guidance", stored.get("env_guidance", request.env_guidance), 0.0)),
     )
 
 
@@ -233,7 +237,7 @@ def check_unit(name: str, value: object) -> float:
 def build_request(text: str, *, gravity: float | None = None, wind: tuple[float, float] | None = None,
                   length_s: float | None = None, frames: int | None = None, seed: int = 0, num_samples: int = 1,
                   sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
-                  foot_lock: float = 0.0, compare: str | None = None, formats: str | None = None,
+                  foot_lock: float = 0.0, env_guidance: float = 1.0, compare: str | None = None, formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
     if seed < 0:
@@ -254,6 +258,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         guidance=check_finite("--guidance", guidance, 0.0),
         alpha=check_finite("--alpha", alpha),
         foot_lock=check_unit("--foot-lock", foot_lock),
+        env_guidance=check_finite("--env-guidance", env_guidance, 0.0),
         formats=parse_formats(formats, no_video),
         force=bool(force),
     )

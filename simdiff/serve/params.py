@@ -24,6 +24,8 @@ MAX_STEPS: int = 200
 model for at most about 4× a default generation, so a queue of them drains in bounded time."""
 GUIDANCE_RANGE: tuple[float, float] = (0.0, 20.0)
 """Classifier-free guidance scale bounds."""
+ENV_GUIDANCE_RANGE: tuple[float, float] = (0.0, 10.0)
+"""Environment guidance s_e bounds (1 = off)."""
 MAX_TEXT: int = MAX_PROMPT_CHARS
 """Longest prompt in characters (the same limit as ``simdiff generate``)."""
 
@@ -46,6 +48,8 @@ class GenerateParams:
             simulated motion and carries the generated one and the tracking result in ``meta``.
         foot_lock: foot-lock strength in [0, 1] (:mod:`simdiff.motion.foot_lock`), or None for the model's
             ``sampling.json`` value (0 without one), as ``simdiff generate``.
+        env_guidance: environment guidance s_e ≥ 0 (:mod:`simdiff.diffusion.guidance`), or None for the model's
+            ``sampling.json`` value (1, off, without one).
     """
 
     text: str
@@ -59,6 +63,7 @@ class GenerateParams:
     guidance: float = 2.5
     simulate: bool = False
     foot_lock: float | None = None
+    env_guidance: float | None = None
 
     @property
     def frames(self) -> int:
@@ -75,6 +80,7 @@ def limits() -> dict[str, Any]:
     return {
         "gravity": list(GRAVITY_RANGE), "wind": MAX_WIND, "alpha": list(ALPHA_RANGE), "seconds": MAX_SECONDS,
         "fps": FPS, "steps": MAX_STEPS, "guidance": list(GUIDANCE_RANGE), "text": MAX_TEXT,
+        "env_guidance": list(ENV_GUIDANCE_RANGE),
     }
 
 
@@ -106,7 +112,7 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
-            simulate, foot_lock}``;
+            simulate, foot_lock, env_guidance}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -150,5 +156,9 @@ def parse_generate(body: Any) -> GenerateParams:
     if foot_lock is not None:
         foot_lock = _number(body, "foot_lock", 0.0)
         _check_range("foot_lock", foot_lock, 0.0, 1.0)
+    env_guidance = body.get("env_guidance")
+    if env_guidance is not None:
+        env_guidance = _number(body, "env_guidance", 1.0)
+        _check_range("env_guidance", env_guidance, *ENV_GUIDANCE_RANGE)
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
-                          guidance=guidance, simulate=simulate, foot_lock=foot_lock, **wind)
+                          guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance, **wind)

@@ -145,8 +145,8 @@ class MotionService:
         return "simdiff" if config.sim.mode == "continuous" else "categorical"
 
     def _resolved(self, params: GenerateParams, strict: bool) -> GenerateParams:
-        """``params`` with the fields left None (α, foot lock) taken from the model's ``sampling.json``, as
-        ``simdiff generate`` does (α 1 and no foot lock without one). A bad file is the model's error when
+        """``params`` with the fields left None (α, foot lock, env guidance) taken from the model's ``sampling.json``,
+        as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
         from simdiff.product.request import check_finite, check_unit
@@ -156,11 +156,14 @@ class MotionService:
             alpha = params.alpha if params.alpha is not None else check_finite("alpha", stored.get("alpha", 1.0))
             lock = params.foot_lock if params.foot_lock is not None else check_unit("foot_lock",
                                                                                    stored.get("foot_lock", 0.0))
+            push = params.env_guidance if params.env_guidance is not None else check_finite(
+                "env_guidance", stored.get("env_guidance", 1.0), 0.0)
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
             alpha, lock = (1.0 if params.alpha is None else params.alpha), (params.foot_lock or 0.0)
-        return replace(params, alpha=float(alpha), foot_lock=float(lock))
+            push = 1.0 if params.env_guidance is None else params.env_guidance
+        return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push))
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -234,7 +237,8 @@ class MotionService:
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
                                      guidance=params.guidance, seed=params.seed, progress=self._progress,
-                                     foot_lock=params.foot_lock)
+                                     foot_lock=params.foot_lock,
+                                     **({"env_guidance": params.env_guidance} if uses_env else {}))
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count
@@ -242,6 +246,7 @@ class MotionService:
         joints = features_to_joints(features)
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
                 "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": params.foot_lock,
+                "env_guidance": params.env_guidance if uses_env else None,
                 "elapsed_s": round(elapsed, 3),
                 "queue_position": position, "waited_s": round(waited, 3)}
         if params.simulate:

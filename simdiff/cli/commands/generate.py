@@ -18,7 +18,8 @@ outputs (in --out, default ./out/<prompt>/), per sample K = 0, 1, ...:
   sampleK_features.npy   (T, 263) un-normalised HumanML3D features, one row per joint frame
   sampleK.bvh            BVH animation (metres, Y-up, 20 fps; Blender: scale 1)
   sampleK.gif            stick-figure animation (.mp4 with --format npy,bvh,mp4)
-  generation.json        prompt, environment, seed, sampler, steps, guidance, alpha, foot lock, model, timings
+  generation.json        prompt, environment, seed, sampler, steps, guidance, alpha, foot lock, env guidance,
+                         model, timings
 with --simulate, also (the final sample re-tracked in the simulator under the same φ):
   sampleK_simulated_joints.npy  (T', 22, 3) the simulator's motion (T' = T unless it fell or a flight
                                 lasted longer/shorter under φ); sampleK_simulated.bvh with bvh
@@ -75,6 +76,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--foot-lock", type=float, metavar="S",
                      help="move the root so the feet the motion marks planted do not slide, strength 0..1 "
                           "(0 = off; default 0, or the model's sampling.json)")
+    smp.add_argument("--env-guidance", type=float, metavar="S",
+                     help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off; "
+                          "motions under Earth without wind are unchanged (default 1, or the model's sampling.json)")
     out = p.add_argument_group("output")
     out.add_argument("--out", type=Path, metavar="DIR",
                      help="output folder, files in it are replaced (default ./out/<prompt>, or <prompt>-2, -3, ... "
@@ -111,7 +115,8 @@ def run(args: argparse.Namespace) -> int:
         args.text, gravity=args.gravity, wind=args.wind, length_s=args.length, frames=args.frames, seed=args.seed,
         num_samples=args.num_samples, sampler=args.sampler or "ddim", steps=args.steps,
         guidance=2.5 if args.guidance is None else args.guidance, alpha=1.0 if args.alpha is None else args.alpha,
-        foot_lock=0.0 if args.foot_lock is None else args.foot_lock, compare=args.compare, formats=args.format,
+        foot_lock=0.0 if args.foot_lock is None else args.foot_lock,
+        env_guidance=1.0 if args.env_guidance is None else args.env_guidance, compare=args.compare, formats=args.format,
         no_video=args.no_video, force=args.force,
     )
     if args.threads is not None and args.threads < 1:
@@ -140,7 +145,8 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     from simdiff.model.provenance import read_provenance
 
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
-    given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock") if getattr(args, name) is not None}
+    given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance")
+             if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")
     for env in request.envs:

@@ -4,7 +4,7 @@ import { api } from "./api.js";
 import { SkeletonPlayer } from "./player.js";
 
 const $ = (id) => document.getElementById(id);
-const SLIDERS = ["gravity", "wind_x", "wind_y", "alpha"];
+const SLIDERS = ["gravity", "wind_x", "wind_y", "alpha", "env_guidance"];
 
 const state = {
   status: "starting",  // starting | loading | generating | opening | ready | idle | error
@@ -62,7 +62,7 @@ function show(motion) {
     const p = meta.params;
     state.params = p;
     state.generation_id += 1;
-    caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${p.alpha.toFixed(2)}` : "");
+    caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${p.alpha.toFixed(2)}` + (p.env_guidance !== 1 ? ` · environment guidance ${p.env_guidance.toFixed(1)}` : "") : "");
     if (meta.simulated) caption += ` · simulated finish (${meta.simulated.status}, joint error ${Math.round(meta.simulated.err_mm)} mm)`;
     const waited = meta.queue_position ? ` after waiting ${meta.waited_s.toFixed(1)} s behind ${meta.queue_position} request(s)` : "";
     setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s${waited}.`);
@@ -84,6 +84,7 @@ function readParams() {
   return {
     text: $("prompt").value.trim() || $("prompt").placeholder,
     gravity: value("gravity"), wind_x: value("wind_x"), wind_y: value("wind_y"), alpha: value("alpha"),
+    env_guidance: value("env_guidance"),
     seconds: value("seconds"), seed: Math.round(value("seed")),
     simulate: Boolean($("simulate") && $("simulate").checked),
     foot_lock: $("foot_lock") && $("foot_lock").checked ? 1 : 0,
@@ -126,6 +127,7 @@ function configure(info) {
   const { limits, defaults } = info;
   const ranges = {
     gravity: limits.gravity, wind_x: [-limits.wind, limits.wind], wind_y: [-limits.wind, limits.wind], alpha: limits.alpha,
+    env_guidance: limits.env_guidance,
   };
   for (const id of SLIDERS) {
     const input = $(id);
