@@ -42,6 +42,8 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--guidance", type=float, default=2.5)
     p.add_argument("--alpha", type=float, default=1.0, help="adapter strength of SimDiff models")
     p.add_argument("--foot-lock", type=float, default=0.0, help="foot-lock strength in [0, 1] (0: off)")
+    p.add_argument("--env-guidance", type=float, default=1.0,
+                   help="environment guidance s_e of SimDiff models (1: off; changes only motions off Earth)")
     p.add_argument("--workers", type=int, default=0, help="simulator processes (0: all cores)")
     p.add_argument("--no-response", action="store_true", help="skip the physics-response section")
     p.add_argument("--speed", action="store_true", help="also run benchmarks/bench_generate.py (3 runs)")
@@ -82,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or str(ROOT / "reports" / "model_check" / Path(args.model).resolve().name)
         config = CheckConfig(model=args.model, corpus=args.corpus, evaluator=args.evaluator, out=out, seeds=args.seeds,
                              steps=args.steps, guidance=args.guidance, alpha=args.alpha,
-                             foot_lock=args.foot_lock, device=args.device,
+                             foot_lock=args.foot_lock, env_guidance=args.env_guidance, device=args.device,
                              split=SplitOptions(split=args.split, n=args.n),
                              prompts=PromptOptions(jump_samples=args.jump_samples, speed_samples=args.speed_samples,
                                                    length=args.length),

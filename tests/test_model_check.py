@@ -243,3 +243,18 @@ def test_backbone_has_no_response_section(checked: dict, tmp_path: Path) -> None
     by = {v["check"]: v for v in report["verdicts"]}
     assert by["gravity_rise"]["passed"] is None and by["wind_downwind"]["passed"] is None
     assert by["sliding"]["passed"] is not None and "skipped" in report["generation_speed"]
+
+
+def test_env_guidance_measures_only_the_response_again(checked: dict, tmp_path: Path) -> None:
+    import shutil
+
+    shutil.copytree(checked["root"] / "out" / "parts", tmp_path / "out" / "parts")
+    config = _config(checked["paths"], tmp_path / "out")
+    config.env_guidance = 3.0
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert all(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))  # Earth motions: unchanged
+    assert not report["response"]["gravity"].get("cached") and not report["response"]["wind"].get("cached")
+    assert report["settings"]["env_guidance"] == 3.0 and "env guidance 3.0" in (tmp_path / "out" / "check.md").read_text()
+    with pytest.raises(SimdiffError, match="--env-guidance must be a finite number ≥ 0, got -1"):
+        CheckConfig(**{**config.__dict__, "env_guidance": -1.0}).validate()

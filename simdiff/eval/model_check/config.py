@@ -88,7 +88,8 @@ class CheckConfig:
         out: report folder (``check.json``, ``check.md``, ``parts/``).
         seeds: one protocol replication per seed; the prompt checks split their samples over them.
         steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models; foot_lock: the
-            generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`).
+            generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`); env_guidance: environment
+            guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth).
         device: torch device; quick: the smoke preset was applied (reported).
     """
 
@@ -101,6 +102,7 @@ class CheckConfig:
     guidance: float = 2.5
     alpha: float = 1.0
     foot_lock: float = 0.0
+    env_guidance: float = 1.0
     device: str = "cpu"
     quick: bool = False
     split: SplitOptions = field(default_factory=SplitOptions)
@@ -123,6 +125,8 @@ class CheckConfig:
                 raise SimdiffError(f"{name} must be at least {low}, got {value}")
         if not 0.0 <= self.foot_lock <= 1.0:
             raise SimdiffError(f"--foot-lock must be in [0, 1], got {self.foot_lock}")
+        if not 0.0 <= self.env_guidance < float("inf"):
+            raise SimdiffError(f"--env-guidance must be a finite number ≥ 0, got {self.env_guidance}")
         if self.prompts.length > 196:
             raise SimdiffError(f"--length must be at most 196 frames, got {self.prompts.length}")
         model, corpus, evaluator = Path(self.model), Path(self.corpus), Path(self.evaluator)

@@ -144,7 +144,7 @@ class ModelCheck:
             c = self.config
             self._sets[key] = generate_set(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
                                            steps=c.steps, guidance=c.guidance, progress=self.progress,
-                                           foot_lock=c.foot_lock)
+                                           foot_lock=c.foot_lock, env_guidance=c.env_guidance)
         return self._sets[key]
 
     # --- sections ---------------------------------------------------------------------------
@@ -162,7 +162,8 @@ class ModelCheck:
             dataset = HumanML3D(c.corpus, c.split.split, seed=c.seeds[0])
             env = self.env(EARTH)
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
-                              steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock)
+                              steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock,
+                              env_guidance=c.env_guidance)
             return measure_split(evaluator, dataset, fn, c.split, c.seeds, self.progress)
 
         return self.part("test_split", {"corpus": _stamp(c.corpus, f"{c.split.split}.txt"), "evaluator": _stamp(c.evaluator),
@@ -206,7 +207,9 @@ class ModelCheck:
             return {"skipped": f"the model is a {self.kind} model without a continuous Sim Encoder: no φ to respond to"}
         if not c.response.enabled:
             return {"skipped": "turned off (--no-response)"}
-        inputs = {"options": c.response.__dict__, "prompts": c.prompts.__dict__, "injected": self._injected is not None}
+        inputs = {"options": c.response.__dict__, "prompts": c.prompts.__dict__, "injected": self._injected is not None,
+                  # the only sections off Earth: environment guidance leaves the Earth sections' motions as they are
+                  **({"env_guidance": c.env_guidance} if c.env_guidance != 1.0 else {})}
         jumps = self.jump_batches()
         grav = self.part("gravity", {**inputs, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: gravity_response(
             units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, (MOON_G, 0.0, 0.0)), MOON_G,
