@@ -456,3 +456,28 @@ def test_the_simulated_finish_anchors_planted_feet_and_physdiff_does_not(setup: 
         runner.close()
     injected = EchoProjector()
     assert Runner(load_config(write(setup, "table1", name="t1_inj")), projector=injected).finish_sim is injected
+
+
+def test_env_response_row_with_env_guidance(setup: dict[str, Path]) -> None:
+    control = {"prompts": ["a person jumps"], "seeds": 2, "length": 24, "gravity": [-3.0], "wind": [5.0], "combos": [],
+               "resamples": 50}
+    models = [{"name": "SimDiff", "model": "adapters", **FAST},
+              {"name": "SimDiff eg3", "model": "adapters", "env_guidance": 3.0, **FAST}]
+    report = run_experiment(write(setup, "env_response", name="env_eg", env_control=control, models=models),
+                            projector=PhysicsStandIn(), progress=False, text_encoder=hash_text)
+    rows = {r["method"]: r for r in report["rows"]}
+
+    def gen(row: dict, env: tuple) -> list:
+        return [r["gen"] for r in row["records"] if tuple(r["env"]) == env]
+
+    earth, low = (-9.81, 0.0, 0.0), (-3.0, 0.0, 0.0)
+    assert gen(rows["SimDiff"], earth) == gen(rows["SimDiff eg3"], earth)  # Earth motions: unchanged
+    assert gen(rows["SimDiff"], low) != gen(rows["SimDiff eg3"], low)
+    bad = [{"name": "MDM", "model": "backbone", "env_guidance": 2.0, **FAST}]
+    with pytest.raises(SimdiffError, match="env_guidance 2 needs continuous SimDiff adapters"):
+        run_experiment(write(setup, "env_response", name="env_bad", env_control=control, models=bad),
+                       projector=PhysicsStandIn(), progress=False, text_encoder=hash_text)
+    neg = [{"name": "SimDiff", "model": "adapters", "env_guidance": -1, **FAST}]
+    with pytest.raises(SimdiffError, match="env_guidance must be a finite number ≥ 0, got -1"):
+        run_experiment(write(setup, "env_response", name="env_neg", env_control=control, models=neg),
+                       projector=PhysicsStandIn(), progress=False, text_encoder=hash_text)

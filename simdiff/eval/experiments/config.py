@@ -41,6 +41,8 @@ class ModelSpec:
         alpha: adapter strength where the experiment does not sweep it.
         steps: DDIM steps (None: 50); ddpm_steps: DDPM steps (None: all 1000).
         guidance: classifier-free guidance scale.
+        env_guidance: environment guidance s_e of continuous SimDiff models (1: off;
+            :mod:`simdiff.diffusion.guidance`).
         physdiff: :class:`simdiff.baselines.physdiff.PhysDiffConfig` fields → PhysDiff sampling
             (the row's sampler, steps and φ are filled in by the experiment).
         simulate: simulated finish: each final sample is re-tracked under its φ (Earth for
@@ -63,6 +65,7 @@ class ModelSpec:
     steps: int | None = None
     ddpm_steps: int | None = None
     guidance: float = 2.5
+    env_guidance: float = 1.0
     physdiff: dict[str, Any] | None = None
     simulate: bool = False
     alphas: list[float | str] | None = None
@@ -344,6 +347,9 @@ def check(config: ExperimentConfig, origin: str | os.PathLike[str] = "config") -
             raise SimdiffError(f"{origin}: model {spec.name!r} needs 'model' (a role) or 'path'")
         if spec.model and not spec.path and spec.model not in config.paths:
             raise SimdiffError(f"{origin}: model {spec.name!r} names role {spec.model!r}, which 'paths' does not define")
+        if not 0.0 <= float(spec.env_guidance) < float("inf"):
+            raise SimdiffError(f"{origin}: model {spec.name!r} env_guidance must be a finite number ≥ 0, "
+                               f"got {spec.env_guidance!r}")
         if spec.samplers is not None:
             extra = [s for s in spec.samplers if s not in config.samplers]
             if extra or not spec.samplers:

@@ -256,6 +256,8 @@ class Runner:
                                "steps": spec.sampler_steps(sampler), "guidance": spec.guidance,
                                "alpha": alpha, "env": None if env is None else [float(v) for v in env],
                                "env_index": spec.env_index, "device": self.config.device}
+        if spec.env_guidance != 1.0:  # absent when off: the rows measured before it existed stay current
+            out["env_guidance"] = float(spec.env_guidance)
         if self.backbone_of_simdiff(spec):
             out["backbone_only"] = True  # the folder's SimDiff model, adapters left out
         if spec.physdiff is not None:
@@ -285,6 +287,9 @@ class Runner:
 
     def generate_fn(self, spec: ModelSpec, sampler: str, alpha: float | None = None, env: Any = None) -> GenerateFn:
         """``(captions, lengths, seed) -> (B, T, 263)`` raw features for one method row."""
+        if spec.env_guidance != 1.0 and self.sim_mode(spec) != "continuous":
+            raise SimdiffError(f"model {spec.name!r}: env_guidance {spec.env_guidance:g} needs continuous SimDiff "
+                               "adapters (φ does not reach this method)")
         gen = self.model(spec)
         phys = self.physdiff_config(spec, sampler, env) if spec.physdiff is not None else None
         use_env = None
@@ -294,7 +299,8 @@ class Runner:
                             alpha=spec.alpha if alpha is None else float(alpha), sampler=sampler,
                             steps=spec.sampler_steps(sampler), guidance=spec.guidance, physdiff=phys,
                             projector=self.sim if phys is not None else None, simulate=spec.simulate,
-                            finish_projector=self.finish_sim if spec.simulate else None)
+                            finish_projector=self.finish_sim if spec.simulate else None,
+                            env_guidance=spec.env_guidance)
 
     def generate(self, fn: GenerateFn, captions: list[str], lengths: list[int], seed: int) -> tuple[torch.Tensor, float]:
         """Generate in batches of the protocol's size; returns ((N, T, 263) features, seconds)."""
