@@ -243,6 +243,9 @@ def test_backbone_has_no_response_section(checked: dict, tmp_path: Path) -> None
     by = {v["check"]: v for v in report["verdicts"]}
     assert by["gravity_rise"]["passed"] is None and by["wind_downwind"]["passed"] is None
     assert by["sliding"]["passed"] is not None and "skipped" in report["generation_speed"]
+    config.env_guidance = 2.0
+    with pytest.raises(SimdiffError, match="--env-guidance needs a SimDiff model with a continuous Sim Encoder"):
+        ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(), progress=False).run()
 
 
 def test_env_guidance_measures_only_the_response_again(checked: dict, tmp_path: Path) -> None:

@@ -19,7 +19,6 @@ from simdiff.errors import SimdiffError
 if TYPE_CHECKING:
     from simdiff.model.condition import Condition
 
-
 Denoiser = Callable[[Tensor, Tensor, "Condition"], Tensor]
 """``denoiser(x_t (B,T,F), t (B,) int64, cond) -> x̂₀ (B,T,F)``."""
 
@@ -87,4 +86,3 @@ class GuidedDenoiser:
         sub = cond.select(rows)
         ref = torch.tensor(self.reference_env, dtype=sub.env.dtype, device=sub.env.device)  # type: ignore[union-attr]
         return replace(sub, env=ref.expand_as(sub.env).clone())  # type: ignore[arg-type]
-

@@ -235,6 +235,9 @@ class ModelCheck:
         kind = self.kind
         if kind == "categorical":
             raise SimdiffError(f"{c.model}: a categorical SimDiff model; the check needs a backbone or a continuous one")
+        if c.env_guidance != 1.0 and kind != "continuous":
+            raise SimdiffError(f"{c.model}: --env-guidance needs a SimDiff model with a continuous Sim Encoder; "
+                               f"this is a {kind} model (leave it at 1)")
         report: dict[str, Any] = {"schema": SCHEMA, "model": {**_stamp(c.model), "kind": kind},
                                   "corpus": str(Path(c.corpus).resolve()), "evaluator": _stamp(c.evaluator),
                                   "settings": c.as_dict(), "provenance": provenance(c.seeds[0], c.device, self.command)}
