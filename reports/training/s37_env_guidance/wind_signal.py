@@ -1,7 +1,9 @@
 """Wind signal in an augmented corpus: root drift along the wind of each wind rollout minus its Earth rollout.
 
-Usage: python wind_signal.py AUG_DIR   (an `simdiff data augment` output with env.json and new_joints/)
-Prints quartiles of the drift per 10 N over the clip and per second (metres; HumanML3D axes: w_x → +X, w_y → +Z).
+Usage: python wind_signal.py AUG_DIR [CORPUS_DIR]   (AUG_DIR: a `simdiff data augment` output with env.json and
+new_joints/; CORPUS_DIR: its corpus, whose manifest.json gives each source clip's motion_type)
+Prints quartiles of the drift per 10 N over the clip and per second (metres; HumanML3D axes: w_x → +X, w_y → +Z),
+and per motion type when the corpus is given.
 """
 
 import json
@@ -11,12 +13,17 @@ from pathlib import Path
 import numpy as np
 
 root = Path(sys.argv[1])
+types: dict[str, str] = {}
+if len(sys.argv) > 2:
+    manifest = json.loads((Path(sys.argv[2]) / "manifest.json").read_text())
+    types = {c["id"]: str(c.get("motion_type")) for c in manifest["clips"]}
 env = json.loads((root / "env.json").read_text())
 by_source: dict[str, dict[int, tuple[str, dict]]] = {}
 for key, value in env.items():
     by_source.setdefault(value["source"], {})[value["condition"]] = (key, value)
 per_clip, per_second, seconds = [], [], []
-for conds in by_source.values():
+by_type: dict[str, list[float]] = {}
+for source, conds in by_source.items():
     if 0 not in conds or not (root / "new_joints" / f"{conds[0][0]}.npy").is_file():
         continue
     earth = np.load(root / "new_joints" / f"{conds[0][0]}.npy")
@@ -33,8 +40,12 @@ for conds in by_source.values():
         per_clip.append(drift * np.sign(w) * 10 / abs(w))
         per_second.append(per_clip[-1] / (n / 20))
         seconds.append(n / 20)
+        by_type.setdefault(types.get(source, "?"), []).append(per_second[-1])
 q = [25, 50, 75]
 print(f"pairs {len(per_clip)}; downwind {np.mean(np.array(per_clip) > 0):.3f}")
 print("clip seconds", np.round(np.percentile(seconds, q), 2))
 print("drift per 10 N over the clip (m)", np.round(np.percentile(per_clip, q), 4))
 print("drift per 10 N per second (m/s)", np.round(np.percentile(per_second, q), 4))
+if types:
+    for kind, rates in sorted(by_type.items(), key=lambda item: -len(item[1])):
+        print(f"  {kind}: {len(rates)} pairs, per second", np.round(np.percentile(rates, q), 4))
