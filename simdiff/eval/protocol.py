@@ -84,6 +84,16 @@ class ProtocolConfig:
     def max_batches(self) -> int:
         return self.samples_limit // self.batch_size + 1
 
+    def generation_seed(self, replication: int) -> int:
+        """Noise seed of batch 0 of a replication (batch k adds k)."""
+        return self.seed * 1_000_003 + replication * 1009
+
+    def seeds_used(self) -> dict[str, Any]:
+        """The seeds of a run (stated in every report): data draws and generation noise per replication."""
+        return {"base": self.seed, "data_draw": [[self.seed, r] for r in range(self.replications)],
+                "generation": [self.generation_seed(r) for r in range(self.replications)],
+                "note": "batch k of replication r adds k to its generation seed"}
+
 
 def _draw(dataset: Any, rng: np.random.Generator, config: ProtocolConfig) -> list[dict[str, Any]]:
     """This replication's batches of collated GT items (raw features added)."""
@@ -152,7 +162,7 @@ def evaluate_t2m(evaluator: Evaluator, dataset: Any, generate: GenerateFn | None
             gen_emb, phys, seconds = [], [], 0.0
             for k, b in enumerate(batches):
                 start = time.perf_counter()
-                feats = generate(list(b["captions"]), [int(n) for n in b["lengths"]], config.seed * 1_000_003 + r * 1009 + k)
+                feats = generate(list(b["captions"]), [int(n) for n in b["lengths"]], config.generation_seed(r) + k)
                 seconds += time.perf_counter() - start
                 gen_emb.append(evaluator.embed_motion(feats, b["lengths"]))
                 if config.physics:

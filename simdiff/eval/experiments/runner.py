@@ -336,7 +336,7 @@ class Runner:
         out = {"summary": result["summary"]["generated"], "replications": [r["generated"] for r in reps],
                "s_per_motion": float(np.mean([r["gen_s_per_sample"] for r in reps])),
                "samples_per_replication": result["samples_per_replication"], "replications_run": len(reps),
-               "split_size": result["split_size"], "seeds": protocol_seeds(proto)}
+               "split_size": result["split_size"], "seeds": proto.seeds_used()}
         if spec.simulate and getattr(fn, "finish_log", None):
             out["finish"] = finish_summary(fn.finish_log)
         return out
@@ -346,7 +346,7 @@ class Runner:
         result = evaluate_t2m(self.evaluator, self.dataset, None, self.config.protocol, self.progress)
         return {"summary": result["summary"]["ground_truth"], "samples_per_replication": result["samples_per_replication"],
                 "replications_run": len(result["replications"]), "split_size": result["split_size"],
-                "seeds": protocol_seeds(self.config.protocol)}
+                "seeds": self.config.protocol.seeds_used()}
 
     def subset_measure(self, spec: ModelSpec, sampler: str, alpha: float | None, n: int, env: Any = None) -> dict[str, Any]:
         """Physics metrics and time of ``n`` generated test motions (too few for the T2M metrics)."""
@@ -483,13 +483,6 @@ class Runner:
             bar.set_postfix_str(f"{plan.key} (~{plan.estimate_s / 60:.1f} min)")
             rows.append(self.fetch(plan))
         return rows
-
-
-def protocol_seeds(proto: ProtocolConfig) -> dict[str, Any]:
-    """The seeds a protocol row used (stated in every report): data draws and generation noise per replication."""
-    return {"base": proto.seed, "data_draw": [[proto.seed, r] for r in range(proto.replications)],
-            "generation": [proto.seed * 1_000_003 + r * 1009 for r in range(proto.replications)],
-            "note": "batch k of replication r adds k to its generation seed"}
 
 
 def _stamp(path: str) -> dict[str, Any]:
