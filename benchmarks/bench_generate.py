@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_generate.py [--model DIR] [--preset small] [--threads 2] [--length 6]
-        [--repeats 3] [--no-video] [--json out.json]
+        [--repeats 3] [--no-video] [--env-guidance S [S ...]] [--json out.json]
 
 Each repeat runs the real command in a fresh interpreter (``python -m simdiff generate ...``) and
 times it from outside: interpreter start and imports, model load (weights + MiniLM), text
@@ -13,6 +13,11 @@ imports, argument checks). Wall seconds and CPU seconds (user + system of the ch
 reported: on a machine shared with other jobs the wall time grows with their load while the CPU
 time does not (with one thread it is close to the wall time the command takes on an idle machine).
 One extra run under ``python -X importtime`` lists the heaviest imports.
+
+``--env-guidance 1 2`` times the command with each environment-guidance value in turn (repeat i runs
+every value before repeat i + 1, so a change of load hits them alike) and reports each value's
+summary and its median wall time as a ratio to the first value's, measured in one run; without it
+the command uses the model's ``sampling.json``.
 
 Without ``--model`` the shipped default model is used when installed, else a random model of
 ``--preset`` size (speed does not depend on the weights) with the CMU feature statistics.
@@ -53,10 +58,12 @@ def random_model(folder: Path, preset: str) -> Path:
     return folder
 
 
-def command(model: Path, out: Path, threads: int, length: float, no_video: bool) -> list[str]:
+def command(model: Path, out: Path, threads: int, length: float, no_video: bool,
+            env_guidance: float | None = None) -> list[str]:
     cmd = [sys.executable, "-m", "simdiff", "generate", README_TEXT, *README_ENV, "--model", str(model),
            "--out", str(out), "--length", f"{length:g}", "-q"]
-    return cmd + (["--threads", str(threads)] if threads else []) + (["--no-video"] if no_video else [])
+    return (cmd + (["--threads", str(threads)] if threads else []) + (["--no-video"] if no_video else [])
+            + (["--env-guidance", f"{env_guidance:g}"] if env_guidance is not None else []))
 
 
 def timed_run(cmd: list[str], out: Path) -> dict:
@@ -150,8 +157,14 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3, help="timed runs (default 3)")
     parser.add_argument("--no-video", action="store_true", help="skip the GIF")
     parser.add_argument("--no-importtime", action="store_true", help="skip the -X importtime run")
+    parser.add_argument("--env-guidance", type=float, nargs="+", metavar="S",
+                        help="time the command with each of these environment-guidance values in turn and report "
+                             "the ratios to the first (default: the model's sampling.json)")
     parser.add_argument("--json", type=Path, help="also write the results here")
     args = parser.parse_args()
+    if args.repeats < 1:
+        raise SystemExit(f"bench_generate: --repeats must be at least 1, got {args.repeats}")
+    values: list[float | None] = list(args.env_guidance) if args.env_guidance else [None]
 
     from simdiff.model.default import DEFAULT_MODEL_DIR
 
@@ -165,13 +178,17 @@ def main() -> None:
             model, kind = random_model(tmp_dir / "model", args.preset), f"random {args.preset} SimDiff"
         config = json.loads((Path(model) / "config.json").read_text())
         load_before = os.getloadavg()
-        runs = []
+        by_value: dict[int, list[dict]] = {j: [] for j in range(len(values))}
         for i in range(args.repeats):
-            out = tmp_dir / f"out{i}"
-            runs.append(timed_run(command(model, out, args.threads, args.length, args.no_video), out))
-            print(f"run {i}: wall {runs[-1]['wall_s']:.2f} s, cpu {runs[-1]['cpu_s']:.2f} s", file=sys.stderr)
+            for j, value in enumerate(values):
+                out = tmp_dir / f"out{i}_{j}"
+                run = timed_run(command(model, out, args.threads, args.length, args.no_video, value), out)
+                by_value[j].append(run)
+                label = "" if value is None else f" (env guidance {value:g})"
+                print(f"run {i}{label}: wall {run['wall_s']:.2f} s, cpu {run['cpu_s']:.2f} s", file=sys.stderr)
+        runs = by_value[0]
         imports = None if args.no_importtime else import_profile(
-            command(model, tmp_dir / "imp", args.threads, args.length, args.no_video))
+            command(model, tmp_dir / "imp", args.threads, args.length, args.no_video, values[0]))
         imports_cpu = import_cpu()
         load_after = os.getloadavg()
 
@@ -180,7 +197,8 @@ def main() -> None:
         "benchmark": "bench_generate",
         "command": " ".join(["simdiff", "generate", repr(README_TEXT), *README_ENV, "--length", f"{args.length:g}"]
                             + (["--threads", str(args.threads)] if args.threads else [])
-                            + (["--no-video"] if args.no_video else [])),
+                            + (["--no-video"] if args.no_video else [])
+                            + (["--env-guidance", f"{values[0]:g}"] if values[0] is not None else [])),
         "model": {"kind": kind, "path": str(model), "latent_dim": config["backbone"]["latent_dim"],
                   "num_layers": config["backbone"]["num_layers"], "simdiff": config["sim"] is not None},
         "sampler": "ddim-50, guidance 2.5 (batched CFG)",
@@ -194,6 +212,12 @@ def main() -> None:
         "imports_cpu_s": imports_cpu,
         "runs": runs,
     }
+    if len(values) > 1:
+        first = summary["wall_s"]["median"]
+        result["env_guidance"] = [
+            {"value": value, "summary": summarise(by_value[j]), "runs": by_value[j],
+             "wall_ratio_to_first": round(statistics.median(r["wall_s"] for r in by_value[j]) / first, 3)}
+            for j, value in enumerate(values)]
     text = json.dumps(result, indent=2)
     print(text)
     if args.json:
