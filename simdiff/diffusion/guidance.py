@@ -52,7 +52,7 @@ class GuidedDenoiser:
 
     def __call__(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
         """x: (B, T, F), timesteps: (B,) → guided x̂₀ (B, T, F)."""
-        rows = self._env_rows(cond)
+        rows, ref = self._plan(cond)
         if self.scale == 1.0:
             cond_out = guided = self.denoiser(x, timesteps, cond)
         else:
@@ -63,26 +63,24 @@ class GuidedDenoiser:
                 cond_out = self.denoiser(x, timesteps, cond)
                 uncond_out = self.denoiser(x, timesteps, cond.unconditional())
             guided = uncond_out + self.scale * (cond_out - uncond_out)
-        if rows is None:
+        if rows is None or ref is None:  # nothing off the reference φ
             return guided
         # a pass of its own, so that the rows above are computed exactly as without environment guidance
-        ref_out = self.denoiser(x[rows], timesteps[rows], self._reference(cond, rows))
+        ref_out = self.denoiser(x[rows], timesteps[rows], ref)
         guided = guided.clone()
         guided[rows] += (self.env_scale - 1.0) * (cond_out[rows] - ref_out)
         return guided
 
-    def _env_rows(self, cond: Condition) -> Tensor | None:
-        """(K,) indices of the rows environment guidance changes; None when it changes none."""
+    def _plan(self, cond: Condition) -> tuple[Tensor | None, Condition | None]:
+        """((K,) indices of the rows environment guidance changes, their condition with φ set to the reference), or
+        (None, None) when it changes none (a few small tensor operations per step, next to a network pass)."""
         if self.env_scale == 1.0:
-            return None
+            return None, None
         if cond.env is None:
             raise SimdiffError("environment guidance needs a SimDiff model with a continuous Sim Encoder (φ as numbers)")
-        ref = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
-        rows = torch.nonzero((cond.env != ref).any(dim=-1)).flatten()
-        return rows if rows.numel() else None
-
-    def _reference(self, cond: Condition, rows: Tensor) -> Condition:
-        """The conditional condition of ``rows`` with φ set to the reference."""
+        phi = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
+        rows = torch.nonzero((cond.env != phi).any(dim=-1)).flatten()
+        if not rows.numel():
+            return None, None
         sub = cond.select(rows)
-        ref = torch.tensor(self.reference_env, dtype=sub.env.dtype, device=sub.env.device)  # type: ignore[union-attr]
-        return replace(sub, env=ref.expand_as(sub.env).clone())  # type: ignore[arg-type]
+        return rows, replace(sub, env=phi.expand_as(sub.env).clone())  # type: ignore[arg-type]

@@ -78,4 +78,3 @@ class Condition:
 
         alpha = self.alpha.to(device) if isinstance(self.alpha, Tensor) else self.alpha
         return Condition(mv(self.text), mv(self.uncond), mv(self.frame_mask), mv(self.env), mv(self.env_index), alpha)
-

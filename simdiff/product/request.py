@@ -198,6 +198,10 @@ def check_finite(name: str, value: float, minimum: float | None = None) -> float
     return value
 
 
+STORED_NUMBERS: tuple[str, ...] = ("guidance", "alpha", "foot_lock", "env_guidance")
+"""The numeric ``sampling.json`` settings."""
+
+
 def with_model_defaults(request: GenerationRequest, stored: dict[str, float | int | str],
                         given: set[str]) -> GenerationRequest:
     """Apply a model's stored sampling settings (``sampling.json``) to the options the user did not give.
@@ -217,13 +221,18 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
         steps = steps_for(sampler, stored.get("steps"))  # type: ignore[arg-type]
     return replace(
         request, sampler=sampler, steps=steps,
-        guidance=request.guidance if "guidance" in given else check_finite("guidance", stored.get("guidance", request.guidance), 0.0),
-        alpha=request.alpha if "alpha" in given else check_finite("alpha", stored.get("alpha", request.alpha)),
-        foot_lock=(request.foot_lock if "foot_lock" in given
-                   else check_unit("foot_lock", stored.get("foot_lock", request.foot_lock))),
-        env_guidance=(request.env_guidance if "env_guidance" in given
-                      else check_finite("env_guidance", stored.get("env_guidance", request.env_guidance), 0.0)),
+        **{name: getattr(request, name) if name in given else stored_setting(stored, name, getattr(request, name))
+           for name in STORED_NUMBERS},
     )
+
+
+def stored_setting(stored: dict[str, float | int | str], name: str, default: float) -> float:
+    """A model's stored value of the numeric setting ``name`` (``default`` when it has none), checked as the
+    option is: ``foot_lock`` in [0, 1], ``alpha`` finite, the others finite and ≥ 0 (one-line errors naming it)."""
+    value = stored.get(name, default)
+    if name == "foot_lock":
+        return check_unit(name, value)
+    return check_finite(name, value, None if name == "alpha" else 0.0)  # type: ignore[arg-type]
 
 
 def check_unit(name: str, value: object) -> float:

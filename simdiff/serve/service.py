@@ -149,15 +149,13 @@ class MotionService:
         as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import check_finite, check_unit
+        from simdiff.product.request import stored_setting
 
         try:
             stored = sampling_defaults(self.model_dir)
-            alpha = params.alpha if params.alpha is not None else check_finite("alpha", stored.get("alpha", 1.0))
-            lock = params.foot_lock if params.foot_lock is not None else check_unit("foot_lock",
-                                                                                   stored.get("foot_lock", 0.0))
-            push = params.env_guidance if params.env_guidance is not None else check_finite(
-                "env_guidance", stored.get("env_guidance", 1.0), 0.0)
+            alpha = params.alpha if params.alpha is not None else stored_setting(stored, "alpha", 1.0)
+            lock = params.foot_lock if params.foot_lock is not None else stored_setting(stored, "foot_lock", 0.0)
+            push = params.env_guidance if params.env_guidance is not None else stored_setting(stored, "env_guidance", 1.0)
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
