@@ -8,7 +8,7 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints, process_joints
-from simdiff.motion.foot_lock import CONTACT_JOINTS, lock_feet, lock_feet_numpy
+from simdiff.motion.foot_lock import CONTACT_JOINTS, clean_feet, lock_feet, lock_feet_numpy
 
 
 def _clip(frames: int = 40, speed: float = 0.03) -> np.ndarray:
@@ -98,7 +98,26 @@ def test_generator_applies_the_lock_to_the_final_sample() -> None:
     b = gen.generate(["walk"] * 2, [24, 16], steps=3, seed=1, foot_lock=1.0)
     lens = torch.tensor([24, 16])
     valid = torch.arange(24)[None, :, None] < lens[:, None, None]
-    assert torch.allclose(b.features, lock_feet(a.features, lens) * valid, atol=1e-5)
+    assert torch.allclose(b.features, clean_feet(a.features, lens) * valid, atol=1e-5)
     mask = torch.arange(24)[None] < lens[:, None]
     assert torch.allclose((b.normalized * gen.std + gen.mean)[mask], b.features[mask], atol=1e-4)
     assert torch.equal(b.normalized[~mask], a.normalized[~mask])
+
+
+def test_clean_feet_locks_then_clears_at_one_strength() -> None:
+    from simdiff.motion.foot_clearance import clear_swing_feet
+
+    f = torch.as_tensor(_clip())
+    f[:, SLICES["contacts"].start : SLICES["contacts"].start + 2] = 0.0  # the left leg swings unplanted: it is lifted after the lock
+    for s in (0.0, 0.5, 1.0):
+        assert torch.allclose(clean_feet(f, strength=s), clear_swing_feet(lock_feet(f, strength=s), strength=s))
+    assert not torch.allclose(clean_feet(f), lock_feet(f), atol=1e-4)
+
+
+def test_an_explicit_planted_mask_replaces_the_channels() -> None:
+    f = torch.as_tensor(_clip())
+    channels = f[..., SLICES["contacts"]] > 0.5
+    assert torch.equal(lock_feet(f, planted=channels), lock_feet(f))
+    assert torch.equal(lock_feet(f, planted=torch.zeros_like(channels)), f)  # nothing planted: nothing moves
+    with pytest.raises(SimdiffError, match=r"planted must be \(1, 40, 4\) booleans, got \(40, 2\)"):
+        lock_feet(f, planted=channels[:, :2])

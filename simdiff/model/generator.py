@@ -122,8 +122,9 @@ class MotionGenerator:
             seed: noise seed (None: nondeterministic).
             text_embeddings: (B, text_dim) precomputed text vectors instead of encoding ``texts``.
             x0_hook, hook_timesteps: replace x̂₀ at chosen t (PhysDiff projection).
-            foot_lock: strength in [0, 1] of :func:`simdiff.motion.foot_lock.lock_feet` applied to the final
-                sample (0: off): the root is moved so the joints the sample marks in contact do not slide.
+            foot_lock: strength in [0, 1] of :func:`simdiff.motion.foot_lock.clean_feet` applied to the final
+                sample (0: off): the root is moved so the joints the sample marks in contact do not slide, then
+                swinging feet that drag along the floor are lifted 2 cm clear of it (knee re-solved).
             env_guidance: s_e ≥ 0 (1 = off): the adapters' answer to φ against Earth without wind is pushed s_e
                 times as far (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only. Motions under
                 Earth without wind are unchanged; the others cost one more network pass per step.
@@ -157,9 +158,9 @@ class MotionGenerator:
                    progress=progress, env_guidance=env_guidance)
         features = (x * self.std + self.mean) * mask[..., None]
         if foot_lock and frames >= 2:  # one frame has no step to correct
-            from simdiff.motion.foot_lock import lock_feet
+            from simdiff.motion.foot_lock import clean_feet
 
-            features = lock_feet(features, lens, foot_lock) * mask[..., None]
+            features = clean_feet(features, lens, foot_lock) * mask[..., None]
             x = torch.where(mask[..., None], (features - self.mean) / self.std, x)
         return Generation(features=features, normalized=x, lengths=lens)
 

@@ -7,7 +7,9 @@ by the pivot's displacement, frame by frame, so it keeps its place and the rest 
 the root's horizontal velocity changes (and, to keep the features consistent, the joint-velocity channels by the
 same amount); poses, heights, the root's yaw and the contact channels are untouched, so a flight or a crouch is
 exactly as generated. It is the classic root-trajectory part of foot-skate cleanup, not inverse kinematics: two
-planted feet that slide apart (a split) keep the lower one in place, not both.
+planted feet that slide apart (a split) keep the lower one in place, not both. The generator's ``foot_lock``
+applies :func:`clean_feet`: this lock, then :mod:`simdiff.motion.foot_clearance` (swinging feet that drag along
+the floor are lifted clear of it, the knee re-solved), both at the same strength.
 """
 
 from __future__ import annotations
@@ -22,6 +24,10 @@ from simdiff.motion.skeleton import FOOT_LEFT, FOOT_RIGHT
 CONTACT_JOINTS: tuple[int, int, int, int] = (*FOOT_LEFT, *FOOT_RIGHT)
 """Joints of the four contact channels, in channel order (left ankle, left toe, right ankle, right toe)."""
 
+CLEANUP_VERSION: int = 2
+"""What the generator's ``foot_lock`` does: 1 the lock alone (sessions 36-37), 2 the lock and the swing-foot
+clearance (:func:`clean_feet`). Cached measurements made with a foot lock carry it in their fingerprint."""
+
 CONTACT_THRESHOLD: float = 0.5
 """A contact channel above this marks its joint as planted (the channels are 0/1 in the data)."""
 
@@ -32,13 +38,16 @@ def _yaw_rotate(half: torch.Tensor, x: torch.Tensor, z: torch.Tensor) -> tuple[t
     return c * x + s * z, -s * x + c * z
 
 
-def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, strength: float = 1.0) -> torch.Tensor:
+def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, strength: float = 1.0,
+              planted: torch.Tensor | None = None) -> torch.Tensor:
     """Features whose planted feet do not slide (see the module docstring).
 
     Args:
         features: (B, T, 263) or (T, 263) un-normalised HumanML3D features (20 fps, metres, Y-up).
         lengths: (B,) valid frames (None: all T); frames past a length are returned unchanged.
         strength: share of each planted slide taken out, in [0, 1] (1: planted joints keep their place).
+        planted: (B, T, 4) or (T, 4) bool, which contact joints are planted, in place of the contact channels
+            (None: the channels, > :data:`CONTACT_THRESHOLD`); for experiments with other contact rules.
     Returns:
         Features of the same shape, dtype and device.
     """
@@ -53,7 +62,12 @@ def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, stren
     valid = (torch.arange(t)[None] < lens[:, None]).to(f.device)  # (B, T)
     joints = features_to_joints(f)  # (B, T, 22, 3)
     feet = joints[:, :, list(CONTACT_JOINTS)][..., [0, 2]]  # (B, T, 4, 2)
-    planted = f[..., SLICES["contacts"]] > CONTACT_THRESHOLD  # (B, T, 4)
+    if planted is None:
+        planted = f[..., SLICES["contacts"]] > CONTACT_THRESHOLD  # (B, T, 4)
+    else:
+        if tuple(planted.shape[-2:]) != (t, 4) or planted.numel() != b * t * 4:
+            raise SimdiffError(f"planted must be ({b}, {t}, 4) booleans, got {tuple(planted.shape)}")
+        planted = planted.reshape(b, t, 4).to(device=f.device, dtype=torch.bool)
     both = planted[:, 1:] & planted[:, :-1] & valid[:, 1:, None]  # (B, T-1, 4): planted through the pair
     step = feet[:, 1:] - feet[:, :-1]  # (B, T-1, 4, 2)
     # The pivot: of the joints planted through the pair, the lowest one at its start (the heel at a strike, the
@@ -79,6 +93,19 @@ def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, stren
     return out[0] if single else out
 
 
+def clean_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, strength: float = 1.0) -> torch.Tensor:
+    """The generator's foot cleanup at ``strength``: planted feet locked (:func:`lock_feet`), then swinging feet
+    lifted clear of the floor (:func:`simdiff.motion.foot_clearance.clear_swing_feet`). Shapes as :func:`lock_feet`."""
+    from simdiff.motion.foot_clearance import clear_swing_feet
+
+    return clear_swing_feet(lock_feet(features, lengths, strength), lengths, strength)
+
+
 def lock_feet_numpy(features: np.ndarray, strength: float = 1.0) -> np.ndarray:
     """:func:`lock_feet` for one (T, 263) numpy clip (float32 out)."""
     return lock_feet(torch.as_tensor(np.asarray(features, dtype=np.float32)), strength=strength).numpy()
+
+
+def clean_feet_numpy(features: np.ndarray, strength: float = 1.0) -> np.ndarray:
+    """:func:`clean_feet` for one (T, 263) numpy clip (float32 out)."""
+    return clean_feet(torch.as_tensor(np.asarray(features, dtype=np.float32)), strength=strength).numpy()

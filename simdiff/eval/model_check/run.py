@@ -21,6 +21,7 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.eval.model_check.config import EARTH, JUMP_PROMPTS, MOON_G, SPEED_PROMPTS, WIND_N, CheckConfig
 from simdiff.eval.model_check.samples import PromptBatch, generate_set, plan_batches, units
+from simdiff.motion.foot_lock import CLEANUP_VERSION
 
 SCHEMA: str = "simdiff.model_check/1"
 
@@ -112,8 +113,9 @@ class ModelCheck:
     # --- parts ------------------------------------------------------------------------------
     def base_inputs(self) -> dict[str, Any]:
         c = self.config
+        lock = {"foot_lock": c.foot_lock, "foot_cleanup": CLEANUP_VERSION} if c.foot_lock else {}
         return {"schema": SCHEMA, "model": _stamp(c.model), "seeds": c.seeds, "steps": c.steps, "guidance": c.guidance,
-                "alpha": c.alpha, "device": c.device, **({"foot_lock": c.foot_lock} if c.foot_lock else {})}
+                "alpha": c.alpha, "device": c.device, **lock}
 
     def part(self, name: str, inputs: dict[str, Any], measure: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         """The stored result of section ``name`` when its fingerprint matches, else measured and stored."""
