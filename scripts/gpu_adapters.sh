@@ -13,7 +13,8 @@
 # Device command (repository root; device timeout_s 570):
 #   OUT=$OUT AUG_PACK=.gpu/aug TEXT_TABLE=.gpu/captions.safetensors BACKBONE=.gpu/backbone \
 #     RUNS="plain:0 pair10:10" bash scripts/gpu_adapters.sh
-# RUNS: space-separated NAME:LAMBDA (λ of --env-pairs; 0 = the paper's plain loss).
+# RUNS: space-separated NAME:LAMBDA[:MU] (λ of --env-pairs, 0 = the paper's plain loss; MU of --env-pairs-drift,
+#   the twins' mean root-velocity term, default 0).
 # Overrides: CONFIG (configs/adapters_paired_gpu.json) SPLIT (all) MINUTES (7) LOADER_WORKERS (cores / runs)
 #   DEVICE (cuda) PYTHON (python) ADAPTERS_INIT (a SimDiff folder to warm-start the adapters from) SEED
 set -uo pipefail
@@ -49,10 +50,11 @@ watcher=$!
 mkdir -p "$WORK/logs"
 pids=()
 for r in $RUNS; do
-  n=${r%%:*}; lam=${r#*:}
-  log "train $n: --env-pairs $lam --max-minutes $MINUTES --loader-workers $LOADER_WORKERS"
+  n=${r%%:*}; rest=${r#*:}; lam=${rest%%:*}; mu=0
+  [ "$rest" != "$lam" ] && mu=${rest#*:}
+  log "train $n: --env-pairs $lam --env-pairs-drift $mu --max-minutes $MINUTES --loader-workers $LOADER_WORKERS"
   "$PY" -m simdiff train adapters --data "${data[@]}" --split "$SPLIT" --init "$BACKBONE" --out "$WORK/$n" \
-    --config "$CONFIG" --env-pairs "$lam" --device "$DEVICE" --text-table "$TEXT_TABLE" --max-minutes "$MINUTES" \
+    --config "$CONFIG" --env-pairs "$lam" --env-pairs-drift "$mu" --device "$DEVICE" --text-table "$TEXT_TABLE" --max-minutes "$MINUTES" \
     --loader-workers "$LOADER_WORKERS" --no-progress ${ADAPTERS_INIT:+--adapters-init "$ADAPTERS_INIT"} \
     ${SEED:+--seed "$SEED"} > "$WORK/logs/$n.log" 2>&1 &
   pids+=($!)

@@ -156,6 +156,11 @@ def test_adapters_train_on_a_simulator_augmented_corpus(runs, tmp_path, capsys) 
     assert main(["train", "adapters", "--data", str(tmp_path / "aug"), "--source", str(corpus),
                  "--init", str(runs / "bb" / "model"), "--steps", "1", "--env-pairs", "-1", "--out", str(tmp_path / "ad4"), "--no-progress"]) == 2
     assert "env_pairs must be a finite weight >= 0, got -1.0" in capsys.readouterr().err
+    assert main(["train", "adapters", "--data", str(tmp_path / "aug"), "--source", str(corpus), "--init",
+                 str(runs / "bb" / "model"), "--steps", "1", "--env-pairs-drift", "3", "--out", str(tmp_path / "ad5"),
+                 "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "env_pairs_drift = 3.0 needs env_pairs > 0" in err and err.count("\n") == 1
     # Adapters refuse a corpus without φ.
     assert main(["train", "adapters", "--data", str(corpus), "--init", str(runs / "bb" / "model"),
                  "--steps", "1", "--out", str(tmp_path / "ad2"), "--no-progress"]) == 2

@@ -225,3 +225,50 @@ def test_pipeline_adapters_stage_hashes_env_pairs_only_when_on(tmp_path: Path) -
     assert "env_pairs" not in off  # the same hash as before the setting existed: older runs stay current
     ctx.config.adapters.env_pairs = 10.0
     assert adapters_settings(ctx) == {**off, "env_pairs": 10.0}
+
+
+def test_twin_drift_mse_compares_mean_root_velocity_differences() -> None:
+    from simdiff.diffusion.losses import twin_drift_mse
+
+    g = torch.Generator().manual_seed(0)
+    x0 = torch.randn(4, 10, 263, generator=g)  # twins: items 0,1 and 2,3
+    mask = torch.ones(4, 10, dtype=torch.bool)
+    paired = torch.tensor([True, True])
+    assert float(twin_drift_mse(x0, x0, mask, paired)) == 0.0
+    noisy = x0.clone()
+    wiggle = torch.randn(2, 10, 2, generator=g)
+    noisy[:2, :, 1:3] += wiggle - wiggle.mean(dim=1, keepdim=True)  # per-frame change, same window means
+    noisy[:, :, 3:] += 1.0  # other channels do not count
+    assert float(twin_drift_mse(noisy, x0, mask, paired)) < 1e-10
+    drift = x0.clone()
+    drift[2:, :, 1] -= 0.3  # the twin drifts 0.3 less along x: the true mean difference grows by 0.3 on one channel
+    assert abs(float(twin_drift_mse(x0, drift, mask, paired)) - 0.3**2 / 2) < 1e-6
+    short = mask.clone()
+    short[0, 5:] = False  # only the frames valid in both twins are averaged
+    only_late = x0.clone()
+    only_late[0, 5:, 1] += 9.0
+    assert float(twin_drift_mse(only_late, x0, short, torch.tensor([True, False]))) < 1e-10
+    assert float(twin_drift_mse(drift, x0, mask, torch.tensor([False, False]))) == 0.0
+
+
+def test_trainer_validates_env_pairs_drift(tmp_path: Path) -> None:
+    ds = synthetic_dataset(4, 20, max_frames=20, with_env=True)
+    bb = _backbone(tmp_path)
+    with pytest.raises(SimdiffError, match="env_pairs_drift = 1.0 needs env_pairs > 0"):
+        Trainer(tmp_path / "a", run_config(2, mode="adapters", sim=True, env_pairs_drift=1.0), ds,
+                text_encoder=HashText(), init_model=bb)
+    with pytest.raises(SimdiffError, match="env_pairs_drift must be a finite weight >= 0, got -1.0"):
+        Trainer(tmp_path / "b", run_config(2, mode="adapters", sim=True, env_pairs=1.0, env_pairs_drift=-1.0), ds,
+                text_encoder=HashText(), init_model=bb)
+
+
+def test_drift_term_trains_and_changes_the_run(tmp_path: Path) -> None:
+    bb = _backbone(tmp_path)
+    ds = ShiftTwins()
+    losses = {}
+    for name, mu in (("pairs", 0.0), ("drift", 100.0)):
+        cfg = run_config(6, mode="adapters", sim=True, env_pairs=10.0, env_pairs_drift=mu, batch_size=6, seed=4)
+        trainer = Trainer(tmp_path / name, cfg, ds, text_encoder=HashText(), init_model=bb)
+        losses[name] = trainer.train(progress=False)
+    assert all(np.isfinite(losses["drift"]))
+    assert losses["drift"][0] > losses["pairs"][0]  # the same first batch, one more non-negative term

@@ -203,19 +203,20 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
     env = {**os.environ, "OUT": str(out), "DEVICE": "cpu",
            "AUG_PACK": f"{tmp_path / 'packs' / 'aug'} {tmp_path / 'packs' / 'aug2'}",
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
-           "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5", "LOADER_WORKERS": "0",
+           "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5:2", "LOADER_WORKERS": "0",
            "MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
            "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
                           text=True, timeout=240)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     assert sorted(p.name for p in out.iterdir()) == ["pair5.tar", "plain.tar", "run.log"]
-    for name, lam in (("plain", 0.0), ("pair5", 5.0)):
+    for name, lam, mu in (("plain", 0.0, 0.0), ("pair5", 5.0, 2.0)):
         with tarfile.open(out / f"{name}.tar") as tar:
             tar.extractall(tmp_path / "back" / name, filter="data")
         run = tmp_path / "back" / name
         assert json.loads((run / "train_log.jsonl").read_text().splitlines()[-1])["step"] == 2
-        assert json.loads((run / "train_config.json").read_text())["train"]["env_pairs"] == lam
+        train = json.loads((run / "train_config.json").read_text())["train"]
+        assert (train["env_pairs"], train["env_pairs_drift"]) == (lam, mu)
         assert "trained adapters to step 2" in (run / f"{name}.log").read_text()
         assert len(json.loads((run / "model" / "provenance.json").read_text())["trained_on"]) == 3  # bb + 2 parts
         assert MotionGenerator.load(run / "model", load_text=False).is_simdiff

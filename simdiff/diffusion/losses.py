@@ -41,6 +41,25 @@ def twin_difference_mse(pred: Tensor, x0: Tensor, mask: Tensor, paired: Tensor) 
     return masked_mse((pred[:h] - pred[h:])[keep], (x0[:h] - x0[h:])[keep], (mask[:h] & mask[h:])[keep])
 
 
+def twin_drift_mse(pred: Tensor, x0: Tensor, mask: Tensor, paired: Tensor, channels: slice = slice(1, 3)) -> Tensor:
+    """Squared error of the twins' difference in *mean* root velocity (items i and i + B/2, rows with ``paired``).
+
+    For each paired twin, the root-velocity ``channels`` (default HumanML3D's heading-frame x, z: 1:3) are averaged
+    over the frames valid in both, and the predicted difference of those means is compared with the true one;
+    mean over twins and channels. A steady drift (wind pushing a walker) is a per-frame change of a few per cent of
+    the root speed, buried in the frame-by-frame differences of two rollouts; averaged over the window it is the
+    whole signal. pred, x0: (B, T, F) normalised features; mask: (B, T) bool; paired: (B/2,) bool. 0 when none.
+    """
+    h = x0.shape[0] // 2
+    if not bool(paired.any()):
+        return pred.new_zeros(())
+    keep = paired.nonzero().flatten()
+    m = (mask[:h] & mask[h:])[keep].to(pred.dtype)[..., None]  # (K, T, 1)
+    frames = m.sum(dim=1).clamp_min(1.0)  # (K, 1)
+    mean_diff = lambda x: ((x[:h] - x[h:])[keep][..., channels] * m).sum(dim=1) / frames  # noqa: E731
+    return ((mean_diff(pred) - mean_diff(x0)) ** 2).mean()
+
+
 def diffusion_prediction(denoiser: Denoiser, scheduler: BaseScheduler, x0: Tensor, cond: Condition,
                          generator: torch.Generator | None = None) -> Tensor:
     """Draw t ~ U{0..T−1} and ε ~ N(0, I), noise ``x0`` to x_t and return the predicted x₀ (B, T, F)."""

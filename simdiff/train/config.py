@@ -41,6 +41,9 @@ class TrainConfig:
             ``λ · MSE(x̂₀(φ) − x̂₀(φ'), x₀(φ) − x₀(φ'))``: the response to φ, which the plain loss sees only as a
             small part of each sample's error. The frozen backbone then runs without dropout so twin
             predictions differ only through φ.
+        env_pairs_drift: weight μ of the twins' mean root-velocity term (needs ``env_pairs`` > 0; 0 = off):
+            ``μ · (mean_t Δx̂₀_root − mean_t Δx₀_root)²`` (:func:`simdiff.diffusion.losses.twin_drift_mse`), the
+            steady drift a wind gives a walker, which the per-frame pair loss weighs as a tiny part of its error.
     """
 
     mode: str = "backbone"
@@ -57,6 +60,7 @@ class TrainConfig:
     losses: GeometricLossConfig = field(default_factory=GeometricLossConfig)
     crop: CropConfig = field(default_factory=CropConfig)
     env_pairs: float = 0.0
+    env_pairs_drift: float = 0.0
 
 
 @dataclass

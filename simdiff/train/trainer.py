@@ -22,7 +22,7 @@ import torch
 from torch import Tensor, nn
 
 from simdiff.diffusion.ddpm import DDPMScheduler
-from simdiff.diffusion.losses import diffusion_prediction, masked_mse, twin_difference_mse
+from simdiff.diffusion.losses import diffusion_prediction, masked_mse, twin_difference_mse, twin_drift_mse
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import build_network, load_pretrained, save_pretrained
 from simdiff.model.condition import Condition
@@ -90,6 +90,10 @@ class Trainer:
             raise SimdiffError(f"training mode must be backbone or adapters, got {tc.mode!r}")
         if not (math.isfinite(tc.env_pairs) and tc.env_pairs >= 0):
             raise SimdiffError(f"env_pairs must be a finite weight >= 0, got {tc.env_pairs}")
+        if not (math.isfinite(tc.env_pairs_drift) and tc.env_pairs_drift >= 0):
+            raise SimdiffError(f"env_pairs_drift must be a finite weight >= 0, got {tc.env_pairs_drift}")
+        if tc.env_pairs_drift > 0 and not tc.env_pairs > 0:
+            raise SimdiffError(f"env_pairs_drift = {tc.env_pairs_drift} needs env_pairs > 0 (the drift term compares twins)")
         if tc.env_pairs > 0 and tc.mode != "adapters":
             raise SimdiffError(f"env_pairs = {tc.env_pairs} needs adapters mode (the φ-difference loss trains the adapters)")
         with torch.random.fork_rng(devices=[]):
@@ -262,7 +266,10 @@ class Trainer:
         if tc.losses.active:
             loss = loss + geometric_loss(pred, x0, mask, self.mean, self.std, tc.losses)
         if "paired" in batch:
-            loss = loss + tc.env_pairs * self._pair_loss(pred, x0, mask, batch["paired"].to(self.device))
+            paired = batch["paired"].to(self.device)
+            loss = loss + tc.env_pairs * self._pair_loss(pred, x0, mask, paired)
+            if tc.env_pairs_drift > 0:
+                loss = loss + tc.env_pairs_drift * twin_drift_mse(pred, x0, mask, paired)
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
         if tc.optim.grad_clip > 0:

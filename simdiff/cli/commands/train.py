@@ -70,6 +70,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--env-pairs", type=float, metavar="WEIGHT",
                    help="weight of the paired φ-difference loss on twin clips (a paired augmentation; 0 = off, "
                         "the paper's loss); see TrainConfig.env_pairs")
+    a.add_argument("--env-pairs-drift", type=float, metavar="WEIGHT",
+                   help="weight of the twins' mean root-velocity (drift) term, with --env-pairs (0 = off); see "
+                        "TrainConfig.env_pairs_drift")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -116,6 +119,8 @@ def _run_config(args: argparse.Namespace):
         tc.optim.lr = args.lr
     if getattr(args, "env_pairs", None) is not None:
         tc.env_pairs = args.env_pairs
+    if getattr(args, "env_pairs_drift", None) is not None:
+        tc.env_pairs_drift = args.env_pairs_drift
     if tc.steps < 1 or tc.batch_size < 1:
         raise SimdiffError("--steps and --batch-size must be positive")
     if args.loader_workers < 0:

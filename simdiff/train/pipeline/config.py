@@ -82,6 +82,8 @@ class AdapterStage:
     max_minutes: float = 0.0
     env_pairs: float = 0.0
     """Weight of the paired φ-difference loss (``TrainConfig.env_pairs``; needs a paired augmentation)."""
+    env_pairs_drift: float = 0.0
+    """Weight of the twins' mean root-velocity term (``TrainConfig.env_pairs_drift``; with ``env_pairs``)."""
 
 
 @dataclass

@@ -89,8 +89,9 @@ def backbone_settings(ctx: PipelineContext) -> dict[str, Any]:
 
 def adapters_settings(ctx: PipelineContext) -> dict[str, Any]:
     settings = _train_settings(ctx, "adapters")
-    if not settings.get("env_pairs"):  # off: hashed as before the setting existed, so older runs stay current
-        settings.pop("env_pairs", None)
+    for name in ("env_pairs", "env_pairs_drift"):  # off: hashed as before the setting existed, so runs stay current
+        if not settings.get(name):
+            settings.pop(name, None)
     return settings
 
 
@@ -137,7 +138,7 @@ def run_adapters(ctx: PipelineContext) -> dict[str, Any]:
     model.sim = SimConfig(mode=a.sim_mode)
     train = TrainConfig(mode="adapters", steps=a.steps, batch_size=a.batch_size, seed=seed, ema=a.ema,
                         ema_decay=a.ema_decay, save_every=a.save_every, optim=OptimConfig(lr=a.lr),
-                        env_pairs=a.env_pairs)
+                        env_pairs=a.env_pairs, env_pairs_drift=a.env_pairs_drift)
     dataset = open_training_dataset(ctx.augmented_dir(), "train", seed)
     if len(dataset) == 0:
         raise SimdiffError(f"{ctx.augmented_dir()}: the augmented corpus kept no training clip "
