@@ -1,0 +1,19 @@
+"""Val-split quality (R@3, FID) of samples generated under a non-Earth φ: model_check with EARTH replaced."""
+import sys
+import torch
+import simdiff.eval.model_check.run as R
+from simdiff.eval.model_check import CheckConfig, ModelCheck
+from simdiff.eval.model_check.config import PromptOptions, ResponseOptions, SplitOptions
+
+phi = tuple(float(v) for v in sys.argv[1].split(","))
+se, out = float(sys.argv[2]), sys.argv[3]
+torch.set_num_threads(2)
+R.EARTH = phi
+E = "/work/scratch/s29"
+c = CheckConfig(model=sys.argv[4], corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=out, seeds=[0],
+                steps=20, guidance=2.5, alpha=0.5, foot_lock=1.0, env_guidance=se,
+                split=SplitOptions(split="val", n=128), prompts=PromptOptions(jump_samples=16, speed_samples=8),
+                response=ResponseOptions(enabled=False))
+rep = ModelCheck(c.validate(), progress=False, command=sys.argv).run()
+f = rep["figures"]
+print(phi, se, {k: f.get(k) for k in ("r_precision_top3", "fid", "jump_fraction", "sliding_own_floor", "skate_ratio", "walk_median", "run_median")})
