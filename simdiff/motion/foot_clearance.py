@@ -20,7 +20,9 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints
+from simdiff.motion.foot_lock import CONTACT_THRESHOLD
 from simdiff.motion.metrics import OWN_FLOOR_PERCENTILE
+from simdiff.motion.skeleton import FPS
 
 LEGS: tuple[tuple[int, int, int, int, int, int], ...] = ((1, 4, 7, 10, 0, 1), (2, 5, 8, 11, 2, 3))
 """Per leg: hip, knee, ankle, toe joint and the ankle's and toe's contact channel (left, right)."""
@@ -90,14 +92,14 @@ def clear_swing_feet(features: torch.Tensor, lengths: torch.Tensor | None = None
     joints = features_to_joints(f)  # (B, T, 22, 3)
     lowest = joints[..., 1].min(-1).values.masked_fill(~valid, float("nan"))
     floor = torch.nanquantile(lowest, OWN_FLOOR_PERCENTILE / 100.0, dim=1)  # (B,)
-    planted = f[..., SLICES["contacts"]] > 0.5  # (B, T, 4)
+    planted = f[..., SLICES["contacts"]] > CONTACT_THRESHOLD  # (B, T, 4)
     half = torch.zeros_like(f[..., 0])
     half[:, 1:] = torch.cumsum(f[:, :-1, 0], dim=1)
     delta = torch.zeros_like(joints)  # (B, T, 22, 3) world displacement per joint
     forward = torch.stack([-torch.sin(2 * half), torch.zeros_like(half), torch.cos(2 * half)], dim=-1)  # +Z unrotated
     for hip, knee, ankle, toe, c_ankle, c_toe in LEGS:
         foot = joints[:, :, [ankle, toe]]  # (B, T, 2, 3)
-        step = (foot[:, 1:, :, [0, 2]] - foot[:, :-1, :, [0, 2]]).norm(dim=-1).amax(-1) * 20.0  # (B, T-1) m/s
+        step = (foot[:, 1:, :, [0, 2]] - foot[:, :-1, :, [0, 2]]).norm(dim=-1).amax(-1) * FPS  # (B, T-1) m/s
         pair_ok = valid[:, 1:] & (step > min_speed)
         moving = torch.zeros_like(valid)
         moving[:, 1:] |= pair_ok
