@@ -20,7 +20,7 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints
-from simdiff.motion.foot_lock import CONTACT_THRESHOLD
+from simdiff.motion.foot_lock import CONTACT_THRESHOLD, batch_features, yaw_rotate
 from simdiff.motion.metrics import OWN_FLOOR_PERCENTILE
 from simdiff.motion.skeleton import FPS
 
@@ -36,9 +36,8 @@ speed)."""
 
 def _world_to_heading(half: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     """World vectors (..., 3) into the heading frame of yaw half-angle ``half`` (...) (features' convention)."""
-    c, s = torch.cos(2 * half), torch.sin(2 * half)
-    x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    return torch.stack([c * x + s * z, y, -s * x + c * z], dim=-1)
+    x, z = yaw_rotate(half, v[..., 0], v[..., 2])
+    return torch.stack([x, v[..., 1], z], dim=-1)
 
 
 def _perpendicular(v: torch.Tensor, u: torch.Tensor) -> torch.Tensor:
@@ -82,13 +81,8 @@ def clear_swing_feet(features: torch.Tensor, lengths: torch.Tensor | None = None
         raise SimdiffError(f"swing-foot clearance strength must be in [0, 1], got {strength}")
     if not clearance >= 0.0 or not min_speed >= 0.0:
         raise SimdiffError(f"clearance and min_speed must be >= 0, got {clearance} and {min_speed}")
-    single = features.dim() == 2
-    f = (features[None] if single else features).detach().to(torch.float64).clone()
-    if f.shape[-1] != 263 or f.shape[-2] < 2:
-        raise SimdiffError(f"swing-foot clearance needs (B, T >= 2, 263) features, got {tuple(features.shape)}")
+    f, single, valid = batch_features(features, lengths, "swing-foot clearance")  # valid: (B, T)
     b, t = f.shape[:2]
-    lens = torch.full((b,), t, dtype=torch.long) if lengths is None else torch.as_tensor(lengths).long().cpu()
-    valid = (torch.arange(t)[None] < lens[:, None]).to(f.device)  # (B, T)
     joints = features_to_joints(f)  # (B, T, 22, 3)
     lowest = joints[..., 1].min(-1).values.masked_fill(~valid, float("nan"))
     floor = torch.nanquantile(lowest, OWN_FLOOR_PERCENTILE / 100.0, dim=1)  # (B,)

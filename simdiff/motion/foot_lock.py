@@ -32,7 +32,19 @@ CONTACT_THRESHOLD: float = 0.5
 """A contact channel above this marks its joint as planted (the channels are 0/1 in the data)."""
 
 
-def _yaw_rotate(half: torch.Tensor, x: torch.Tensor, z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+def batch_features(features: torch.Tensor, lengths: torch.Tensor | None, what: str) -> tuple[torch.Tensor, bool, torch.Tensor]:
+    """A float64 working copy (B, T, 263) of (B, T, 263) or (T, 263) features, whether the input was one clip, and
+    the (B, T) bool mask of valid frames (``lengths`` (B,), None: all T); ``what`` names the caller in the error."""
+    single = features.dim() == 2
+    f = (features[None] if single else features).detach().to(torch.float64).clone()
+    if f.shape[-1] != 263 or f.shape[-2] < 2:
+        raise SimdiffError(f"{what} needs (B, T >= 2, 263) features, got {tuple(features.shape)}")
+    b, t = f.shape[:2]
+    lens = torch.full((b,), t, dtype=torch.long) if lengths is None else torch.as_tensor(lengths).long().cpu()
+    return f, single, (torch.arange(t)[None] < lens[:, None]).to(f.device)
+
+
+def yaw_rotate(half: torch.Tensor, x: torch.Tensor, z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
     """World (x, z) into the root-facing frame of yaw half-angle ``half`` (inverse of features' un-rotation)."""
     c, s = torch.cos(2 * half), torch.sin(2 * half)
     return c * x + s * z, -s * x + c * z
@@ -53,13 +65,8 @@ def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, stren
     """
     if not 0.0 <= strength <= 1.0:
         raise SimdiffError(f"foot-lock strength must be in [0, 1], got {strength}")
-    single = features.dim() == 2
-    f = (features[None] if single else features).detach().to(torch.float64).clone()
-    if f.shape[-1] != 263 or f.shape[-2] < 2:
-        raise SimdiffError(f"foot lock needs (B, T >= 2, 263) features, got {tuple(features.shape)}")
+    f, single, valid = batch_features(features, lengths, "foot lock")
     b, t = f.shape[:2]
-    lens = torch.full((b,), t, dtype=torch.long) if lengths is None else torch.as_tensor(lengths).long().cpu()
-    valid = (torch.arange(t)[None] < lens[:, None]).to(f.device)  # (B, T)
     joints = features_to_joints(f)  # (B, T, 22, 3)
     feet = joints[:, :, list(CONTACT_JOINTS)][..., [0, 2]]  # (B, T, 4, 2)
     if planted is None:
@@ -80,11 +87,11 @@ def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, stren
     half = torch.zeros_like(f[..., 0])
     half[:, 1:] = torch.cumsum(f[:, :-1, 0], dim=1)  # root yaw half-angle per frame, as features_to_joints
     # Root linear velocity at row t-1 is the step t-1 -> t in the frame of yaw(t).
-    dx, dz = _yaw_rotate(half[:, 1:], shift[..., 0], shift[..., 1])
+    dx, dz = yaw_rotate(half[:, 1:], shift[..., 0], shift[..., 1])
     f[:, :-1, 1] += dx
     f[:, :-1, 2] += dz
     # Joint velocities at row t-1 (the step t-1 -> t of every joint, in the frame of yaw(t-1)): the same shift.
-    vx, vz = _yaw_rotate(half[:, :-1], shift[..., 0], shift[..., 1])
+    vx, vz = yaw_rotate(half[:, :-1], shift[..., 0], shift[..., 1])
     vel = f[:, :-1, SLICES["vel"]].reshape(b, t - 1, -1, 3)
     vel[..., 0] += vx[..., None]
     vel[..., 2] += vz[..., None]

@@ -10,7 +10,8 @@ se, out = float(sys.argv[2]), sys.argv[3]
 torch.set_num_threads(2)
 R.EARTH = phi
 E = "/work/scratch/s29"
-c = CheckConfig(model="simdiff/assets/default_model", corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=out, seeds=[0],
+model = sys.argv[4] if len(sys.argv) > 4 else "simdiff/assets/default_model"  # session 38: another model folder
+c = CheckConfig(model=model, corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=out, seeds=[0],
                 steps=20, guidance=2.5, alpha=0.5, foot_lock=1.0, env_guidance=se,
                 split=SplitOptions(split="val", n=128), prompts=PromptOptions(jump_samples=16, speed_samples=8),
                 response=ResponseOptions(enabled=False))
