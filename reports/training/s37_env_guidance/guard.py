@@ -1,4 +1,5 @@
 """Val-split quality (R@3, FID) of samples generated under a non-Earth φ: model_check with EARTH replaced."""
+import os
 import sys
 import torch
 import simdiff.eval.model_check.run as R
@@ -9,7 +10,7 @@ phi = tuple(float(v) for v in sys.argv[1].split(","))
 se, out = float(sys.argv[2]), sys.argv[3]
 torch.set_num_threads(2)
 R.EARTH = phi
-E = "/work/scratch/s29"
+E = os.environ.get("SIMDIFF_SCRATCH", "/work/scratch/s29")  # session 39: the corpus3/ and eval/ folder
 model = sys.argv[4] if len(sys.argv) > 4 else "simdiff/assets/default_model"  # session 38: another model folder
 c = CheckConfig(model=model, corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=out, seeds=[0],
                 steps=20, guidance=2.5, alpha=0.5, foot_lock=1.0, env_guidance=se,

@@ -1,0 +1,5 @@
+bash stageB.sh shipped /work/main/simdiff/assets/default_model
+bash stageB.sh ws_d20 /work/scratch/s39/gpu/ws_d20/model
+bash stageC.sh shipped /work/main/simdiff/assets/default_model
+bash stageC.sh ws_d20 /work/scratch/s39/gpu/ws_d20/model
+echo ALLDONE
