@@ -1,0 +1,15 @@
+# usage: check.sh STAGE NAME MODEL — rule 11's model_check runs (scratch in /work/scratch/s39, out eval11/STAGE_NAME)
+#   A: selection seeds 100 101, val n 32, response on   B: val n 128 seeds 0 1, no response
+#   T: test n 256 seeds 0-4, response on                 Tq: the same without the response
+cd /work/main; . .venv/bin/activate
+S=/work/scratch/s39
+case $1 in
+  A) args="--split val --n 32 --seeds 100 101 --workers 2";;
+  B) args="--split val --n 128 --seeds 0 1 --no-response";;
+  T) args="--split test --n 256 --seeds 0 1 2 3 4 --workers 2";;
+  Tq) args="--split test --n 256 --seeds 0 1 2 3 4 --no-response";;
+  *) echo "check.sh: unknown stage '$1' (A, B, T or Tq)" >&2; exit 2;;
+esac
+/usr/bin/time -f "stage$1 $2 %e s" python benchmarks/model_check.py --model $3 --corpus $S/corpus3 --evaluator $S/eval \
+  $args --jump-samples 16 --speed-samples 8 --steps 20 --alpha 0.5 --foot-lock 1 --env-guidance 2 --threads 2 \
+  --out $S/eval11/${1:0:1}_$2 -q

@@ -1,5 +1,0 @@
-cd /work/main; . .venv/bin/activate
-S=/work/scratch/s39
-/usr/bin/time -f "test $1 %e s" python benchmarks/model_check.py --model $2 --corpus $S/corpus3 --evaluator $S/eval \
-  --split test --n 256 --seeds 0 1 2 3 4 --jump-samples 16 --speed-samples 8 --steps 20 --alpha 0.5 --foot-lock 1 --env-guidance 2 --threads 2 \
-  --workers 2 --out $S/eval11/T_$1 -q
