@@ -13,7 +13,5 @@ for leg in 20 40 60; do  # three 20-minute legs of one run; each leg's export is
 done
 for n in cw20 cw40 cw60; do bash reports/training/s39_drift_gpu/check.sh A $n $S/${n}_model; done
 bash reports/training/s39_drift_gpu/check.sh B cw20 $S/cw20_model
-for phi in -1.6,0,0 -9.81,10,0; do
-  SIMDIFF_SCRATCH=$S python reports/training/s37_env_guidance/guard.py $phi 2 $S/eval11/C_cw20/$phi $S/cw20_model
-done
+bash reports/training/s39_drift_gpu/stageC.sh cw20 $S/cw20_model   # guard.py at g -1.6 and at w_x +10 N
 bash reports/training/s39_drift_gpu/check.sh T cw20 $S/cw20_model
