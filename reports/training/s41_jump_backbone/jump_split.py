@@ -9,18 +9,20 @@ import re
 import sys
 from pathlib import Path
 
+from simdiff.data.humanml3d import read_captions, read_split
+
 WORD = re.compile(r"\b(jump|jumps|jumping|jumped|hop|hops|hopping|hopped|leap|leaps|leaping|leapt)\b", re.I)
 
 
 def captions(root: Path, clip: str) -> list[str]:
     path = root / "texts" / f"{clip}.txt"
-    return [line.split("#")[0] for line in path.read_text().splitlines() if line.strip()] if path.is_file() else []
+    return [c.text for c in read_captions(path)] if path.is_file() else []
 
 
 def main() -> None:
     root, repeat = Path(sys.argv[1]), int(sys.argv[2])
-    train = [x for x in (root / "train.txt").read_text().split() if x]
-    flight = set((root / "train_flight.txt").read_text().split())
+    train = read_split(root / "train.txt")
+    flight = set(read_split(root / "train_flight.txt"))
     jumps = [c for c in train if c in flight and any(WORD.search(t) for t in captions(root, c))]
     print("\n".join(train + jumps * (repeat - 1)))
     n = len(train) + len(jumps) * (repeat - 1)
