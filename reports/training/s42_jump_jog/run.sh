@@ -2,8 +2,8 @@
 # /work/scratch/s41/J40_model, its stage runs in $S/eval11/{A,B,T}_J40 and C_J40)
 S=/work/scratch/s39
 python reports/training/s42_jump_jog/mix_split.py $S/corpus3 8 8 3 > $S/corpus3/train_mix.txt   # rule 15's split
-bash reports/training/s42_jump_jog/chain.sh        # rule 15: backbone leg (stopped by hand after ~15 min; chain2 took over)
-bash reports/training/s42_jump_jog/chain2.sh       # waits, resumes to step 1,600 (stopped at step 800: rule15_outcome.txt)
+STEPS=4000 MINUTES=55 bash reports/training/s42_jump_jog/chain.sh   # rule 15: first backbone leg (stopped by hand after ~15 min)
+STEPS=1600 MINUTES=90 bash reports/training/s42_jump_jog/chain.sh   # resumes to step 1,600 (stopped at step 800: rule15_outcome.txt)
 for se in 5 4 3; do                                # rule 16 stage A: Earth parts of A_J40 reused
   cp -r $S/eval11/A_J40 $S/eval11/A_J40se$se
   bash reports/training/s39_drift_gpu/check.sh A J40se$se /work/scratch/s41/J40_model $se
