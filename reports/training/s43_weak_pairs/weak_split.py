@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import sys
-from collections import defaultdict
 from pathlib import Path
 
 from simdiff.data.humanml3d import read_split
@@ -21,9 +20,7 @@ def main(weakg: Path, gen: Path, wind: Path, name: str, base: str = "first_try",
          w_low: int = 6) -> None:
     env = json.loads((weakg / "env.json").read_text())
     ids = read_split(weakg / f"{base}.txt")
-    by_source: dict[str, list[str]] = defaultdict(list)
-    for i in ids:
-        by_source[env[i]["source"]].append(i)
+    twinned = {env[i]["source"] for i in ids if env[i]["factor"] == "earth"}  # sources with a kept Earth item
     out: list[str] = []
     counts = {"earth": 0, "no twin": 0, "mid": 0, "low": 0}
     for i in ids:
@@ -32,7 +29,7 @@ def main(weakg: Path, gen: Path, wind: Path, name: str, base: str = "first_try",
             counts["earth"] += 1
             out.append(i)
             continue
-        if not any(env[j]["factor"] == "earth" for j in by_source[row["source"]]):
+        if row["source"] not in twinned:
             counts["no twin"] += 1
             out.append(i)
             continue

@@ -1,7 +1,6 @@
 # rule 18 confirmation runs: check.sh's stage A with fresh seeds 200 201
 cd /work/main && . .venv/bin/activate
 S=/work/scratch/s39
-while ! grep -q "r17 done" /work/scratch/r17.log; do sleep 10; done
 for nm in "K55 /work/scratch/s42/K55_model" "J40 /work/scratch/s41/J40_model"; do set -- $nm
   echo "== $(date +%H:%M:%S) A2 $1"
   /usr/bin/time -f "stageA2 $1 %e s" python benchmarks/model_check.py --model $2 --corpus $S/corpus3 --evaluator $S/eval \
