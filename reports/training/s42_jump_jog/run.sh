@@ -41,7 +41,5 @@ bash reports/training/s39_drift_gpu/stageC.sh J40 /work/scratch/s41/J40_model
 bash reports/training/s39_drift_gpu/check.sh B J40 /work/scratch/s41/J40_model   # -> stageB/J40_s45
 bash reports/training/s39_drift_gpu/stageC.sh J40 /work/scratch/s41/J40_model    # -> stageC/J40_s45
 STEPS=1600 MINUTES=90 bash reports/training/s42_jump_jog/chain.sh                # K55: not adopted (rule15_outcome.txt)
-# rule 17 (base J40): ../s43_weak_pairs
-python reports/training/s43_weak_pairs/weak_split.py $S/aug_weakg $S/aug_gen $S/aug_wind weak36
-bash reports/training/s43_weak_pairs/chain.sh /work/scratch/s41/J40_model       # G17: not adopted
+# rule 17 (base J40) and its control: ../s43_weak_pairs/run.sh
 # rule 18: ../s45_gravity_confirm/run.sh (stage A on fresh seeds 200 201 for K55 and J40)
