@@ -1,5 +1,5 @@
 """Session 41's quick jump probe: the checker's 6 jump/hop prompts x N samples (seed 1000 + prompt index, 120 frames)
-under several sampler settings; prints, per setting, how many samples jump (flight >= 0.2 s and pelvis >= 15 cm up,
+under several sampler settings (a setting's "length" changes the frames); prints, per setting, how many samples jump (flight >= 0.2 s and pelvis >= 15 cm up,
 simdiff.eval.model_check.detect.jump_stats) and per prompt "jumping|median flight s|median pelvis range m".
 A screen (one seed, 8 samples per prompt), not a claim. SimDiff models run at Earth, alpha 0.5.
 Usage: python jump_probe.py MODEL_DIR '[{}, {"eta": 1.0}, {"steps": 50}, {"guidance": 5.0}, {"foot_lock": 0.0}]' [N]
@@ -29,7 +29,7 @@ def main() -> None:
                       guidance=s.get("guidance", 2.5), foot_lock=s.get("foot_lock", 1.0))
             if gen_model.is_simdiff:
                 kw.update(alpha=0.5, env=[-9.81, 0.0, 0.0])
-            out = gen_model.generate([prompt] * n, 120, seed=1000 + i, **kw)
+            out = gen_model.generate([prompt] * n, s.get("length", 120), seed=1000 + i, **kw)
             joints = features_to_joints(out.features.double()).numpy()
             stats = [jump_stats(j) for j in joints]
             rows.append((sum(x["jump"] for x in stats), np.median([x["flight_s"] for x in stats]),
