@@ -91,3 +91,22 @@ def test_shipped_default_model_generates() -> None:
     assert joints.shape == (40, 22, 3) and np.isfinite(joints).all()
     height = joints[:, 15, 1].mean() - joints[..., 1].min(axis=1).mean()  # head above the lowest joint
     assert 1.0 < height < 2.2, height  # a trained model makes a human-sized figure
+
+
+SHIPPED_TEST_REPORT = Path(__file__).parents[1] / "reports/training/s46_length/test/J40w2.5s50/check.json"
+"""The test-split model check of the shipped model at its shipped settings (session 46; update when shipping anew)."""
+
+
+@pytest.mark.skipif(not SHIPPED_TEST_REPORT.is_file(), reason="the shipped model's test report is not in this checkout")
+def test_shipped_settings_are_the_measured_ones() -> None:
+    """`simdiff generate`'s defaults (sampling.json) are the settings the shipped model's test figures were measured at
+    (sessions 36-45 measured DDIM 20 while users got DDIM 50), on weights of the measured file's size."""
+    import json
+
+    report = json.loads(SHIPPED_TEST_REPORT.read_text())
+    measured, stored = report["settings"], sampling_defaults(DEFAULT_MODEL_DIR)
+    assert stored.get("sampler", "ddim") == "ddim"  # the model check samples with DDIM
+    for key in ("steps", "guidance", "alpha", "foot_lock", "env_guidance"):
+        assert key in stored and stored[key] == measured[key], key
+    assert report["test_split"]["split"] == "test" and len(report["settings"]["seeds"]) >= 5
+    assert report["model"]["size"] == (DEFAULT_MODEL_DIR / "model.safetensors").stat().st_size
