@@ -17,3 +17,8 @@ python reports/training/s39_drift_gpu/summarize.py $S/eval11/A_J40w2.5s50 "$S/ev
 # adopted: the test split on it, and J40 at (2.5, 20) with the same evaluator
 W=2.5 STEPS=50 bash reports/training/s39_drift_gpu/check.sh T J40w2.5s50 $M
 bash reports/training/s39_drift_gpu/check.sh Tq J40 $M
+# rule 20: stage C at g -1.6 for s_e 3, then 2.5 (each failed its R@3 guard; stage A and +10 N not needed)
+export SIMDIFF_SCRATCH=$S
+for se in 3 2.5; do
+  W=2.5 STEPS=50 python reports/training/s37_env_guidance/guard.py -1.6,0,0 $se "$S/eval11/C_J40s50se$se/-1.6,0,0" $M
+done
