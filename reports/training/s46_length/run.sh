@@ -22,3 +22,4 @@ export SIMDIFF_SCRATCH=$S
 for se in 3 2.5; do
   W=2.5 STEPS=50 python reports/training/s37_env_guidance/guard.py -1.6,0,0 $se "$S/eval11/C_J40s50se$se/-1.6,0,0" $M
 done
+W=2.5 STEPS=100 bash reports/training/s39_drift_gpu/check.sh B J40w2.5s100 $M   # screen after rule 20, not judged by a rule
