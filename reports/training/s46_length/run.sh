@@ -1,5 +1,6 @@
 # Session 46: the commands as run (S=/work/scratch/s39 holds session 45's rebuilt corpus3 and evaluator; J40 =
 # /work/scratch/s41/J40_model, a copy of simdiff/assets/default_model's weights). One job at a time on 2 cores.
+S=/work/scratch/s39
 M=/work/scratch/s41/J40_model
 # screens (outside the val/test protocol; run from /work/scratch)
 python reports/training/s41_jump_backbone/jump_probe.py $M '[{"length":60},{"length":80},{"length":120}]' 8

@@ -1,6 +1,6 @@
 """Session 46's speed probe: median horizontal pelvis speed (m/s) of the checker's walk/run prompts at several
-sample lengths (frames, 20 fps). N samples per prompt, seed 2000 + prompt index, Earth, alpha 0.5, shipped sampler
-settings (DDIM 20, guidance 2.5, foot lock 1). A screen, not a claim.
+sample lengths (frames, 20 fps). N samples per prompt, seed 2000 + prompt index, Earth, alpha 0.5, the earlier checks'
+sampler settings (DDIM 20, guidance 2.5, foot lock 1). A screen, not a claim.
 Usage: python speed_probe.py MODEL_DIR 40,60,120 [N]
 """
 import sys
@@ -9,14 +9,9 @@ import numpy as np
 import torch
 
 from simdiff.eval.model_check.config import SPEED_PROMPTS
+from simdiff.eval.model_check.detect import root_speed
 from simdiff.model.generator import MotionGenerator
 from simdiff.motion.features import features_to_joints
-
-
-def speed(joints: np.ndarray) -> float:
-    """Mean horizontal pelvis speed of one motion (frames x joints x 3, metres, 20 fps), m/s."""
-    root = joints[:, 0, [0, 2]]
-    return float(np.linalg.norm(np.diff(root, axis=0), axis=1).mean() * 20.0)
 
 
 def main() -> None:
@@ -33,7 +28,7 @@ def main() -> None:
             for i, prompt in enumerate(prompts):
                 out = model.generate([prompt] * n, length, seed=2000 + i, **kw)
                 joints = features_to_joints(out.features.double()).numpy()
-                s = [speed(j) for j in joints]
+                s = [root_speed(j) for j in joints]
                 cells.append(f"{prompt!r} {np.median(s):.2f} [{np.percentile(s, 25):.2f}, {np.percentile(s, 75):.2f}]")
         print(f"length {length}:", " | ".join(cells), flush=True)
 
