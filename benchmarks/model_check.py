@@ -44,6 +44,8 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--foot-lock", type=float, default=0.0, help="foot-lock strength in [0, 1] (0: off)")
     p.add_argument("--env-guidance", type=float, default=1.0,
                    help="environment guidance s_e of SimDiff models (1: off; changes only motions off Earth)")
+    p.add_argument("--anchor", default="adapters", choices=("adapters", "backbone"),
+                   help="what the text guidance runs on (backbone: the adapters add only their answer to φ vs Earth)")
     p.add_argument("--workers", type=int, default=0, help="simulator processes (0: all cores)")
     p.add_argument("--no-response", action="store_true", help="skip the physics-response section")
     p.add_argument("--speed", action="store_true", help="also run benchmarks/bench_generate.py (3 runs)")
@@ -84,7 +86,8 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or str(ROOT / "reports" / "model_check" / Path(args.model).resolve().name)
         config = CheckConfig(model=args.model, corpus=args.corpus, evaluator=args.evaluator, out=out, seeds=args.seeds,
                              steps=args.steps, guidance=args.guidance, alpha=args.alpha,
-                             foot_lock=args.foot_lock, env_guidance=args.env_guidance, device=args.device,
+                             foot_lock=args.foot_lock, env_guidance=args.env_guidance, anchor=args.anchor,
+                             device=args.device,
                              split=SplitOptions(split=args.split, n=args.n),
                              prompts=PromptOptions(jump_samples=args.jump_samples, speed_samples=args.speed_samples,
                                                    length=args.length),

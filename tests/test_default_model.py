@@ -67,6 +67,12 @@ def test_sampling_defaults(tmp_path: Path) -> None:
                                given={"env_guidance"}).env_guidance == 1.0
     with pytest.raises(SimdiffError, match="env_guidance must be ≥ 0, got -2"):
         with_model_defaults(build_request("walk"), {"env_guidance": -2.0}, given=set())
+    assert with_model_defaults(build_request("walk"), {"anchor": "backbone"}, given=set()).anchor == "backbone"
+    assert with_model_defaults(build_request("walk"), {}, given=set()).anchor == "adapters"
+    assert with_model_defaults(build_request("walk", anchor="adapters"), {"anchor": "backbone"},
+                               given={"anchor"}).anchor == "adapters"
+    with pytest.raises(SimdiffError, match="anchor must be adapters or backbone, got 'sim'"):
+        with_model_defaults(build_request("walk"), {"anchor": "sim"}, given=set())
 
 
 @pytest.mark.parametrize("text, needle", [
@@ -108,5 +114,6 @@ def test_shipped_settings_are_the_measured_ones() -> None:
     assert stored.get("sampler", "ddim") == "ddim"  # the model check samples with DDIM
     for key in ("steps", "guidance", "alpha", "foot_lock", "env_guidance"):
         assert key in stored and stored[key] == measured[key], key
+    assert stored.get("anchor", "adapters") == measured.get("anchor", "adapters")
     assert report["test_split"]["split"] == "test" and len(measured["seeds"]) >= 5
     assert report["model"]["size"] == (DEFAULT_MODEL_DIR / "model.safetensors").stat().st_size

@@ -253,6 +253,30 @@ def test_generate_env_guidance_changes_only_motions_off_earth(tmp_path: Path, ca
     assert "--env-guidance must be ≥ 0, got -1" in err and err.count("\n") == 1
 
 
+def test_generate_backbone_anchor_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
+    from simdiff.serve.testing import write_tiny_model
+
+    model = write_tiny_model(tmp_path / "reacting")  # jittered weights: the adapters answer φ
+    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
+            "--format", "npy", "--no-video", "-q", "--alpha", "0.5"]
+
+    def run(name: str, *extra: str) -> np.ndarray:
+        assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
+        return np.load(tmp_path / name / "sample0_features.npy")
+
+    plain, anchored = run("plain"), run("anchored", "--anchor", "backbone")
+    assert np.array_equal(anchored, run("alone", "--alpha", "0"))  # Earth without wind: the backbone alone
+    assert not np.allclose(plain, anchored, atol=1e-4)
+    assert json.loads((tmp_path / "anchored" / "generation.json").read_text())["anchor"] == "backbone"
+    (model / "sampling.json").write_text('{"anchor": "backbone"}')
+    assert np.array_equal(run("stored"), anchored)
+    assert np.array_equal(run("given", "--anchor", "adapters"), plain)
+    (model / "sampling.json").write_text('{"anchor": "sim"}')
+    assert main([*argv, "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "anchor must be adapters or backbone, got 'sim'" in err and err.count("\n") == 1
+
+
 def test_generate_env_guidance_on_a_backbone_is_one_line(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "backbone", sim=False)
     code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--model", str(model), "--threads", "1",

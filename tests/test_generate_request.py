@@ -106,6 +106,16 @@ def test_steps_and_other_numbers() -> None:
     with pytest.raises(SimdiffError, match="--env-guidance must be a finite number"):
         build_request("walk", env_guidance=float("inf"))
     assert build_request("walk").env_guidance == 1.0 and build_request("walk", env_guidance=3).env_guidance == 3.0
+
+
+def test_anchor_is_checked_and_matches_the_sampler() -> None:
+    from simdiff.diffusion.guidance import ANCHORS as SAMPLER_ANCHORS
+    from simdiff.product.request import ANCHORS
+
+    assert ANCHORS == SAMPLER_ANCHORS
+    assert build_request("walk").anchor == "adapters" and build_request("walk", anchor="backbone").anchor == "backbone"
+    with pytest.raises(SimdiffError, match="--anchor must be adapters or backbone, got 'nope'"):
+        build_request("walk", anchor="nope")
     with pytest.raises(SimdiffError, match="--num-samples must be 1..64, got 0"):
         build_request("walk", num_samples=0)
     with pytest.raises(SimdiffError, match="--seed must be ≥ 0, got -2"):

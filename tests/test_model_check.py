@@ -231,6 +231,8 @@ def test_config_refuses_bad_values(checked: dict) -> None:
         CheckConfig(**{**config.__dict__, "seeds": [1, 1]}).validate()
     with pytest.raises(SimdiffError, match="corpus"):
         CheckConfig(**{**config.__dict__, "corpus": str(checked["root"])}).validate()
+    with pytest.raises(SimdiffError, match="--anchor must be adapters or backbone, got 'sim'"):
+        CheckConfig(**{**config.__dict__, "anchor": "sim"}).validate()
 
 
 def test_backbone_has_no_response_section(checked: dict, tmp_path: Path) -> None:
@@ -245,6 +247,9 @@ def test_backbone_has_no_response_section(checked: dict, tmp_path: Path) -> None
     assert by["sliding"]["passed"] is not None and "skipped" in report["generation_speed"]
     config.env_guidance = 2.0
     with pytest.raises(SimdiffError, match="--env-guidance needs a SimDiff model with a continuous Sim Encoder"):
+        ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(), progress=False).run()
+    config.env_guidance, config.anchor = 1.0, "backbone"
+    with pytest.raises(SimdiffError, match="--anchor backbone needs a SimDiff model with a continuous Sim Encoder"):
         ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(), progress=False).run()
 
 
@@ -261,3 +266,16 @@ def test_env_guidance_measures_only_the_response_again(checked: dict, tmp_path: 
     assert report["settings"]["env_guidance"] == 3.0 and "env guidance 3.0" in (tmp_path / "out" / "check.md").read_text()
     with pytest.raises(SimdiffError, match="--env-guidance must be a finite number ≥ 0, got -1"):
         CheckConfig(**{**config.__dict__, "env_guidance": -1.0}).validate()
+
+
+def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: Path) -> None:
+    import shutil
+
+    shutil.copytree(checked["root"] / "out" / "parts", tmp_path / "out" / "parts")
+    config = _config(checked["paths"], tmp_path / "out")
+    config.anchor = "backbone"
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert not any(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))  # Earth motions change too
+    assert report["settings"]["anchor"] == "backbone"
+    assert "guidance anchor backbone" in (tmp_path / "out" / "check.md").read_text()

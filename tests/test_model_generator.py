@@ -60,6 +60,25 @@ def test_generate_rejects_bad_input() -> None:
     assert sim.generate(["walk"] * 2, 20, env=(-3.0, 5.0, 0.0), alpha=0.5, steps=2).features.shape == (2, 20, 263)
 
 
+def test_backbone_anchor_gives_the_backbone_at_earth_and_is_validated() -> None:
+    config = tiny(True)
+    torch.manual_seed(0)
+    net = build_network(config)
+    for a in net.adapters:
+        torch.nn.init.normal_(a.up.weight, std=0.3)
+    gen = MotionGenerator(net, config, HashText())
+    envs = [[-9.81, 0.0, 0.0], [-1.6, 0.0, 0.0]]
+    anchored = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1, env_guidance=2.0,
+                            anchor="backbone").features
+    alone = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.0, steps=3, seed=1).features
+    assert torch.equal(anchored[0], alone[0]) and not torch.allclose(anchored[1], alone[1], atol=1e-4)
+    with pytest.raises(SimdiffError, match="unknown guidance anchor 'none'"):
+        gen.generate(["walk"], 12, env=envs[1], steps=2, anchor="none")
+    backbone = MotionGenerator(build_network(tiny()), tiny(), HashText())
+    with pytest.raises(SimdiffError, match="continuous Sim Encoder"):
+        backbone.generate(["walk"], 12, steps=2, anchor="backbone")
+
+
 def test_load_pretrained_missing_folder(tmp_path) -> None:
     with pytest.raises(SimdiffError, match="config.json"):
         load_pretrained(tmp_path / "nope")

@@ -361,3 +361,20 @@ def test_generate_env_guidance_from_sampling_json_or_the_request(server, model_d
     for bad in (-1, 11, "x"):
         status, out, _ = call(server, "/api/generate", {**moon, "env_guidance": bad})
         assert status == 400 and "env_guidance" in out["error"]
+
+
+def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):
+    earth = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5}
+    status, plain, _ = call(server, "/api/generate", earth)
+    assert status == 200 and plain["meta"]["params"]["anchor"] == "adapters"
+    status, anchored, _ = call(server, "/api/generate", {**earth, "anchor": "backbone"})
+    assert status == 200 and anchored["joints"] != plain["joints"]
+    assert anchored["joints"] == call(server, "/api/generate", {**earth, "alpha": 0.0})[1]["joints"]
+    (model_dir / "sampling.json").write_text('{"anchor": "backbone"}')
+    try:
+        status, stored, _ = call(server, "/api/generate", earth)
+        assert status == 200 and stored["joints"] == anchored["joints"]
+    finally:
+        (model_dir / "sampling.json").unlink()
+    status, out, _ = call(server, "/api/generate", {**earth, "anchor": "sim"})
+    assert status == 400 and "anchor must be adapters or backbone, got 'sim'" in out["error"]

@@ -4,6 +4,10 @@
 * Environment guidance (continuous SimDiff models): x̃₀ += (s_e − 1)·(x₀(c, φ) − x₀(c, φ_ref)), the
   adapters' answer to φ against the reference environment (Earth, no wind) pushed ``s_e`` times as far.
   Rows whose φ equals the reference are left exactly as without it.
+* Anchor (continuous SimDiff models): ``"adapters"`` (the default) guides the text with the adapters on, as above;
+  ``"backbone"`` guides the text with the backbone alone (α 0) and adds the adapters' answer to φ against the
+  reference: x̃₀ = x₀⁰(∅) + s·(x₀⁰(c) − x₀⁰(∅)) + s_e·(x₀(c, φ) − x₀(c, φ_ref)). At the reference φ it is exactly
+  the backbone; elsewhere only the change of φ, not the adapters' answer to Earth itself, moves the motion.
 """
 
 from __future__ import annotations
@@ -25,6 +29,9 @@ Denoiser = Callable[[Tensor, Tensor, "Condition"], Tensor]
 REFERENCE_ENV: tuple[float, float, float] = (-9.81, 0.0, 0.0)
 """φ_ref of environment guidance: Earth's gravity (m/s², along z) and no wind (N)."""
 
+ANCHORS: tuple[str, ...] = ("adapters", "backbone")
+"""What the text guidance runs on: the network with its adapters at α, or the backbone alone (see the module)."""
+
 
 class GuidedDenoiser:
     """Wrap a denoiser with classifier-free guidance.
@@ -38,10 +45,12 @@ class GuidedDenoiser:
             Sim Encoder); costs one more conditional forward over the rows whose φ is not ``reference_env``
             (a separate one: the other rows are computed bit for bit as without it).
         reference_env: φ_ref = (g_z m/s², w_x N, w_y N).
+        anchor: ``"adapters"`` or ``"backbone"`` (see the module); ``"backbone"`` needs ``cond.env`` and costs one
+            2K forward over the K rows whose φ is not ``reference_env`` (φ and φ_ref with the adapters at α).
     """
 
     def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True, env_scale: float = 1.0,
-                 reference_env: Sequence[float] = REFERENCE_ENV) -> None:
+                 reference_env: Sequence[float] = REFERENCE_ENV, anchor: str = "adapters") -> None:
         self.denoiser = denoiser
         self.scale = float(scale)
         self.batched = batched
@@ -49,35 +58,45 @@ class GuidedDenoiser:
         self.reference_env = tuple(float(v) for v in reference_env)
         if len(self.reference_env) != 3:
             raise SimdiffError(f"reference_env must be 3 numbers (g_z, w_x, w_y), got {len(self.reference_env)}")
+        if anchor not in ANCHORS:
+            raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose {' or '.join(ANCHORS)}")
+        self.anchor = anchor
 
     def __call__(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
         """x: (B, T, F), timesteps: (B,) → guided x̂₀ (B, T, F)."""
         rows, ref = self._plan(cond)
+        text_cond = cond if self.anchor == "adapters" else replace(cond, alpha=0.0)
         if self.scale == 1.0:
-            cond_out = guided = self.denoiser(x, timesteps, cond)
+            cond_out = guided = self.denoiser(x, timesteps, text_cond)
         else:
             if self.batched:
-                out = self.denoiser(torch.cat([x, x]), torch.cat([timesteps, timesteps]), cond.with_guidance_pair())
+                out = self.denoiser(torch.cat([x, x]), torch.cat([timesteps, timesteps]), text_cond.with_guidance_pair())
                 cond_out, uncond_out = out.chunk(2)
             else:
-                cond_out = self.denoiser(x, timesteps, cond)
-                uncond_out = self.denoiser(x, timesteps, cond.unconditional())
+                cond_out = self.denoiser(x, timesteps, text_cond)
+                uncond_out = self.denoiser(x, timesteps, text_cond.unconditional())
             guided = uncond_out + self.scale * (cond_out - uncond_out)
         if rows is None or ref is None:  # nothing off the reference φ
             return guided
-        # a pass of its own, so that the rows above are computed exactly as without environment guidance
-        ref_out = self.denoiser(x[rows], timesteps[rows], ref)
+        # passes of their own, so that the rows above are computed exactly as without environment guidance
         guided = guided.clone()
-        guided[rows] += (self.env_scale - 1.0) * (cond_out[rows] - ref_out)
+        if self.anchor == "adapters":
+            ref_out = self.denoiser(x[rows], timesteps[rows], ref)
+            guided[rows] += (self.env_scale - 1.0) * (cond_out[rows] - ref_out)
+            return guided
+        xr, tr = x[rows], timesteps[rows]
+        phi_out, ref_out = self.denoiser(torch.cat([xr, xr]), torch.cat([tr, tr]), cond.select(rows).stacked(ref)).chunk(2)
+        guided[rows] += self.env_scale * (phi_out - ref_out)
         return guided
 
     def _plan(self, cond: Condition) -> tuple[Tensor | None, Condition | None]:
         """((K,) indices of the rows environment guidance changes, their condition with φ set to the reference), or
         (None, None) when it changes none (a few small tensor operations per step, next to a network pass)."""
-        if self.env_scale == 1.0:
+        if self.env_scale == 1.0 and self.anchor == "adapters":
             return None, None
         if cond.env is None:
-            raise SimdiffError("environment guidance needs a SimDiff model with a continuous Sim Encoder (φ as numbers)")
+            what = "environment guidance" if self.anchor == "adapters" else "the backbone anchor"
+            raise SimdiffError(f"{what} needs a SimDiff model with a continuous Sim Encoder (φ as numbers)")
         phi = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
         rows = torch.nonzero((cond.env != phi).any(dim=-1)).flatten()
         if not rows.numel():

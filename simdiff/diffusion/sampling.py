@@ -50,6 +50,7 @@ def sample(
     hook_timesteps: Iterable[int] | None = None,
     progress: Callable[[Iterable[Tensor]], Iterable[Tensor]] | None = None,
     env_guidance: float = 1.0,
+    anchor: str = "adapters",
 ) -> Tensor:
     """Run the reverse process from pure noise; returns x₀ (B, num_frames, nfeats) normalised features.
 
@@ -63,13 +64,14 @@ def sample(
         x0_hook: replaces x̂₀ at the timesteps in ``hook_timesteps`` (all when None).
         progress: optional iterable wrapper (e.g. ``tqdm``).
         env_guidance: environment guidance s_e (1 = off; :class:`GuidedDenoiser`), continuous φ only.
+        anchor: what the text guidance runs on, ``"adapters"`` or ``"backbone"`` (:class:`GuidedDenoiser`).
     """
     device = cond.text.device
     b = cond.batch_size
     x = x_init.to(device) if x_init is not None else torch.randn(
         (b, num_frames, nfeats), generator=generator, device=generator.device if generator else device
     ).to(device)
-    model = GuidedDenoiser(denoiser, guidance, batched_cfg, env_scale=env_guidance)
+    model = GuidedDenoiser(denoiser, guidance, batched_cfg, env_scale=env_guidance, anchor=anchor)
     hooked = None if hook_timesteps is None else {int(t) for t in hook_timesteps}
     steps: Iterable[Tensor] = scheduler.timesteps
     if progress is not None:

@@ -225,7 +225,8 @@ def _multimodality(evaluator: Evaluator, batches: list[dict[str, Any]], generate
 def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_index: int | None = None, alpha: float = 1.0,
                  sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5,
                  physdiff: Any = None, projector: Any = None, simulate: bool = False,
-                 finish_projector: Any = None, foot_lock: float = 0.0, env_guidance: float = 1.0) -> GenerateFn:
+                 finish_projector: Any = None, foot_lock: float = 0.0, env_guidance: float = 1.0,
+                 anchor: str = "adapters") -> GenerateFn:
     """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
 
     ``simulate``: the simulated finish: every final sample is re-tracked by ``finish_projector``
@@ -234,7 +235,7 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
     projection does). The returned function's ``finish_log`` lists one entry per finished sample
     (``success``: tracked to the end; ``frames_replaced``), in generation order. ``foot_lock``: the
     generator's foot lock strength (0: off; not with ``physdiff``); ``env_guidance``: environment guidance s_e
-    (1: off; SimDiff continuous models).
+    (1: off; SimDiff continuous models); ``anchor``: what the text guidance runs on (:mod:`simdiff.diffusion.guidance`).
     """
     finish_log: list[dict[str, Any]] = []
 
@@ -244,6 +245,8 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
             kwargs = {"env": env, "env_index": env_index, "alpha": alpha}
             if env_guidance != 1.0:
                 kwargs["env_guidance"] = env_guidance
+            if anchor != "adapters":
+                kwargs["anchor"] = anchor
         if physdiff is not None:
             from simdiff.baselines.physdiff import physdiff_generate
 

@@ -56,6 +56,30 @@ class Condition:
             alpha=alpha,
         )
 
+    def stacked(self, other: "Condition") -> "Condition":
+        """The (B + B') condition of this batch followed by ``other``'s (α: both floats and equal, or tensors)."""
+
+        def cat(a: Tensor | None, b: Tensor | None, name: str) -> Tensor | None:
+            if (a is None) != (b is None):
+                raise ValueError(f"cannot stack conditions: one has {name}, the other not")
+            return None if a is None or b is None else torch.cat([a, b])
+
+        def alphas(c: "Condition") -> Tensor:
+            a = c.alpha
+            return a if isinstance(a, Tensor) else torch.full((c.batch_size,), float(a), device=c.text.device)
+
+        same = not isinstance(self.alpha, Tensor) and not isinstance(other.alpha, Tensor) and self.alpha == other.alpha
+        keep = [c.uncond if c.uncond is not None else torch.zeros(c.batch_size, dtype=torch.bool, device=c.text.device)
+                for c in (self, other)]
+        return Condition(
+            text=torch.cat([self.text, other.text]),
+            uncond=None if self.uncond is None and other.uncond is None else torch.cat(keep),
+            frame_mask=cat(self.frame_mask, other.frame_mask, "frame_mask"),
+            env=cat(self.env, other.env, "env"),
+            env_index=cat(self.env_index, other.env_index, "env_index"),
+            alpha=self.alpha if same else torch.cat([alphas(self), alphas(other)]),
+        )
+
     def select(self, rows: Tensor) -> "Condition":
         """The condition of the batch rows ``rows`` ((K,) int64 indices)."""
 

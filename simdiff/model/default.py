@@ -69,15 +69,15 @@ def load_default(model: str | os.PathLike[str] | None = None, device: "torch.dev
 SAMPLING_NAME = "sampling.json"
 """Optional file beside ``config.json`` with the model's recommended sampling settings."""
 SAMPLING_KEYS: dict[str, type] = {"alpha": float, "guidance": float, "steps": int, "sampler": str, "foot_lock": float,
-                                  "env_guidance": float}
+                                  "env_guidance": float, "anchor": str}
 
 
 def sampling_defaults(model: str | os.PathLike[str] | None = None) -> dict[str, float | int | str]:
     """Recommended sampling settings stored with a model (``sampling.json``), or ``{}`` when it has none.
 
     The file is a JSON object with any of ``alpha`` (adapter strength), ``guidance``, ``steps``,
-    ``sampler``, ``foot_lock`` (:mod:`simdiff.motion.foot_lock`'s strength) and ``env_guidance``
-    (:mod:`simdiff.diffusion.guidance`'s s_e), e.g. ``{"alpha": 0.8}``;
+    ``sampler``, ``foot_lock`` (:mod:`simdiff.motion.foot_lock`'s strength), ``env_guidance``
+    (:mod:`simdiff.diffusion.guidance`'s s_e) and ``anchor`` (its text-guidance anchor), e.g. ``{"alpha": 0.8}``;
     values the user gives on the command line win.
 
     Raises:

@@ -13,6 +13,7 @@ from typing import Callable, Iterable, Sequence
 import torch
 from torch import Tensor, nn
 
+from simdiff.diffusion.guidance import ANCHORS
 from simdiff.diffusion.sampling import X0Hook, make_scheduler, sample
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
@@ -108,6 +109,7 @@ class MotionGenerator:
         progress: Callable[[Iterable[Tensor]], Iterable[Tensor]] | None = None,
         foot_lock: float = 0.0,
         env_guidance: float = 1.0,
+        anchor: str = "adapters",
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -128,6 +130,9 @@ class MotionGenerator:
             env_guidance: s_e ≥ 0 (1 = off): the adapters' answer to φ against Earth without wind is pushed s_e
                 times as far (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only. Motions under
                 Earth without wind are unchanged; the others cost one more network pass per step.
+            anchor: ``"adapters"`` (default) or ``"backbone"``: the text guidance runs on the backbone alone and only
+                the adapters' answer to φ against Earth without wind (times s_e) is added, so motions under Earth
+                without wind are the backbone's (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only.
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -148,6 +153,11 @@ class MotionGenerator:
             if self.config.sim is None or self.config.sim.mode != "continuous":
                 raise SimdiffError("env guidance needs a SimDiff model with a continuous Sim Encoder; "
                                    "this model has none (leave it at 1)")
+        if anchor not in ANCHORS:
+            raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose {' or '.join(ANCHORS)}")
+        if anchor != "adapters" and (self.config.sim is None or self.config.sim.mode != "continuous"):
+            raise SimdiffError(f"anchor {anchor!r} needs a SimDiff model with a continuous Sim Encoder; "
+                               "this model has none (leave it at 'adapters')")
         cond = Condition(text=text, frame_mask=mask, alpha=float(alpha), **self._env(b, env, env_index))
         generator = None
         if seed is not None:
@@ -155,7 +165,7 @@ class MotionGenerator:
         scheduler = make_scheduler(sampler, steps, eta)
         x = sample(self.network, scheduler, cond, frames, nfeats=self.config.backbone.nfeats, guidance=guidance,
                    batched_cfg=batched_cfg, generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps,
-                   progress=progress, env_guidance=env_guidance)
+                   progress=progress, env_guidance=env_guidance, anchor=anchor)
         features = (x * self.std + self.mean) * mask[..., None]
         if foot_lock and frames >= 2:  # one frame has no step to correct
             from simdiff.motion.foot_lock import clean_feet

@@ -121,6 +121,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
                     alpha=request.alpha, sampler=request.sampler, steps=request.steps, guidance=request.guidance,
                     seed=request.seed + k, text_embeddings=text, progress=progress, foot_lock=request.foot_lock,
                     **({"env_guidance": request.env_guidance} if request.env_guidance != 1.0 else {}),
+                    **({"anchor": request.anchor} if request.anchor != "adapters" else {}),
                 )
                 features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
     finally:
@@ -243,6 +244,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "alpha_source": alpha_source if simdiff_model else None,
         "foot_lock": request.foot_lock,
         "env_guidance": request.env_guidance if simdiff_model else None,
+        "anchor": request.anchor if simdiff_model else None,
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",
         "samples": records,

@@ -46,6 +46,7 @@ class GenerationRequest:
         alpha: adapter strength α (0 = backbone only).
         foot_lock: foot-lock strength in [0, 1] (0: off; :mod:`simdiff.motion.foot_lock`).
         env_guidance: environment guidance s_e ≥ 0 (1: off; :mod:`simdiff.diffusion.guidance`).
+        anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:data:`ANCHORS`).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
     """
@@ -62,6 +63,7 @@ class GenerationRequest:
     alpha: float = 1.0
     foot_lock: float = 0.0
     env_guidance: float = 1.0
+    anchor: str = "adapters"
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
 
@@ -201,16 +203,26 @@ def check_finite(name: str, value: float, minimum: float | None = None) -> float
 STORED_NUMBERS: tuple[str, ...] = ("guidance", "alpha", "foot_lock", "env_guidance")
 """The numeric ``sampling.json`` settings."""
 
+ANCHORS: tuple[str, ...] = ("adapters", "backbone")
+"""``--anchor`` values: :data:`simdiff.diffusion.guidance.ANCHORS` (repeated here, where torch is not imported)."""
+
+
+def check_anchor(name: str, value: object) -> str:
+    """``value`` if it is one of :data:`ANCHORS`, else a one-line error naming ``name``."""
+    if value not in ANCHORS:
+        raise SimdiffError(f"{name} must be {' or '.join(ANCHORS)}, got {value!r}")
+    return str(value)
+
 
 def with_model_defaults(request: GenerationRequest, stored: dict[str, float | int | str],
                         given: set[str]) -> GenerationRequest:
     """Apply a model's stored sampling settings (``sampling.json``) to the options the user did not give.
 
     Args:
-        stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance`` (see
-            :func:`simdiff.model.default.sampling_defaults`).
+        stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance``,
+            ``anchor`` (see :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
-            ``foot_lock``, ``env_guidance``).
+            ``foot_lock``, ``env_guidance``, ``anchor``).
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -219,8 +231,9 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
         steps = steps_for(sampler, None)
     else:
         steps = steps_for(sampler, stored.get("steps"))  # type: ignore[arg-type]
+    anchor = request.anchor if "anchor" in given else check_anchor("anchor", stored.get("anchor", request.anchor))
     return replace(
-        request, sampler=sampler, steps=steps,
+        request, sampler=sampler, steps=steps, anchor=anchor,
         **{name: getattr(request, name) if name in given else stored_setting(stored, name, getattr(request, name))
            for name in STORED_NUMBERS},
     )
@@ -246,7 +259,8 @@ def check_unit(name: str, value: object) -> float:
 def build_request(text: str, *, gravity: float | None = None, wind: tuple[float, float] | None = None,
                   length_s: float | None = None, frames: int | None = None, seed: int = 0, num_samples: int = 1,
                   sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
-                  foot_lock: float = 0.0, env_guidance: float = 1.0, compare: str | None = None, formats: str | None = None,
+                  foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
+                  compare: str | None = None, formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
     if seed < 0:
@@ -268,6 +282,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         alpha=check_finite("--alpha", alpha),
         foot_lock=check_unit("--foot-lock", foot_lock),
         env_guidance=check_finite("--env-guidance", env_guidance, 0.0),
+        anchor=check_anchor("--anchor", anchor),
         formats=parse_formats(formats, no_video),
         force=bool(force),
     )

@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass
 from typing import Any, Mapping
 
 from simdiff.errors import SimdiffError
-from simdiff.product.request import MAX_PROMPT_CHARS, check_text
+from simdiff.product.request import MAX_PROMPT_CHARS, check_anchor, check_text
 from simdiff.motion.skeleton import FPS, MAX_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND
 
@@ -50,6 +50,8 @@ class GenerateParams:
             ``sampling.json`` value (0 without one), as ``simdiff generate``.
         env_guidance: environment guidance s_e ≥ 0 (:mod:`simdiff.diffusion.guidance`), or None for the model's
             ``sampling.json`` value (1, off, without one).
+        anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:mod:`simdiff.diffusion.guidance`),
+            or None for the model's ``sampling.json`` value (``adapters`` without one).
     """
 
     text: str
@@ -64,6 +66,7 @@ class GenerateParams:
     simulate: bool = False
     foot_lock: float | None = None
     env_guidance: float | None = None
+    anchor: str | None = None
 
     @property
     def frames(self) -> int:
@@ -112,7 +115,7 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
-            simulate, foot_lock, env_guidance}``;
+            simulate, foot_lock, env_guidance, anchor}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -160,5 +163,9 @@ def parse_generate(body: Any) -> GenerateParams:
     if env_guidance is not None:
         env_guidance = _number(body, "env_guidance", 1.0)
         _check_range("env_guidance", env_guidance, *ENV_GUIDANCE_RANGE)
+    anchor = body.get("anchor")
+    if anchor is not None:
+        anchor = check_anchor("anchor", anchor)
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
-                          guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance, **wind)
+                          guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance,
+                          anchor=anchor, **wind)

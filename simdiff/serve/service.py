@@ -149,19 +149,21 @@ class MotionService:
         as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import stored_setting
+        from simdiff.product.request import check_anchor, stored_setting
 
         try:
             stored = sampling_defaults(self.model_dir)
             alpha = params.alpha if params.alpha is not None else stored_setting(stored, "alpha", 1.0)
             lock = params.foot_lock if params.foot_lock is not None else stored_setting(stored, "foot_lock", 0.0)
             push = params.env_guidance if params.env_guidance is not None else stored_setting(stored, "env_guidance", 1.0)
+            anchor = params.anchor if params.anchor is not None else check_anchor("anchor", stored.get("anchor", "adapters"))
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
             alpha, lock = (1.0 if params.alpha is None else params.alpha), (params.foot_lock or 0.0)
             push = 1.0 if params.env_guidance is None else params.env_guidance
-        return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push))
+            anchor = params.anchor or "adapters"
+        return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor)
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -236,7 +238,7 @@ class MotionService:
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
                                      guidance=params.guidance, seed=params.seed, progress=self._progress,
                                      foot_lock=params.foot_lock,
-                                     **({"env_guidance": params.env_guidance} if uses_env else {}))
+                                     **({"env_guidance": params.env_guidance, "anchor": params.anchor} if uses_env else {}))
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count

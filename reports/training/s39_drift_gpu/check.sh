@@ -13,5 +13,5 @@ case $1 in
   *) echo "check.sh: unknown stage '$1' (A, B, T or Tq)" >&2; exit 2;;
 esac
 /usr/bin/time -f "stage$1 $2 %e s" python benchmarks/model_check.py --model $3 --corpus $S/corpus3 --evaluator $S/eval \
-  $args --jump-samples 16 --speed-samples 8 --steps ${STEPS:-20} --guidance ${W:-2.5} --alpha ${ALPHA:-0.5} --foot-lock 1 --env-guidance ${4:-2} --threads 2 \
+  $args --jump-samples 16 --speed-samples 8 --steps ${STEPS:-20} --guidance ${W:-2.5} --alpha ${ALPHA:-0.5} --foot-lock 1 --env-guidance ${4:-2} --anchor ${ANCHOR:-adapters} --threads 2 \
   --out $S/eval11/${1:0:1}_$2 -q

@@ -80,6 +80,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--env-guidance", type=float, metavar="S",
                      help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off; "
                           "motions under Earth without wind are unchanged (default 1, or the model's sampling.json)")
+    smp.add_argument("--anchor", choices=["adapters", "backbone"],
+                     help="what the text guidance runs on: the network with its adapters (adapters), or the backbone "
+                          "alone, the adapters adding only their answer to φ against Earth without wind (backbone); "
+                          "default adapters, or the model's sampling.json")
     out = p.add_argument_group("output")
     out.add_argument("--out", type=Path, metavar="DIR",
                      help="output folder, files in it are replaced (default ./out/<prompt>, or <prompt>-2, -3, ... "
@@ -117,7 +121,8 @@ def run(args: argparse.Namespace) -> int:
         num_samples=args.num_samples, sampler=args.sampler or "ddim", steps=args.steps,
         guidance=2.5 if args.guidance is None else args.guidance, alpha=1.0 if args.alpha is None else args.alpha,
         foot_lock=0.0 if args.foot_lock is None else args.foot_lock,
-        env_guidance=1.0 if args.env_guidance is None else args.env_guidance, compare=args.compare, formats=args.format,
+        env_guidance=1.0 if args.env_guidance is None else args.env_guidance, anchor=args.anchor or "adapters",
+        compare=args.compare, formats=args.format,
         no_video=args.no_video, force=args.force,
     )
     if args.threads is not None and args.threads < 1:
@@ -146,7 +151,7 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     from simdiff.model.provenance import read_provenance
 
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
-    given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance")
+    given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance", "anchor")
              if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")

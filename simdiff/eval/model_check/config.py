@@ -89,7 +89,8 @@ class CheckConfig:
         seeds: one protocol replication per seed; the prompt checks split their samples over them.
         steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models; foot_lock: the
             generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`); env_guidance: environment
-            guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth).
+            guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth);
+            anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:mod:`simdiff.diffusion.guidance`).
         device: torch device; quick: the smoke preset was applied (reported).
     """
 
@@ -103,6 +104,7 @@ class CheckConfig:
     alpha: float = 1.0
     foot_lock: float = 0.0
     env_guidance: float = 1.0
+    anchor: str = "adapters"
     device: str = "cpu"
     quick: bool = False
     split: SplitOptions = field(default_factory=SplitOptions)
@@ -127,6 +129,10 @@ class CheckConfig:
             raise SimdiffError(f"--foot-lock must be in [0, 1], got {self.foot_lock}")
         if not 0.0 <= self.env_guidance < float("inf"):
             raise SimdiffError(f"--env-guidance must be a finite number ≥ 0, got {self.env_guidance}")
+        from simdiff.diffusion.guidance import ANCHORS
+
+        if self.anchor not in ANCHORS:
+            raise SimdiffError(f"--anchor must be {' or '.join(ANCHORS)}, got {self.anchor!r}")
         if self.prompts.length > 196:
             raise SimdiffError(f"--length must be at most 196 frames, got {self.prompts.length}")
         model, corpus, evaluator = Path(self.model), Path(self.corpus), Path(self.evaluator)

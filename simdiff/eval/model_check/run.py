@@ -115,7 +115,7 @@ class ModelCheck:
         c = self.config
         lock = {"foot_lock": c.foot_lock, "foot_cleanup": CLEANUP_VERSION} if c.foot_lock else {}
         return {"schema": SCHEMA, "model": _stamp(c.model), "seeds": c.seeds, "steps": c.steps, "guidance": c.guidance,
-                "alpha": c.alpha, "device": c.device, **lock}
+                "alpha": c.alpha, "device": c.device, **lock, **({"anchor": c.anchor} if c.anchor != "adapters" else {})}
 
     def part(self, name: str, inputs: dict[str, Any], measure: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         """The stored result of section ``name`` when its fingerprint matches, else measured and stored."""
@@ -146,7 +146,7 @@ class ModelCheck:
             c = self.config
             self._sets[key] = generate_set(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
                                            steps=c.steps, guidance=c.guidance, progress=self.progress,
-                                           foot_lock=c.foot_lock, env_guidance=c.env_guidance)
+                                           foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor)
         return self._sets[key]
 
     # --- sections ---------------------------------------------------------------------------
@@ -165,7 +165,7 @@ class ModelCheck:
             env = self.env(EARTH)
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
                               steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock,
-                              env_guidance=c.env_guidance)
+                              env_guidance=c.env_guidance, anchor=c.anchor)
             return measure_split(evaluator, dataset, fn, c.split, c.seeds, self.progress)
 
         return self.part("test_split", {"corpus": _stamp(c.corpus, f"{c.split.split}.txt"), "evaluator": _stamp(c.evaluator),
@@ -240,6 +240,9 @@ class ModelCheck:
         if c.env_guidance != 1.0 and kind != "continuous":
             raise SimdiffError(f"{c.model}: --env-guidance needs a SimDiff model with a continuous Sim Encoder; "
                                f"this is a {kind} model (leave it at 1)")
+        if c.anchor != "adapters" and kind != "continuous":
+            raise SimdiffError(f"{c.model}: --anchor {c.anchor} needs a SimDiff model with a continuous Sim Encoder; "
+                               f"this is a {kind} model (leave it at adapters)")
         report: dict[str, Any] = {"schema": SCHEMA, "model": {**_stamp(c.model), "kind": kind},
                                   "corpus": str(Path(c.corpus).resolve()), "evaluator": _stamp(c.evaluator),
                                   "settings": c.as_dict(), "provenance": provenance(c.seeds[0], c.device, self.command)}

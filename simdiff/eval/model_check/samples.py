@@ -41,11 +41,11 @@ def units(batches: Sequence[PromptBatch]) -> list[str]:
 
 def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *, env: Sequence[float] | None,
                  alpha: float, steps: int, guidance: float, progress: bool = False,
-                 foot_lock: float = 0.0, env_guidance: float = 1.0) -> np.ndarray:
+                 foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters") -> np.ndarray:
     """Generate every batch; returns joints (N, length, 22, 3) float32, metres, Y-up, 20 fps.
 
     ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone (``env_guidance`` then
-    must stay 1).
+    and ``anchor`` must stay at their defaults).
     """
     from tqdm import tqdm
 
@@ -54,6 +54,8 @@ def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *,
     kwargs: dict[str, Any] = {"env": list(env), "alpha": alpha} if env is not None else {}
     if env_guidance != 1.0:
         kwargs["env_guidance"] = env_guidance
+    if anchor != "adapters":
+        kwargs["anchor"] = anchor
     out = []
     for b in tqdm(batches, desc="prompts", disable=not progress, dynamic_ncols=True, leave=False):
         gen = generator.generate([b.prompt] * b.count, length, sampler="ddim", steps=steps, guidance=guidance,
