@@ -1,0 +1,12 @@
+# Session 47: rules 21 and 22 (the guidance anchor). CPU, 2 cores, one job at a time; scratch as sessions 45-46
+# (/work/scratch/s39: corpus3, eval; /work/scratch/s41/J40_model, a copy of simdiff/assets/default_model's weights).
+S=/work/scratch/s39; M=/work/scratch/s41/J40_model; CK=reports/training/s39_drift_gpu/check.sh
+# Stage B (val Earth, n 128, seeds 0 1). The backbone anchor at Earth is exactly alpha 0 (tested), so ALPHA=0:
+ALPHA=0 STEPS=50 bash $CK B J40a0s50 $M                        # rule 21, w 2.5
+for w in 3.0 3.5; do ALPHA=0 W=$w STEPS=50 bash $CK B J40a0w${w}s50 $M; done   # rule 22
+python reports/training/s46_length/rule19_table.py $S/eval11/B_J40w2.5s50 $S/eval11/B_J40a0*
+# Stage C (val n 128 seed 0, off Earth) and stage A (val seeds 100 101, response), the anchor on, w 3.0:
+export SIMDIFF_SCRATCH=$S STEPS=50 W=3.0 ANCHOR=backbone
+python reports/training/s37_env_guidance/guard.py -1.6,0,0 2 $S/eval11/C_J40anchor_w3.0/-1.6,0,0 $M
+bash $CK A J40anchor_w3.0 $M
+python reports/training/s37_env_guidance/guard.py -9.81,10,0 2 $S/eval11/C_J40anchor_w3.0/-9.81,10,0 $M
