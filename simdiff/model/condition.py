@@ -39,22 +39,7 @@ class Condition:
         The text is dropped in the second half only; φ and α are kept in both halves
         (adapters stay active in both CFG passes, φ is never dropped).
         """
-        b = self.batch_size
-        keep = self.uncond if self.uncond is not None else torch.zeros(b, dtype=torch.bool, device=self.text.device)
-        uncond = torch.cat([keep, torch.ones_like(keep)])
-
-        def twice(value: Tensor | None) -> Tensor | None:
-            return None if value is None else torch.cat([value, value])
-
-        alpha = twice(self.alpha) if isinstance(self.alpha, Tensor) else self.alpha
-        return Condition(
-            text=torch.cat([self.text, self.text]),
-            uncond=uncond,
-            frame_mask=twice(self.frame_mask),
-            env=twice(self.env),
-            env_index=twice(self.env_index),
-            alpha=alpha,
-        )
+        return self.stacked(self.unconditional())
 
     def stacked(self, other: "Condition") -> "Condition":
         """The (B + B') condition of this batch followed by ``other``'s (α: both floats and equal, or tensors)."""
