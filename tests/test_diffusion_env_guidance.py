@@ -1,4 +1,5 @@
-"""Environment guidance: x̃₀ = CFG(φ) + (s_e − 1)·(x₀(c, φ) − x₀(c, φ_ref)); Earth rows untouched."""
+"""Environment guidance: x̃₀ = CFG(φ) + (s_e − 1)·(x₀(c, φ) − x₀(c, φ_ref)); Earth rows untouched. And the backbone
+anchor: x̃₀ = CFG of the backbone (α 0) + s_e·(x₀(c, φ, α) − x₀(c, φ_ref, α))."""
 
 from __future__ import annotations
 
@@ -98,3 +99,95 @@ def test_condition_select_picks_rows() -> None:
     picked = a.select(torch.tensor([2, 0]))
     assert torch.equal(picked.env, ENVS[[2, 0]]) and torch.equal(picked.text, a.text[[2, 0]])
     assert picked.alpha.tolist() == [0.5, 1.0] and picked.uncond is None
+
+
+# --- the backbone anchor -----------------------------------------------------------------------------------
+
+def with_env(c: Condition, env: torch.Tensor, alpha: float | torch.Tensor | None = None) -> Condition:
+    return Condition(text=c.text, env=env, alpha=c.alpha if alpha is None else alpha)
+
+
+@pytest.mark.parametrize("batched", [True, False])
+@pytest.mark.parametrize("scale,env_scale", [(2.5, 2.0), (1.0, 1.0), (2.5, 0.0)])
+def test_formula_and_reference_rows_are_the_backbone(batched: bool, scale: float, env_scale: float) -> None:
+    sd, c = simdiff_net(), cond()
+    x, t = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(1)), torch.tensor([900, 500, 20])
+    earth = torch.tensor([REFERENCE_ENV] * 3)
+    with torch.no_grad():
+        out = GuidedDenoiser(sd, scale, batched, env_scale=env_scale, anchor="backbone")(x, t, c)
+        backbone = GuidedDenoiser(sd, scale, batched)(x, t, with_env(c, ENVS, alpha=0.0))
+        push = sd(x, t, c) - sd(x, t, with_env(c, earth))
+        adapters = GuidedDenoiser(sd, scale, batched)(x, t, c)
+    assert torch.allclose(out, backbone + env_scale * push, atol=1e-4)
+    assert torch.equal(out[1], backbone[1])  # φ = φ_ref: the backbone alone, bit for bit
+    assert (out[1] - adapters[1]).abs().max() > 1e-3  # ... which is not what the adapters anchor gives
+    if env_scale:
+        assert (out[0] - backbone[0]).abs().max() > 1e-3 and (out[2] - backbone[2]).abs().max() > 1e-3
+
+
+def test_the_default_anchor_is_unchanged() -> None:
+    sd, c = simdiff_net(), cond()
+    x, t = torch.randn(3, 8, 263), torch.tensor([300, 300, 300])
+    with torch.no_grad():
+        assert torch.equal(GuidedDenoiser(sd, 2.5, env_scale=2.0)(x, t, c),
+                           GuidedDenoiser(sd, 2.5, env_scale=2.0, anchor="adapters")(x, t, c))
+
+
+def test_one_2k_forward_over_the_changed_rows_only() -> None:
+    sd, c = simdiff_net(), cond()
+    calls: list[tuple[int, object]] = []
+
+    def counting(x, t, cc):
+        calls.append((x.shape[0], cc.alpha if not isinstance(cc.alpha, torch.Tensor) else cc.alpha.tolist()))
+        return sd(x, t, cc)
+
+    x, t = torch.randn(3, 8, 263), torch.zeros(3, dtype=torch.long)
+    with torch.no_grad():
+        GuidedDenoiser(counting, 2.5, env_scale=1.0, anchor="backbone")(x, t, c)
+        assert calls == [(6, 0.0), (4, 0.5)]  # the backbone's CFG pair, then φ and φ_ref of the two rows off Earth
+        calls.clear()
+        GuidedDenoiser(counting, 2.5, env_scale=2.0, anchor="backbone")(x, t, with_env(c, torch.tensor([REFERENCE_ENV] * 3)))
+        assert calls == [(6, 0.0)]
+
+
+def test_per_row_alpha_is_kept_in_the_push() -> None:
+    sd = simdiff_net()
+    c = cond(alpha=torch.tensor([0.2, 0.5, 1.0]))
+    x, t = torch.randn(3, 8, 263), torch.tensor([300, 300, 300])
+    with torch.no_grad():
+        out = GuidedDenoiser(sd, 2.5, env_scale=2.0, anchor="backbone")(x, t, c)
+        backbone = GuidedDenoiser(sd, 2.5)(x, t, with_env(c, ENVS, alpha=0.0))
+        push = sd(x, t, c) - sd(x, t, with_env(c, torch.tensor([REFERENCE_ENV] * 3)))
+    assert torch.allclose(out, backbone + 2.0 * push, atol=1e-4)
+
+
+def test_bad_anchor_and_no_continuous_env_are_one_line_errors() -> None:
+    with pytest.raises(SimdiffError, match="unknown guidance anchor 'sim'"):
+        GuidedDenoiser(simdiff_net(), 2.5, anchor="sim")
+    torch.manual_seed(0)
+    backbone = MDMBackbone(backbone_preset("tiny")).eval()
+    with pytest.raises(SimdiffError, match="backbone anchor needs a SimDiff model"):
+        GuidedDenoiser(backbone, 2.5, anchor="backbone")(torch.randn(2, 8, 263), torch.zeros(2, dtype=torch.long),
+                                                        Condition(text=torch.randn(2, 384)))
+
+
+def test_sampling_earth_rows_equal_the_backbone_alone() -> None:
+    sd, c = simdiff_net(), cond()
+    s = make_scheduler("ddim", 6)
+    anchored = sample(sd, s, c, 10, generator=torch.Generator().manual_seed(0), env_guidance=2.0, anchor="backbone")
+    alone = sample(sd, s, with_env(c, ENVS, alpha=0.0), 10, generator=torch.Generator().manual_seed(0))
+    assert torch.equal(anchored[1], alone[1])
+    assert not torch.allclose(anchored[0], alone[0], atol=1e-3)
+
+
+def test_condition_stacked() -> None:
+    a, b = cond(alpha=0.5), cond(alpha=torch.tensor([1.0, 0.0, 0.5]))
+    same = a.stacked(a)
+    assert same.batch_size == 6 and same.alpha == 0.5 and same.uncond is None
+    assert torch.equal(same.env, torch.cat([ENVS, ENVS]))
+    mixed = a.stacked(b)
+    assert mixed.alpha.tolist() == [0.5, 0.5, 0.5, 1.0, 0.0, 0.5]
+    b.uncond = torch.tensor([True, False, False])
+    assert a.stacked(b).uncond.tolist() == [False, False, False, True, False, False]
+    with pytest.raises(ValueError, match="env"):
+        a.stacked(Condition(text=a.text))

@@ -61,12 +61,7 @@ def test_generate_rejects_bad_input() -> None:
 
 
 def test_backbone_anchor_gives_the_backbone_at_earth_and_is_validated() -> None:
-    config = tiny(True)
-    torch.manual_seed(0)
-    net = build_network(config)
-    for a in net.adapters:
-        torch.nn.init.normal_(a.up.weight, std=0.3)
-    gen = MotionGenerator(net, config, HashText())
+    gen = reacting_generator()
     envs = [[-9.81, 0.0, 0.0], [-1.6, 0.0, 0.0]]
     anchored = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1, env_guidance=2.0,
                             anchor="backbone").features
@@ -84,13 +79,18 @@ def test_load_pretrained_missing_folder(tmp_path) -> None:
         load_pretrained(tmp_path / "nope")
 
 
-def test_env_guidance_changes_only_motions_off_earth_and_is_validated() -> None:
+def reacting_generator() -> MotionGenerator:
+    """A tiny continuous SimDiff generator whose adapters answer φ (jittered up-projections)."""
     config = tiny(True)
     torch.manual_seed(0)
     net = build_network(config)
     for a in net.adapters:
         torch.nn.init.normal_(a.up.weight, std=0.3)
-    gen = MotionGenerator(net, config, HashText())
+    return MotionGenerator(net, config, HashText())
+
+
+def test_env_guidance_changes_only_motions_off_earth_and_is_validated() -> None:
+    gen = reacting_generator()
     envs = [[-9.81, 0.0, 0.0], [-1.6, 0.0, 0.0]]
     plain = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1).features
     pushed = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1, env_guidance=3.0).features
