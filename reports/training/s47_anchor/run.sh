@@ -21,3 +21,8 @@ for x in "J40w2.5s50 2.5 adapters" "J40anchor_w3.0 3.0 backbone"; do set -- $x
     --seeds 0 1 2 3 4 --no-response --jump-samples 16 --speed-samples 8 --steps 50 --guidance $2 --alpha 0.5 \
     --foot-lock 1 --env-guidance 2 --anchor $3 --threads 2 --out $S/eval11/E2_$1 -q                    # 14 min each
 done
+# Session 46's DDIM 20 test motions re-scored with the second evaluator (parts of T_J40 reused; 6 min):
+mkdir -p $S/eval11/E2_J40 && cp -r $S/eval11/T_J40/parts $S/eval11/E2_J40/
+python benchmarks/model_check.py --model $M --corpus $S/corpus3 --evaluator $S/eval2 --split test --n 256 --seeds 0 1 2 3 4 \
+  --no-response --jump-samples 16 --speed-samples 8 --steps 20 --guidance 2.5 --alpha 0.5 --foot-lock 1 --env-guidance 2 \
+  --threads 2 --out $S/eval11/E2_J40 -q
