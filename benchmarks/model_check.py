@@ -28,6 +28,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def parse(argv: list[str] | None = None) -> argparse.Namespace:
+    from simdiff.product.request import ANCHORS  # torch-free
+
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--model", required=True, help="model folder (model.safetensors + config.json)")
     p.add_argument("--corpus", required=True, help="corpus folder, HumanML3D layout (+ manifest.json for speeds)")
@@ -44,7 +46,7 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--foot-lock", type=float, default=0.0, help="foot-lock strength in [0, 1] (0: off)")
     p.add_argument("--env-guidance", type=float, default=1.0,
                    help="environment guidance s_e of SimDiff models (1: off; changes only motions off Earth)")
-    p.add_argument("--anchor", default="adapters", choices=("adapters", "backbone"),
+    p.add_argument("--anchor", default="adapters", choices=ANCHORS,
                    help="what the text guidance runs on (backbone: the adapters add only their answer to φ vs Earth)")
     p.add_argument("--workers", type=int, default=0, help="simulator processes (0: all cores)")
     p.add_argument("--no-response", action="store_true", help="skip the physics-response section")

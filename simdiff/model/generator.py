@@ -143,21 +143,23 @@ class MotionGenerator:
         bad = [int(n) for n in lens if not 1 <= int(n) <= MAX_FRAMES]
         if bad:
             raise SimdiffError(f"motion length must be 1..{MAX_FRAMES} frames (9.8 s at 20 fps), got {bad[0]}")
-        text = text_embeddings.float().to(self.device) if text_embeddings is not None else self.encode_text(texts)
-        frames = int(lens.max())
-        mask = (torch.arange(frames)[None] < lens[:, None]).to(self.device)
+        continuous = self.config.sim is not None and self.config.sim.mode == "continuous"
         env_guidance = float(env_guidance)
         if env_guidance != 1.0:
             if not (env_guidance >= 0.0 and env_guidance < float("inf")):
                 raise SimdiffError(f"env guidance must be a finite number ≥ 0, got {env_guidance}")
-            if self.config.sim is None or self.config.sim.mode != "continuous":
+            if not continuous:
                 raise SimdiffError("env guidance needs a SimDiff model with a continuous Sim Encoder; "
                                    "this model has none (leave it at 1)")
         if anchor not in ANCHORS:
             raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose {' or '.join(ANCHORS)}")
-        if anchor != "adapters" and (self.config.sim is None or self.config.sim.mode != "continuous"):
+        if anchor != "adapters" and not continuous:
             raise SimdiffError(f"anchor {anchor!r} needs a SimDiff model with a continuous Sim Encoder; "
                                "this model has none (leave it at 'adapters')")
+        # options checked first: a bad one fails before the text encoder runs
+        text = text_embeddings.float().to(self.device) if text_embeddings is not None else self.encode_text(texts)
+        frames = int(lens.max())
+        mask = (torch.arange(frames)[None] < lens[:, None]).to(self.device)
         cond = Condition(text=text, frame_mask=mask, alpha=float(alpha), **self._env(b, env, env_index))
         generator = None
         if seed is not None:

@@ -8,6 +8,8 @@ from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from simdiff.product.request import ANCHORS
+
 if TYPE_CHECKING:
     from simdiff.product.finisher import Finisher
     from simdiff.product.request import GenerationRequest
@@ -80,7 +82,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--env-guidance", type=float, metavar="S",
                      help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off; "
                           "motions under Earth without wind are unchanged (default 1, or the model's sampling.json)")
-    smp.add_argument("--anchor", choices=["adapters", "backbone"],
+    smp.add_argument("--anchor", choices=ANCHORS,
                      help="what the text guidance runs on: the network with its adapters (adapters), or the backbone "
                           "alone, the adapters adding only their answer to φ against Earth without wind (backbone); "
                           "default adapters, or the model's sampling.json")
