@@ -1,0 +1,17 @@
+# Session 48's commands, in order (scratch S=/work/scratch/s39 from sessions 39-47: corpus3, aug_weakg, aug_gen,
+# aug_wind, evaluator eval, J40's stage runs in eval11/). Rule 24 (rule24.txt) was written before these ran.
+S=/work/scratch/s39; W48=/work/scratch/s48
+python reports/training/s48_inplace/jump_split.py $S/corpus3 8 24 > $S/corpus3/train_jumpy.txt
+simdiff train backbone --data $S/corpus3 --split train_jumpy --init simdiff/assets/default_model \
+  --out $W48/bb --config configs/backbone_small_cpu.json --lr 1e-4 --seed 48 --batch-size 64 \
+  --steps 3000 --save-every 100 --device cpu --text-table .gpu/captions.safetensors --max-minutes 40 \
+  --loader-workers 1 --no-progress                                               # 40 min
+cp -r $W48/bb/model $W48/bb_model
+simdiff train adapters --data $S/aug_weakg $S/aug_gen $S/aug_wind --split first_try --init $W48/bb_model \
+  --adapters-init simdiff/assets/default_model --out $W48/ad --config configs/adapters_paired_gpu_finetune.json \
+  --env-pairs 10 --env-pairs-drift 20 --seed 48 --batch-size 64 --save-every 100 --device cpu \
+  --text-table .gpu/captions.safetensors --max-minutes 15 --loader-workers 1 --no-progress   # 15 min
+cp -r $W48/ad/model $W48/J48_model
+python reports/training/s41_jump_backbone/jump_probe.py $W48/J48_model '[{"steps": 50}]' 8       # a screen
+STEPS=50 bash reports/training/s39_drift_gpu/check.sh B J48 $W48/J48_model                        # rule 24
+STEPS=50 bash reports/training/s39_drift_gpu/check.sh A J48 $W48/J48_model                        # rule 24, if B passes
