@@ -15,3 +15,15 @@ cp -r $W48/ad/model $W48/J48_model
 python reports/training/s41_jump_backbone/jump_probe.py $W48/J48_model '[{"steps": 50}]' 8       # a screen
 STEPS=50 bash reports/training/s39_drift_gpu/check.sh B J48 $W48/J48_model                        # rule 24
 STEPS=50 bash reports/training/s39_drift_gpu/check.sh A J48 $W48/J48_model                        # rule 24, if B passes
+# descriptive, after rule 24's outcome: stage B re-scored with the second evaluator (session 47's eval2, seed 1)
+for pair in "J40w2.5s50 simdiff/assets/default_model" "J48 $W48/J48_model"; do set -- $pair
+  python benchmarks/model_check.py --model $2 --corpus $S/corpus3 --evaluator $S/eval2 --split val --n 128 --seeds 0 1 \
+    --no-response --jump-samples 16 --speed-samples 8 --steps 50 --guidance 2.5 --alpha 0.5 --foot-lock 1 \
+    --env-guidance 2 --anchor adapters --threads 2 --out $S/eval11/B2_$1 -q
+done
+# screens of the text side and of exact training captions (outputs: caption_neighbours.txt, prompt_probe.txt)
+python reports/training/s48_inplace/caption_neighbours.py $S/corpus3 .gpu/captions.safetensors \
+  "a person jumps up in place" "a person jumps up and down" "a person does a long jump" > reports/training/s48_inplace/caption_neighbours.txt
+for m in simdiff/assets/default_model $W48/J48_model; do echo "# $m"
+  python reports/training/s48_inplace/prompt_probe.py $m "a person jumps up." "a person jumps high." "a person jumps up in place"
+done > reports/training/s48_inplace/prompt_probe.txt
