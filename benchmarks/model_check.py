@@ -11,6 +11,8 @@ one replication per seed), jump/hop prompts (flight ≥ 0.2 s with the pelvis �
 speeds against the corpus's train clips, the physics response to g = −1.6 and ±10 N wind against
 the simulator (models with a Sim Encoder), and ``--speed``: ``benchmarks/bench_generate.py``.
 ``--quick``: n = 16, one seed, 10 DDIM steps, 4 samples per prompt (a smoke run, not a claim).
+``--also-evaluator DIR`` (repeatable): further evaluators score the same test-split motions (each generated
+once); reported beside the first evaluator's figures, which the verdicts use.
 Finished sections are kept in ``<out>/parts/`` and reused by a rerun with the same settings.
 """
 
@@ -33,7 +35,9 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--model", required=True, help="model folder (model.safetensors + config.json)")
     p.add_argument("--corpus", required=True, help="corpus folder, HumanML3D layout (+ manifest.json for speeds)")
-    p.add_argument("--evaluator", required=True, help="our evaluator's folder")
+    p.add_argument("--evaluator", required=True, help="our evaluator's folder (the verdicts use it)")
+    p.add_argument("--also-evaluator", action="append", default=[], metavar="DIR",
+                   help="a further evaluator that scores the same test-split motions (repeatable; reported, not judged)")
     p.add_argument("--split", default="test")
     p.add_argument("--n", type=int, default=256, help="test motions per replication (default 256)")
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4], help="one replication per seed")
@@ -89,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
         config = CheckConfig(model=args.model, corpus=args.corpus, evaluator=args.evaluator, out=out, seeds=args.seeds,
                              steps=args.steps, guidance=args.guidance, alpha=args.alpha,
                              foot_lock=args.foot_lock, env_guidance=args.env_guidance, anchor=args.anchor,
-                             device=args.device,
+                             more_evaluators=list(args.also_evaluator), device=args.device,
                              split=SplitOptions(split=args.split, n=args.n),
                              prompts=PromptOptions(jump_samples=args.jump_samples, speed_samples=args.speed_samples,
                                                    length=args.length),

@@ -279,3 +279,40 @@ def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: P
     assert not any(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))  # Earth motions change too
     assert report["settings"]["anchor"] == "backbone"
     assert "guidance anchor backbone" in (tmp_path / "out" / "check.md").read_text()
+
+
+def test_more_evaluators_score_the_same_motions(checked: dict, tmp_path: Path, monkeypatch) -> None:
+    """A second evaluator scores the motions the first scored, each generated once; the verdicts keep the first."""
+    import shutil
+
+    import simdiff.eval.protocol as protocol
+
+    shutil.copytree(checked["root"] / "out" / "parts", tmp_path / "out" / "parts")
+    twin = tmp_path / "evaluator_copy"
+    shutil.copytree(checked["paths"]["evaluator"], twin)
+    calls: list[int] = []
+    make = protocol.generator_fn
+
+    def counting(*args, **kwargs):
+        fn = make(*args, **kwargs)
+        return lambda captions, lengths, seed: calls.append(seed) or fn(captions, lengths, seed)
+
+    monkeypatch.setattr(protocol, "generator_fn", counting)
+    config = _config(checked["paths"], tmp_path / "out")
+    config.more_evaluators = [str(twin)]
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    split, first = report["test_split"], checked["report"]["test_split"]
+    assert not split.get("cached") and report["jumps"].get("cached")  # only the test split is scored again
+    assert len(calls) == len(set(calls)) > 0  # each batch generated once for both evaluators
+    (other,) = split["more_evaluators"]
+    assert other["evaluator"]["path"] == str(twin.resolve())
+    for key in ("fid", "r_precision_top3"):  # same weights, same motions: the same figures, and the first run's
+        assert other["generated"][key]["mean"] == split["generated"][key]["mean"] == first["generated"][key]["mean"]
+    judged = [[v for v in r["verdicts"] if v["check"] != "generate_speed"] for r in (report, checked["report"])]
+    assert judged[0] == judged[1]  # the fixture also had a speed result; every other verdict is the first evaluator's
+    assert "scored by further evaluators" in (tmp_path / "out" / "check.md").read_text()
+    for bad, needle in (([str(checked["paths"]["evaluator"])], "evaluators must be distinct"),
+                        ([str(tmp_path)], "missing model.safetensors")):
+        with pytest.raises(SimdiffError, match=needle):
+            CheckConfig(**{**config.__dict__, "more_evaluators": bad}).validate()

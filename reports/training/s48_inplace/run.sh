@@ -27,3 +27,8 @@ python reports/training/s48_inplace/caption_neighbours.py $S/corpus3 .gpu/captio
 for m in simdiff/assets/default_model $W48/J48_model; do echo "# $m"
   python reports/training/s48_inplace/prompt_probe.py $m "a person jumps up." "a person jumps high." "a person jumps up in place"
 done > reports/training/s48_inplace/prompt_probe.txt
+# the new --also-evaluator against the two separate runs above (same figures, one generation)
+python benchmarks/model_check.py --model simdiff/assets/default_model --corpus $S/corpus3 --evaluator $S/eval \
+  --also-evaluator $S/eval2 --split val --n 128 --seeds 0 1 --no-response --jump-samples 16 --speed-samples 8 \
+  --steps 50 --guidance 2.5 --alpha 0.5 --foot-lock 1 --env-guidance 2 --anchor adapters --threads 2 \
+  --out $S/eval11/BB_J40w2.5s50 -q

@@ -91,6 +91,9 @@ class CheckConfig:
             generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`); env_guidance: environment
             guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth);
             anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:mod:`simdiff.diffusion.guidance`).
+        more_evaluators: further evaluator folders that score the same test-split motions (each motion generated
+            once); the verdicts use ``evaluator``. FID differences between models or settings depend on which
+            evaluator was trained (session 47), so a claimed FID change should hold under a second one.
         device: torch device; quick: the smoke preset was applied (reported).
     """
 
@@ -105,6 +108,7 @@ class CheckConfig:
     foot_lock: float = 0.0
     env_guidance: float = 1.0
     anchor: str = "adapters"
+    more_evaluators: list[str] = field(default_factory=list)
     device: str = "cpu"
     quick: bool = False
     split: SplitOptions = field(default_factory=SplitOptions)
@@ -141,8 +145,11 @@ class CheckConfig:
                 raise SimdiffError(f"model folder {model}: missing {path.name}")
         if not (corpus / f"{self.split.split}.txt").is_file():
             raise SimdiffError(f"corpus {corpus}: no {self.split.split}.txt (give a HumanML3D-layout corpus)")
-        if not (evaluator / "model.safetensors").is_file():
-            raise SimdiffError(f"evaluator folder {evaluator}: missing model.safetensors")
+        for folder in [evaluator, *map(Path, self.more_evaluators)]:
+            if not (folder / "model.safetensors").is_file():
+                raise SimdiffError(f"evaluator folder {folder}: missing model.safetensors")
+        if len({Path(e).resolve() for e in [evaluator, *self.more_evaluators]}) != 1 + len(self.more_evaluators):
+            raise SimdiffError(f"evaluators must be distinct folders, got {[str(evaluator), *self.more_evaluators]}")
         return self
 
 

@@ -64,6 +64,19 @@ def _split_lines(s: dict[str, Any]) -> list[str]:
         lines.append(f"| {key}{' (FID floor for GT)' if key == 'fid' else ''} | {_ci(s['generated'].get(key))} | "
                      f"{_ci(s['ground_truth'].get(key))} | {_ci(r) if r else ''} |")
     lines.append(f"\nGeneration: {_f(s['gen_s_per_sample'])} s per sample (batched).")
+    return lines + _more_evaluator_lines(s.get("more_evaluators") or [])
+
+
+def _more_evaluator_lines(more: list[dict[str, Any]]) -> list[str]:
+    """The same motions scored by further evaluators (the verdicts use the first)."""
+    if not more:
+        return []
+    lines = ["", "The same generated and GT motions scored by further evaluators (not used by the verdicts):", "",
+             "| evaluator | R@3 generated | R@3 GT | FID generated | FID floor (GT) | FID / floor |", "|---|---|---|---|---|---|"]
+    for m in more:
+        g, t = m["generated"], m["ground_truth"]
+        lines.append(f"| `{m['evaluator']['path']}` | {_ci(g.get('r_precision_top3'))} | {_ci(t.get('r_precision_top3'))} | "
+                     f"{_ci(g.get('fid'))} | {_ci(t.get('fid'))} | {_ci(m['ratios'].get('fid_over_floor'))} |")
     return lines
 
 

@@ -36,6 +36,23 @@ def _stamp(path: str | Path, weights: str = "model.safetensors") -> dict[str, An
     return out
 
 
+OTHER_EVALUATOR_KEYS: tuple[str, ...] = ("generated", "ground_truth", "ratios", "per_seed")
+"""What a further evaluator's scoring of the same test-split motions keeps (the rest repeats the first's)."""
+
+
+def _memoised(fn: Callable[[list[str], list[int], int], Any]) -> Callable[[list[str], list[int], int], Any]:
+    """``fn`` with its outputs kept, so every evaluator scores the same motions and each is generated once."""
+    store: dict[tuple[tuple[str, ...], tuple[int, ...], int], Any] = {}
+
+    def generate(captions: list[str], lengths: list[int], seed: int) -> Any:
+        key = (tuple(captions), tuple(int(n) for n in lengths), int(seed))
+        if key not in store:
+            store[key] = fn(captions, lengths, seed)
+        return store[key]
+
+    return generate
+
+
 class ModelCheck:
     """Measures one model folder (:class:`CheckConfig`).
 
@@ -158,18 +175,30 @@ class ModelCheck:
 
         c = self.config
 
-        def measure() -> dict[str, Any]:
-            model = load_evaluator(c.evaluator, c.device)
+        def score(path: str, fn: Callable[..., Any]) -> dict[str, Any]:
+            model = load_evaluator(path, c.device)
             evaluator = OurEvaluator(model, self.text_encoder(model.config.text_encoder))
             dataset = HumanML3D(c.corpus, c.split.split, seed=c.seeds[0])
+            return measure_split(evaluator, dataset, fn, c.split, c.seeds, self.progress)
+
+        def measure() -> dict[str, Any]:
             env = self.env(EARTH)
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
                               steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock,
                               env_guidance=c.env_guidance, anchor=c.anchor)
-            return measure_split(evaluator, dataset, fn, c.split, c.seeds, self.progress)
+            if c.more_evaluators:
+                fn = _memoised(fn)
+            result = score(c.evaluator, fn)
+            if c.more_evaluators:
+                result["more_evaluators"] = [{"evaluator": _stamp(path)} | {k: v for k, v in score(path, fn).items()
+                                                                           if k in OTHER_EVALUATOR_KEYS}
+                                             for path in c.more_evaluators]
+            return result
 
-        return self.part("test_split", {"corpus": _stamp(c.corpus, f"{c.split.split}.txt"), "evaluator": _stamp(c.evaluator),
-                                        "split": c.split.__dict__}, measure)
+        key = {"corpus": _stamp(c.corpus, f"{c.split.split}.txt"), "evaluator": _stamp(c.evaluator), "split": c.split.__dict__}
+        if c.more_evaluators:
+            key["more_evaluators"] = [_stamp(path) for path in c.more_evaluators]
+        return self.part("test_split", key, measure)
 
     def jump_batches(self) -> list[PromptBatch]:
         return plan_batches(JUMP_PROMPTS, self.config.prompts.jump_samples, self.config.seeds)
