@@ -32,3 +32,9 @@ python benchmarks/model_check.py --model simdiff/assets/default_model --corpus $
   --also-evaluator $S/eval2 --split val --n 128 --seeds 0 1 --no-response --jump-samples 16 --speed-samples 8 \
   --steps 50 --guidance 2.5 --alpha 0.5 --foot-lock 1 --env-guidance 2 --anchor adapters --threads 2 \
   --out $S/eval11/BB_J40w2.5s50 -q
+# a third evaluator and the shipped model's test split scored by all three in one run (session 46's parts copied in)
+simdiff evaluate train-evaluator --corpus $S/corpus3 --out $S/eval3 --epochs 4 --seed 2 --no-progress   # 243 s
+python benchmarks/model_check.py --model simdiff/assets/default_model --corpus $S/corpus3 --evaluator $S/eval \
+  --also-evaluator $S/eval2 --also-evaluator $S/eval3 --split test --n 256 --seeds 0 1 2 3 4 --no-response \
+  --jump-samples 16 --speed-samples 8 --steps 50 --guidance 2.5 --alpha 0.5 --foot-lock 1 --env-guidance 2 \
+  --anchor adapters --threads 2 --out $S/eval11/T3_J40w2.5s50 -q                                         # 1,054 s
