@@ -38,3 +38,9 @@ python benchmarks/model_check.py --model simdiff/assets/default_model --corpus $
   --also-evaluator $S/eval2 --also-evaluator $S/eval3 --split test --n 256 --seeds 0 1 2 3 4 --no-response \
   --jump-samples 16 --speed-samples 8 --steps 50 --guidance 2.5 --alpha 0.5 --foot-lock 1 --env-guidance 2 \
   --anchor adapters --threads 2 --out $S/eval11/T3_J40w2.5s50 -q                                         # 1,054 s
+# session 47's anchor test motions scored by evaluators 1 and 3 (session 47's parts copied in), then the paired table
+python benchmarks/model_check.py --model /work/scratch/s41/J40_model --corpus $S/corpus3 --evaluator $S/eval \
+  --also-evaluator $S/eval3 --split test --n 256 --seeds 0 1 2 3 4 --no-response --jump-samples 16 --speed-samples 8 \
+  --steps 50 --guidance 3.0 --alpha 0.5 --foot-lock 1 --env-guidance 2 --anchor backbone --threads 2 \
+  --out $S/eval11/T3_J40anchor_w3.0 -q                                                                  # 953 s
+python reports/training/s48_inplace/paired.py
