@@ -1,7 +1,7 @@
 # Session 48's commands, in order (scratch S=/work/scratch/s39 from sessions 39-47: corpus3, aug_weakg, aug_gen,
 # aug_wind, evaluator eval, J40's stage runs in eval11/). Rule 24 (rule24.txt) was written before these ran.
 S=/work/scratch/s39; W48=/work/scratch/s48
-python reports/training/s48_inplace/jump_split.py $S/corpus3 8 24 > $S/corpus3/train_jumpy.txt
+python reports/training/s42_jump_jog/mix_split.py $S/corpus3 8 16 1 > $S/corpus3/train_jumpy.txt   # jumps 8x, in place 8+16 = 24x, jogs 1x
 simdiff train backbone --data $S/corpus3 --split train_jumpy --init simdiff/assets/default_model \
   --out $W48/bb --config configs/backbone_small_cpu.json --lr 1e-4 --seed 48 --batch-size 64 \
   --steps 3000 --save-every 100 --device cpu --text-table .gpu/captions.safetensors --max-minutes 40 \

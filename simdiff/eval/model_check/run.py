@@ -178,22 +178,22 @@ class ModelCheck:
 
         c = self.config
 
-        def score(path: str, fn: Callable[..., Any]) -> dict[str, Any]:
+        def score(path: str, dataset: Any, fn: Callable[..., Any]) -> dict[str, Any]:
             model = load_evaluator(path, c.device)
             evaluator = OurEvaluator(model, self.text_encoder(model.config.text_encoder))
-            dataset = HumanML3D(c.corpus, c.split.split, seed=c.seeds[0])
             return measure_split(evaluator, dataset, fn, c.split, c.seeds, self.progress)
 
         def measure() -> dict[str, Any]:
+            dataset = HumanML3D(c.corpus, c.split.split, seed=c.seeds[0])  # the protocol draws with its own rng
             env = self.env(EARTH)
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
                               steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock,
                               env_guidance=c.env_guidance, anchor=c.anchor)
             if c.more_evaluators:
                 fn = _memoised(fn)
-            result = score(c.evaluator, fn)
+            result = score(c.evaluator, dataset, fn)
             if c.more_evaluators:
-                result["more_evaluators"] = [{"evaluator": _stamp(path)} | {k: v for k, v in score(path, fn).items()
+                result["more_evaluators"] = [{"evaluator": _stamp(path)} | {k: v for k, v in score(path, dataset, fn).items()
                                                                            if k in OTHER_EVALUATOR_KEYS}
                                              for path in c.more_evaluators]
             return result
