@@ -89,6 +89,22 @@ def test_train_errors(tmp_path, capsys) -> None:
     assert "--init takes the architecture" in err and err.count("\n") == 1
 
 
+def test_init_may_switch_frame_masking(runs, tmp_path) -> None:
+    """--mask-frames adds no weights: a warm start may turn it on, and the saved config says so."""
+    from safetensors.torch import load_file
+
+    assert json.loads((runs / "bb" / "model" / "config.json").read_text())["backbone"]["mask_frames"] is False
+    out = tmp_path / "masked"
+    assert main(["train", "backbone", "--synthetic", "4", "--init", str(runs / "bb" / "model"), "--mask-frames",
+                 "--steps", "1", "--batch-size", "2", "--out", str(out), "--no-progress"]) == 0
+    assert json.loads((out / "model" / "config.json").read_text())["backbone"]["mask_frames"] is True
+    before, after = load_file(runs / "bb" / "model" / "model.safetensors"), load_file(out / "model" / "model.safetensors")
+    assert before.keys() == after.keys()
+    assert main(["train", "adapters", "--synthetic", "4", "--init", str(out / "model"), "--steps", "1",
+                 "--batch-size", "2", "--out", str(tmp_path / "ad"), "--no-progress"]) == 0
+    assert json.loads((tmp_path / "ad" / "model" / "config.json").read_text())["backbone"]["mask_frames"] is True
+
+
 @pytest.mark.slow
 def test_torchrun_two_processes(runs, tmp_path) -> None:
     torchrun = shutil.which("torchrun")

@@ -39,6 +39,14 @@ from simdiff.train.state import latest_checkpoint, read_checkpoint, write_checkp
 TEXT_CACHE = "text_cache.safetensors"
 
 
+def _same_weights_layout(a: Any, b: Any) -> bool:
+    """Two backbone configs hold the same weights (``mask_frames`` only changes attention, not the weights)."""
+    layout_a, layout_b = dataclasses.asdict(a), dataclasses.asdict(b)
+    layout_a.pop("mask_frames", None)
+    layout_b.pop("mask_frames", None)
+    return layout_a == layout_b
+
+
 def _seeds(*key: int) -> tuple[int, int]:
     """Two independent 63-bit seeds derived from ``key``."""
     a, b = np.random.SeedSequence([int(k) & 0xFFFFFFFF for k in key]).generate_state(2, dtype=np.uint64)
@@ -155,7 +163,7 @@ class Trainer:
     def _load_backbone(self, folder: Path) -> tuple[Tensor | None, Tensor | None]:
         network, init_config, extra = load_pretrained(folder, "cpu")
         backbone = network.backbone if isinstance(network, SimDiffNet) else network
-        if dataclasses.asdict(init_config.backbone) != dataclasses.asdict(self.config.model.backbone):
+        if not _same_weights_layout(init_config.backbone, self.config.model.backbone):
             raise SimdiffError(f"{folder}: backbone config differs from this run's model config")
         if init_config.text_encoder != self.config.model.text_encoder:
             raise SimdiffError(f"{folder}: text encoder {init_config.text_encoder!r} differs from this run's "
@@ -171,7 +179,7 @@ class Trainer:
         if dataclasses.asdict(init_config.sim) != dataclasses.asdict(self.config.model.sim):
             raise SimdiffError(f"{folder}: sim config differs from this run's "
                                f"({init_config.sim} vs {self.config.model.sim})")
-        if dataclasses.asdict(init_config.backbone) != dataclasses.asdict(self.config.model.backbone):
+        if not _same_weights_layout(init_config.backbone, self.config.model.backbone):
             raise SimdiffError(f"{folder}: backbone config differs from this run's model config")
         own = self.network.state_dict()
         own.update({k: v for k, v in network.state_dict().items() if not k.startswith("backbone.")})

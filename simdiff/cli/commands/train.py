@@ -52,7 +52,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     b.add_argument("--size", choices=["mdm", "small", "tiny"], help="network size (default small; mdm = the paper's)")
     b.add_argument("--text-encoder", choices=["minilm", "clip"], help="text encoder (default minilm)")
     b.add_argument("--mask-frames", action=argparse.BooleanOptionalAction, default=None,
-                   help="mask padded frames in attention (off reproduces MDM)")
+                   help="mask padded frames in attention (off reproduces MDM); adds no weights, so it may "
+                        "change with --init (the run then fine-tunes the model under the new setting)")
     b.add_argument("--init", type=Path,
                    help="warm start: begin from this model folder's backbone weights (a SimDiff folder gives its "
                         "backbone) with a fresh optimiser; its architecture and text encoder are used")
@@ -130,9 +131,9 @@ def _run_config(args: argparse.Namespace):
     if args.mode == "backbone":
         model = config.model
         if args.init is not None:
-            if args.size is not None or args.text_encoder is not None or args.mask_frames is not None:
-                raise SimdiffError("--init takes the architecture from the model folder; drop --size, "
-                                   "--text-encoder and --mask-frames")
+            if args.size is not None or args.text_encoder is not None:
+                raise SimdiffError("--init takes the architecture from the model folder; drop --size and "
+                                   "--text-encoder")
             init = read_config(args.init)
             model.backbone, model.text_encoder = init.backbone, init.text_encoder
         if args.size is not None:
