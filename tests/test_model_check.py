@@ -281,6 +281,30 @@ def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: P
     assert "guidance anchor backbone" in (tmp_path / "out" / "check.md").read_text()
 
 
+def test_a_config_change_measures_every_section_again(checked: dict, tmp_path: Path) -> None:
+    """Same weights, another config.json (e.g. mask_frames): stored parts are not reused."""
+    import shutil
+
+    shutil.copytree(checked["paths"]["adapters"], tmp_path / "model")
+    config = _config(checked["paths"], tmp_path / "out")
+    config.model = str(tmp_path / "model")
+    config.prompts.jump_samples = config.prompts.speed_samples = 1
+
+    def run() -> dict:
+        return ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                          progress=False).run()
+
+    first = run()
+    assert run()["test_split"].get("cached")
+    path = tmp_path / "model" / "config.json"
+    model = json.loads(path.read_text())
+    model["backbone"]["mask_frames"] = not model["backbone"]["mask_frames"]
+    path.write_text(json.dumps(model))
+    again = run()
+    assert not any(again[k].get("cached") for k in ("test_split", "jumps", "speeds"))
+    assert again["model"]["config_sha256"] != first["model"]["config_sha256"]
+
+
 def test_more_evaluators_score_the_same_motions(checked: dict, tmp_path: Path, monkeypatch) -> None:
     """A second evaluator scores the motions the first scored, each generated once; the verdicts keep the first."""
     import shutil

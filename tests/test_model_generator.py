@@ -101,3 +101,30 @@ def test_env_guidance_changes_only_motions_off_earth_and_is_validated() -> None:
     backbone = MotionGenerator(build_network(tiny()), tiny(), HashText())
     with pytest.raises(SimdiffError, match="continuous Sim Encoder"):
         backbone.generate(["walk"], 12, steps=2, env_guidance=2.0)
+
+
+@pytest.mark.parametrize("mask_frames", [True, False])
+def test_masked_batch_gives_each_sample_at_its_own_length(mask_frames: bool) -> None:
+    """With ``mask_frames`` a short sample in a padded batch is the sample its length gives alone (same noise);
+    without it (MDM) the padded frames are denoised as motion too and the short sample is a crop of a longer one."""
+    from simdiff.diffusion.sampling import make_scheduler, sample
+    from simdiff.model.condition import Condition
+
+    config = ModelConfig(backbone=backbone_preset("tiny", mask_frames=mask_frames), sim=SimConfig())
+    torch.manual_seed(0)
+    net = build_network(config).eval()
+    for a in net.adapters:
+        torch.nn.init.normal_(a.up.weight, std=0.3)
+    text = HashText().encode(["a person walks", "a person jumps"])
+    lengths = torch.tensor([20, 12])
+    env = torch.tensor([[-1.6, 0.0, 0.0], [-1.6, 3.0, 0.0]])
+    x_init = torch.randn(2, 20, 263, generator=torch.Generator().manual_seed(5))
+    kw = dict(guidance=2.5, env_guidance=2.0)
+    batch = sample(net, make_scheduler("ddim", 5), Condition(text=text, frame_mask=torch.arange(20)[None] < lengths[:, None],
+                                                            env=env, alpha=0.5), 20, x_init=x_init, **kw)
+    alone = sample(net, make_scheduler("ddim", 5), Condition(text=text[1:], frame_mask=torch.ones(1, 12, dtype=torch.bool),
+                                                            env=env[1:], alpha=0.5), 12, x_init=x_init[1:, :12], **kw)
+    assert torch.allclose(batch[1, :12], alone[0], atol=1e-4) is mask_frames
+    first = sample(net, make_scheduler("ddim", 5), Condition(text=text[:1], frame_mask=torch.ones(1, 20, dtype=torch.bool),
+                                                            env=env[:1], alpha=0.5), 20, x_init=x_init[:1], **kw)
+    assert torch.allclose(batch[0], first[0], atol=1e-4)  # the longest sample has no padding either way

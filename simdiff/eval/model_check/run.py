@@ -27,12 +27,17 @@ SCHEMA: str = "simdiff.model_check/1"
 
 
 def _stamp(path: str | Path, weights: str = "model.safetensors") -> dict[str, Any]:
+    """A folder and the versions of its files (weights' size and mtime, ``config.json``'s hash): a stored part with
+    another stamp is measured again."""
     p = Path(path).expanduser().resolve()
     out: dict[str, Any] = {"path": str(p)}
     f = p / weights
     if f.is_file():
         st = f.stat()
         out.update(size=st.st_size, mtime_ns=st.st_mtime_ns)
+    config = p / "config.json"
+    if config.is_file():  # settings such as mask_frames change samples without touching the weights
+        out["config_sha256"] = hashlib.sha256(config.read_bytes()).hexdigest()
     return out
 
 
