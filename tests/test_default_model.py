@@ -99,14 +99,15 @@ def test_shipped_default_model_generates() -> None:
     assert 1.0 < height < 2.2, height  # a trained model makes a human-sized figure
 
 
-SHIPPED_TEST_REPORT = Path(__file__).parents[1] / "reports/training/s46_length/test/J40w2.5s50/check.json"
-"""The test-split model check of the shipped model at its shipped settings (session 46; update when shipping anew)."""
+SHIPPED_TEST_REPORT = Path(__file__).parents[1] / "reports/training/s49_mask_frames/test/J40m/check.json"
+"""The test-split model check of the shipped model at its shipped settings (session 49; update when shipping anew)."""
 
 
 @pytest.mark.skipif(not SHIPPED_TEST_REPORT.is_file(), reason="the shipped model's test report is not in this checkout")
 def test_shipped_settings_are_the_measured_ones() -> None:
     """`simdiff generate`'s defaults (sampling.json) are the settings the shipped model's test figures were measured at
-    (earlier reports measured DDIM 20 while users got DDIM 50), on weights of the measured file's size."""
+    (earlier reports measured DDIM 20 while users got DDIM 50), on weights of the measured file's size and with the
+    measured config."""
     import json
 
     report = json.loads(SHIPPED_TEST_REPORT.read_text())
@@ -117,3 +118,7 @@ def test_shipped_settings_are_the_measured_ones() -> None:
     assert stored.get("anchor", "adapters") == measured.get("anchor", "adapters")
     assert report["test_split"]["split"] == "test" and len(measured["seeds"]) >= 5
     assert report["model"]["size"] == (DEFAULT_MODEL_DIR / "model.safetensors").stat().st_size
+    # and with the shipped config.json (mask_frames changes batched samples without touching the weights)
+    import hashlib
+
+    assert report["model"]["config_sha256"] == hashlib.sha256((DEFAULT_MODEL_DIR / "config.json").read_bytes()).hexdigest()

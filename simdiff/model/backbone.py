@@ -140,7 +140,8 @@ class MDMBackbone(nn.Module):
         h = torch.cat([token[:, None, :], self.input_process(x)], dim=1)
         h = self.pe_dropout(h + self.pe[: t + 1][None])
         key_padding_mask = None
-        if self.config.mask_frames and cond.frame_mask is not None:
+        # a batch without padding takes the unmasked path: the same numbers, without the masked kernel's cost
+        if self.config.mask_frames and cond.frame_mask is not None and not bool(cond.frame_mask.all()):
             valid = torch.cat([torch.ones(b, 1, dtype=torch.bool, device=x.device), cond.frame_mask.bool()], dim=1)
             key_padding_mask = ~valid
         for i, layer in enumerate(self.seqTransEncoder.layers):
