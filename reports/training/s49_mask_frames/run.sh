@@ -13,3 +13,12 @@ simdiff train adapters --data $S/aug_weakg $S/aug_gen $S/aug_wind --split first_
   --text-table .gpu/captions.safetensors --loader-workers 1 --no-progress          # J48's 1,400 steps
 cp -r $W/ad/model $W/M49_model
 STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh B M49 $W/M49_model   # rule 25
+# rule 26 (written after rule 25's outcome, before these): the shipped weights and J48's with the mask at inference only
+for pair in "J40m simdiff/assets/default_model" "J48m $W/../s48/J48_model"; do set -- $pair
+  cp -r $2 $W/$1_model   # then "mask_frames": true in $W/$1_model/config.json
+  STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh B $1 $W/$1_model
+done                                                                              # 317 s, 345 s
+# adopted: simdiff/assets/default_model/config.json "mask_frames": true; the test split once, three evaluators
+STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh T 3_J40m simdiff/assets/default_model   # 1,603 s
+python reports/training/s49_mask_frames/paired.py > reports/training/s49_mask_frames/paired.txt
+python benchmarks/bench_generate.py --json reports/training/s49_mask_frames/bench_generate.json
