@@ -13,7 +13,8 @@ the simulator (models with a Sim Encoder), and ``--speed``: ``benchmarks/bench_g
 ``--quick``: n = 16, one seed, 10 DDIM steps, 4 samples per prompt (a smoke run, not a claim).
 ``--also-evaluator DIR`` (repeatable): further evaluators score the same test-split motions (each generated
 once); reported beside the first evaluator's figures, which the verdicts use.
-Finished sections are kept in ``<out>/parts/`` and reused by a rerun with the same settings.
+Finished sections are kept in ``<out>/parts/`` and reused by a rerun with the same settings and the same model files
+(weights' size and mtime, ``config.json``'s hash).
 """
 
 from __future__ import annotations
