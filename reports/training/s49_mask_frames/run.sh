@@ -22,3 +22,5 @@ done                                                                            
 STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh T 3_J40m simdiff/assets/default_model   # 1,603 s
 python reports/training/s49_mask_frames/paired.py > reports/training/s49_mask_frames/paired.txt
 python benchmarks/bench_generate.py --json reports/training/s49_mask_frames/bench_generate.json
+# screen, no rule: guidance 3.5 and 2.0 on the shipped (masked) model, val stage B
+for w in 3.5 2.0; do W=$w STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh B J40m_w$w simdiff/assets/default_model; done
