@@ -41,10 +41,7 @@ TEXT_CACHE = "text_cache.safetensors"
 
 def _same_weights_layout(a: Any, b: Any) -> bool:
     """Two backbone configs hold the same weights (``mask_frames`` only changes attention, not the weights)."""
-    layout_a, layout_b = dataclasses.asdict(a), dataclasses.asdict(b)
-    layout_a.pop("mask_frames", None)
-    layout_b.pop("mask_frames", None)
-    return layout_a == layout_b
+    return dataclasses.replace(a, mask_frames=b.mask_frames) == b
 
 
 def _seeds(*key: int) -> tuple[int, int]:
