@@ -12,6 +12,7 @@ from safetensors.torch import load_file
 from simdiff.errors import SimdiffError
 from simdiff.model import Condition, MotionGenerator, load_pretrained
 from simdiff.train import StepBatcher, Trainer, synthetic_dataset
+from simdiff.train.config import OptimConfig, lr_at
 from simdiff.train.testing import HashTextEncoder as HashText
 from simdiff.train.testing import tiny_run_config as run_config
 from simdiff.train.state import latest_checkpoint
@@ -52,10 +53,11 @@ class Interrupt(Exception):
     pass
 
 
-@pytest.mark.parametrize("ema", [False, True])
-def test_resume_after_interruption_is_bit_exact(tmp_path, ema: bool) -> None:
+@pytest.mark.parametrize(("ema", "schedule"), [(False, "constant"), (True, "constant"), (True, "cosine")])
+def test_resume_after_interruption_is_bit_exact(tmp_path, ema: bool, schedule: str) -> None:
     ds = synthetic_dataset(6, 24, max_frames=24)
     cfg = run_config(10, save_every=4, ema=ema, ema_decay=0.9)
+    cfg.train.optim.lr_schedule = schedule
     Trainer(tmp_path / "a", cfg, ds, text_encoder=HashText()).train(progress=False)
 
     def crash(step: int, loss: float) -> None:
@@ -75,6 +77,27 @@ def test_resume_after_interruption_is_bit_exact(tmp_path, ema: bool) -> None:
     sb = load_file(str(tmp_path / "b/checkpoints/step_000000010/state.safetensors"))
     assert sa.keys() == sb.keys() and all(torch.equal(sa[k], sb[k]) for k in sa)
     assert any(k.startswith("ema.") for k in sa) == ema
+
+
+def test_lr_at_follows_the_named_schedule() -> None:
+    o = OptimConfig(lr=2e-4)
+    assert [lr_at(o, s, 10) for s in (0, 5, 10)] == [2e-4] * 3
+    o.lr_schedule = "cosine"
+    assert lr_at(o, 0, 10) == pytest.approx(2e-4) and lr_at(o, 5, 10) == pytest.approx(1e-4)
+    assert lr_at(o, 10, 10) == pytest.approx(0.0, abs=1e-12) and lr_at(o, 2, 10) > lr_at(o, 3, 10)
+
+
+def test_cosine_schedule_sets_each_steps_lr_and_a_bad_name_is_refused(tmp_path) -> None:
+    ds = synthetic_dataset(4, 24, max_frames=24)
+    cfg = run_config(8, save_every=0)
+    cfg.train.optim.lr_schedule = "cosine"
+    trainer = Trainer(tmp_path / "a", cfg, ds, text_encoder=HashText())
+    seen: list[float] = []
+    trainer.train(progress=False, on_step=lambda step, loss: seen.append(trainer.optimizer.param_groups[0]["lr"]))
+    assert seen == pytest.approx([lr_at(cfg.train.optim, s, 8) for s in range(8)])
+    cfg.train.optim.lr_schedule = "linear"
+    with pytest.raises(SimdiffError, match="'linear'"):
+        Trainer(tmp_path / "b", cfg, ds, text_encoder=HashText())
 
 
 def test_ema_export_differs_from_raw(tmp_path) -> None:

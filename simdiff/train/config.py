@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from simdiff.model.config import ModelConfig
@@ -10,12 +11,30 @@ from simdiff.train.geometric import CropConfig, GeometricLossConfig
 
 @dataclass
 class OptimConfig:
-    """AdamW settings (MDM: lr 1e-4, no weight decay, no clipping)."""
+    """AdamW settings (MDM: lr 1e-4, no weight decay, no clipping, constant lr).
+
+    ``lr_schedule``: ``"constant"`` (MDM) or ``"cosine"`` (lr · ½(1 + cos(π · step / steps)): from ``lr`` at step 0
+    to 0 at the run's last step; a function of the step alone, so a resumed run continues the same curve).
+    """
 
     lr: float = 1e-4
     weight_decay: float = 0.0
     betas: tuple[float, float] = (0.9, 0.999)
     grad_clip: float = 0.0
+    lr_schedule: str = "constant"
+
+
+LR_SCHEDULES: tuple[str, ...] = ("constant", "cosine")
+"""Names :attr:`OptimConfig.lr_schedule` accepts."""
+
+
+def lr_at(optim: OptimConfig, step: int, steps: int) -> float:
+    """Learning rate of optimiser step ``step`` (0-based) in a run of ``steps`` steps."""
+    if optim.lr_schedule == "constant":
+        return optim.lr
+    if optim.lr_schedule == "cosine":
+        return optim.lr * 0.5 * (1.0 + math.cos(math.pi * min(step, steps) / max(steps, 1)))
+    raise ValueError(f"unknown lr_schedule {optim.lr_schedule!r} (choose from {', '.join(LR_SCHEDULES)})")
 
 
 @dataclass

@@ -29,7 +29,7 @@ from simdiff.model.condition import Condition
 from simdiff.model.provenance import Provenance, write_provenance
 from simdiff.model.simdiff_net import SimDiffNet
 from simdiff.text.cache import CachedTextEncoder
-from simdiff.train.config import RunConfig
+from simdiff.train.config import LR_SCHEDULES, RunConfig, lr_at
 from simdiff.train.data import MotionDataset, StepBatcher, StepBatches
 from simdiff.train.ema import EMA
 from simdiff.train.geometric import geometric_loss
@@ -126,6 +126,8 @@ class Trainer:
         self.network.to(self.device)
         self.trainable = {n: p for n, p in self.network.named_parameters() if p.requires_grad}
         o = tc.optim
+        if o.lr_schedule not in LR_SCHEDULES:
+            raise SimdiffError(f"unknown lr_schedule {o.lr_schedule!r} (choose from {', '.join(LR_SCHEDULES)})")
         self.optimizer = torch.optim.AdamW(list(self.trainable.values()), lr=o.lr, weight_decay=o.weight_decay,
                                            betas=tuple(o.betas))
         self.scheduler = DDPMScheduler()
@@ -277,6 +279,8 @@ class Trainer:
                 loss = loss + tc.env_pairs_drift * twin_drift_mse(pred, x0, mask, paired)
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
+        for group in self.optimizer.param_groups:
+            group["lr"] = lr_at(tc.optim, self.step, tc.steps)
         if tc.optim.grad_clip > 0:
             nn.utils.clip_grad_norm_(list(self.trainable.values()), tc.optim.grad_clip)
         self.optimizer.step()

@@ -27,6 +27,8 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--steps", type=int, help="total optimiser steps")
     p.add_argument("--batch-size", type=int, help="global batch size")
     p.add_argument("--lr", type=float, help="AdamW learning rate (default 1e-4)")
+    p.add_argument("--lr-schedule", choices=["constant", "cosine"],
+                   help="constant (MDM, the default) or cosine: from --lr down to 0 at --steps")
     p.add_argument("--seed", type=int, help="seed for init, data order, noise, dropout (default 10)")
     p.add_argument("--ema", action=argparse.BooleanOptionalAction, default=None, help="keep and export an EMA of the weights")
     p.add_argument("--ema-decay", type=float, help="EMA decay (default 0.9999)")
@@ -118,6 +120,8 @@ def _run_config(args: argparse.Namespace):
             setattr(tc, field, getattr(args, flag))
     if args.lr is not None:
         tc.optim.lr = args.lr
+    if args.lr_schedule is not None:
+        tc.optim.lr_schedule = args.lr_schedule
     if getattr(args, "env_pairs", None) is not None:
         tc.env_pairs = args.env_pairs
     if getattr(args, "env_pairs_drift", None) is not None:
