@@ -13,3 +13,10 @@ STEPS=50 bash reports/training/s39_drift_gpu/check.sh A J40m_se3 $M 3
 # s_e 3 passed (a)-(c): sampling.json "env_guidance": 3.0; the test split once, three evaluators
 S=/work/scratch/s39
 STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh T 3_J40m_se3 $M 3
+# rule 29 (rule29.txt, written after the s_e 3 test run): s_e 4 — stage C at g -1.6, A, C at +10 N, all passed;
+# sampling.json "env_guidance": 4.0 and the test split once more
+/usr/bin/time -f "stageC J40m se4 -1.6 %e s" python reports/training/s37_env_guidance/guard.py -1.6,0,0 4 $C/C_J40m_se4/-1.6,0,0 $M
+STEPS=50 bash reports/training/s39_drift_gpu/check.sh A J40m_se4 $M 4
+/usr/bin/time -f "stageC J40m se4 +10N %e s" python reports/training/s37_env_guidance/guard.py -9.81,10,0 4 $C/C_J40m_se4/-9.81,10,0 $M
+STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh T 3_J40m_se4 $M 4   # 1,669 s
+python benchmarks/bench_generate.py --json reports/training/s50_anneal/bench_generate.json
