@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from simdiff.errors import SimdiffError
 from simdiff.model.config import ModelConfig
 from simdiff.train.geometric import CropConfig, GeometricLossConfig
 
@@ -34,7 +35,7 @@ def lr_at(optim: OptimConfig, step: int, steps: int) -> float:
         return optim.lr
     if optim.lr_schedule == "cosine":
         return optim.lr * 0.5 * (1.0 + math.cos(math.pi * min(step, steps) / max(steps, 1)))
-    raise ValueError(f"unknown lr_schedule {optim.lr_schedule!r} (choose from {', '.join(LR_SCHEDULES)})")
+    raise SimdiffError(f"unknown lr_schedule {optim.lr_schedule!r} (choose from {', '.join(LR_SCHEDULES)})")
 
 
 @dataclass

@@ -29,7 +29,7 @@ from simdiff.model.condition import Condition
 from simdiff.model.provenance import Provenance, write_provenance
 from simdiff.model.simdiff_net import SimDiffNet
 from simdiff.text.cache import CachedTextEncoder
-from simdiff.train.config import LR_SCHEDULES, RunConfig, lr_at
+from simdiff.train.config import RunConfig, lr_at
 from simdiff.train.data import MotionDataset, StepBatcher, StepBatches
 from simdiff.train.ema import EMA
 from simdiff.train.geometric import geometric_loss
@@ -126,10 +126,9 @@ class Trainer:
         self.network.to(self.device)
         self.trainable = {n: p for n, p in self.network.named_parameters() if p.requires_grad}
         o = tc.optim
-        if o.lr_schedule not in LR_SCHEDULES:
-            raise SimdiffError(f"unknown lr_schedule {o.lr_schedule!r} (choose from {', '.join(LR_SCHEDULES)})")
-        self.optimizer = torch.optim.AdamW(list(self.trainable.values()), lr=o.lr, weight_decay=o.weight_decay,
-                                           betas=tuple(o.betas))
+        # lr_at refuses an unknown schedule here, before any step; each step then sets its own lr
+        self.optimizer = torch.optim.AdamW(list(self.trainable.values()), lr=lr_at(o, 0, tc.steps),
+                                           weight_decay=o.weight_decay, betas=tuple(o.betas))
         self.scheduler = DDPMScheduler()
         if text_encoder is None:
             from simdiff.text.base import load_text_encoder
