@@ -180,3 +180,18 @@ def test_centred_mean_is_scipys_constant_mode_uniform_filter() -> None:
             np.testing.assert_allclose(centred_mean(x, size), want, atol=1e-12)
     with pytest.raises(SimdiffError, match="odd window, got 4"):
         centred_mean(np.zeros((1, 5, 2)), 4)
+
+
+def test_never_touches_the_floor_only_when_every_valid_frame_is_clear() -> None:
+    from simdiff.motion.metrics import FLOOR_CLEARANCE, never_touches
+
+    assert FLOOR_CLEARANCE == 0.10
+    afloat = standing(40, 0.5)  # lowest joint 0.5 m up all clip long
+    landing = afloat.copy()
+    landing[30:, :, 1] -= 0.45  # comes down to 5 cm in its last 10 frames
+    grazing = standing(40, 0.10)  # exactly at the clearance: touches
+    batch = np.stack([afloat, landing, grazing, standing(40, 0.0)])
+    assert never_touches(batch).tolist() == [True, False, False, False]
+    assert never_touches(batch, [40, 30, 40, 40]).tolist() == [True, True, False, False]  # the landing is padding
+    assert never_touches(afloat).tolist() == [True]  # one motion (T, 22, 3)
+    assert never_touches(torch.from_numpy(batch), clearance=0.6).tolist() == [False] * 4

@@ -74,6 +74,9 @@ def test_check_writes_every_field(checked: dict) -> None:
     jumps = report["jumps"]
     assert [r["n"] for r in jumps["per_prompt"]] == [2] * 6 and jumps["overall"]["n"] == 12
     assert "outside every flight" in jumps["rule"]["standing_level"]
+    assert all(r["never_touch"] >= 0 for r in jumps["per_prompt"]) and "0.10 m" in jumps["rule"]["floor"]
+    assert "never_touch" in split["generated"] and 0.0 <= split["ground_truth"]["never_touch"]["mean"] <= 1.0
+    assert report["speeds"]["types"]["walk"]["never_touch"] >= 0
     speeds = report["speeds"]["types"]
     assert speeds["walk"]["samples"]["n"] == 4 and speeds["walk"]["corpus_train"]["n"] >= 1
     grav, wind = report["response"]["gravity"], report["response"]["wind"]
@@ -83,6 +86,7 @@ def test_check_writes_every_field(checked: dict) -> None:
     assert report["figures"]["generate_wall_s"] == 4.2
     md = (out / "check.md").read_text()
     assert "## Verdicts" in md and "quick preset" in md and "| jumps |" in md and "cannot carry" in md
+    assert "never touch floor |" in md and "| never_touch |" in md and "Samples that never touch the floor" in md
 
 
 def test_verdicts_follow_the_figures(checked: dict) -> None:
@@ -141,6 +145,11 @@ def test_jump_detection_on_ballistic_pelvis() -> None:
     short = jump_stats(jump(120, height=0.3, start=40, airtime=0.15))  # high enough, too short a flight
     assert not short["jump"] and short["flight_s"] < 0.2
     assert not jump_stats(walk(120))["jump"]
+    floating = jump(120, height=0.4, start=40, airtime=0.5)
+    floating[..., 1] += 0.5  # the same jump 0.5 m up: it never takes off from the floor
+    hover = jump_stats(floating)
+    assert not hover["jump"] and not hover["touches_floor"] and high["touches_floor"]
+    assert hover["flight_s"] == pytest.approx(high["flight_s"]) and hover["rise_m"] == pytest.approx(high["rise_m"])
     still = walk(60, speed=0.0, amplitude=0.0, bounce=0.0)
     assert standing_level(still) == pytest.approx(float(still[0, 0, 1]))
     assert root_speed(walk(80, speed=1.3)) == pytest.approx(1.3, rel=0.02)
@@ -185,6 +194,22 @@ def test_gravity_response_on_synthetic_jumps() -> None:
     assert apex["n_ratio"] == 3  # simulated change 0.6 − 0.3 = 0.3; generated +0.15, +0.15, −0.1
     assert apex["median_ratio"] == pytest.approx(0.5, abs=0.05)
     assert out["ratios"]["flight_s"]["median_ratio"] > 0
+    assert out["never_touch"]["earth"] == out["never_touch"]["low_g"] == out["never_touch"]["simulated_low_g"] == 0
+    assert out["never_touch"]["simulated_tracked"] == 3
+
+
+def test_gravity_response_does_not_count_a_floating_sample_as_rising() -> None:
+    earth = np.stack([jump(120, height=0.3, start=40, airtime=0.5)] * 3)
+    low = np.stack([jump(120, height=0.45, start=40, airtime=0.75)] * 3)
+    low[2, ..., 1] += 1.0  # the third sample hovers a metre up: higher apex gain by the relative rule, no take-off
+    out = gravity_response(["a", "b", "c"], earth, low, -1.6, _Physics(apex=0.6, drift=0.0), resamples=20)
+    assert out["rise_both"] == 2 and out["rise_apex_only"] == 3
+    assert out["never_touch"]["low_g"] == 1 and out["never_touch"]["earth"] == 0
+    assert out["ratios"]["apex_gain_m"]["n_ratio"] == 2 and out["ratios"]["apex_gain_m"]["n_tracked"] == 2
+    f = figures({"response": {"gravity": out}})
+    assert f["gravity_never_touch"] == 1
+    by = {v["check"]: v for v in verdicts(f)}
+    assert "1 of 3 samples never touch the floor" in by["gravity_rise"]["detail"]
 
 
 def test_wind_response_counts_downwind_drift() -> None:
@@ -199,6 +224,7 @@ def test_wind_response_counts_downwind_drift() -> None:
     assert out["n"] == 4 and out["downwind"] == 2
     assert out["drift_per_10n_simulated_m"]["median"] == pytest.approx(0.1, abs=1e-4)
     assert out["per_env"]["wx+10 wy+0"]["generated_m"]["median"] == pytest.approx(0.05, abs=1e-4)
+    assert out["per_env"]["wx+10 wy+0"]["never_touch"] == 0
 
 
 def test_script_reuses_parts_and_reports_bad_input(checked: dict, tmp_path: Path, monkeypatch, capsys) -> None:

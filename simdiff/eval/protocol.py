@@ -8,7 +8,8 @@ with the GT length, embed GT and generated motions and the texts, and compute
 * generated: R-precision top-1/2/3, MM-Dist, FID against this replication's GT motion
   embeddings, Diversity (300 pairs), physics metrics (CLoSD's per-batch mean), floating_to_gt
   (|floating − the same captions' GT floating|, mm) and phys_err (penetration + sliding +
-  floating_to_gt, mm; see :func:`simdiff.motion.metrics.phys_err`);
+  floating_to_gt, mm; see :func:`simdiff.motion.metrics.phys_err`), never_touch (fraction of
+  samples whose lowest joint never comes within 0.10 m of y = 0, :func:`simdiff.motion.metrics.never_touches`);
 * ground truth: the same, with FID against a second independent GT draw (crops/captions);
 * MultiModality (``mm_prompts`` > 0): ``mm_repeats`` generations for each of ``mm_prompts``
   captions, ``mm_times`` pairs each.
@@ -115,11 +116,12 @@ def _draw(dataset: Any, rng: np.random.Generator, config: ProtocolConfig) -> lis
 
 def _physics(features: Tensor, lengths: Tensor) -> dict[str, float]:
     from simdiff.motion.features import features_to_joints
-    from simdiff.motion.metrics import own_floor_metrics, physics_metrics
+    from simdiff.motion.metrics import never_touches, own_floor_metrics, physics_metrics
 
-    joints = features_to_joints(features.detach().cpu().double())
-    lens = lengths.clamp(min=2, max=joints.shape[1])
-    return {**physics_metrics(joints.numpy(), lens.numpy()), **own_floor_metrics(joints.numpy(), lens.numpy())}
+    joints = features_to_joints(features.detach().cpu().double()).numpy()
+    lens = lengths.clamp(min=2, max=joints.shape[1]).numpy()
+    return {**physics_metrics(joints, lens), **own_floor_metrics(joints, lens),
+            "never_touch": float(never_touches(joints, lens).mean())}
 
 
 def _scores(text: np.ndarray, motion: np.ndarray, ref_motion: np.ndarray, config: ProtocolConfig,

@@ -221,6 +221,28 @@ def own_floor_metrics(
     return {"sliding_own_floor": physics_metrics(shifted, lens)["sliding"], "own_floor": float(floor.mean() * 1000.0)}
 
 
+FLOOR_CLEARANCE: float = 0.10
+"""Metres: a motion whose lowest joint stays higher than this in every valid frame never touches the floor."""
+
+
+def never_touches(
+    joints: np.ndarray | torch.Tensor,
+    lengths: Sequence[int] | np.ndarray | torch.Tensor | None = None,
+    clearance: float = FLOOR_CLEARANCE,
+) -> np.ndarray:
+    """(B,) bool: the motion's lowest joint stays more than ``clearance`` m above y = 0 in every valid frame.
+
+    The floor is y = 0, not the motion's own floor: a sample that hovers a metre up all clip long has a
+    perfect own-floor gait and flights by the relative rule of :mod:`simdiff.motion.flight`, yet no
+    body part ever reaches the ground (session 50's runs under g = −1.6). Real motion under any gravity
+    touches the floor to take off. Joints (B, T, 22, 3) or (T, 22, 3), metres, Y-up; lengths (B,).
+    """
+    arr, lens = _prepare(joints, lengths)
+    lowest = arr[..., 1].min(axis=-1)  # (B, T)
+    valid = np.arange(arr.shape[1])[None, :] < lens[:, None]
+    return np.where(valid, lowest, np.inf).min(axis=1) > clearance
+
+
 def floating_to_gt(
     joints: np.ndarray | torch.Tensor,
     gt_joints: np.ndarray | torch.Tensor,

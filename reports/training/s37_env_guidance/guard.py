@@ -19,4 +19,5 @@ c = CheckConfig(model=model, corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=o
                 response=ResponseOptions(enabled=False))
 rep = ModelCheck(c.validate(), progress=False, command=sys.argv).run()
 f = rep["figures"]
-print(phi, se, {k: f.get(k) for k in ("r_precision_top3", "fid", "jump_fraction", "sliding_own_floor", "skate_ratio", "walk_median", "run_median")})
+print(phi, se, {k: f.get(k) for k in ("r_precision_top3", "fid", "jump_fraction", "sliding_own_floor", "skate_ratio", "walk_median", "run_median",
+                                  "floating", "never_touch")})

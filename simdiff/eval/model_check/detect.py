@@ -8,7 +8,9 @@ the pelvis rises at least :data:`MIN_RISE_M` above its *standing level*: the med
 over the frames outside every flight (the frames with a foot on the ground by the flight rule).
 The median of the grounded frames is the stance height of a motion that mostly stands or walks;
 a crouch before take-off lowers it a little (the rise is then slightly larger than over upright
-stance), a motion that crouches throughout has its crouch as the level.
+stance), a motion that crouches throughout has its crouch as the level. A motion that never
+touches the floor (:func:`simdiff.motion.metrics.never_touches`: its lowest joint stays above
+0.10 m all clip long) does not jump, however its feet move relative to each other: it floats.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from scipy import stats as sps
 from simdiff.errors import SimdiffError
 from simdiff.motion.flight import MIN_FLIGHT_S, airborne, flights
 from simdiff.motion.flight import check_joints as _joints
+from simdiff.motion.metrics import never_touches
 from simdiff.motion.skeleton import FPS
 
 MIN_RISE_M: float = 0.15
@@ -40,7 +43,8 @@ def jump_stats(joints: np.ndarray, fps: float = FPS) -> dict[str, float | bool]:
     Returns:
         flight_s (longest flight, s), rise_m (highest pelvis rise above the standing level during a
         flight of at least :data:`MIN_FLIGHT_S`; 0 without such a flight), standing_m (the level),
-        jump (both thresholds met).
+        touches_floor (some joint comes within 0.10 m of y = 0), jump (both thresholds met and
+        the motion touches the floor).
     """
     j = _joints(joints)
     found = flights(j)
@@ -50,8 +54,9 @@ def jump_stats(joints: np.ndarray, fps: float = FPS) -> dict[str, float | bool]:
     for s, e in found:
         if (e - s) / fps >= MIN_FLIGHT_S - 1e-9 and np.isfinite(level):
             rise = max(rise, float(j[s:e, 0, 1].max() - level))
-    return {"flight_s": float(longest), "rise_m": rise, "standing_m": level,
-            "jump": bool(longest >= MIN_FLIGHT_S - 1e-9 and rise >= MIN_RISE_M)}
+    touches = not bool(never_touches(j)[0])
+    return {"flight_s": float(longest), "rise_m": rise, "standing_m": level, "touches_floor": touches,
+            "jump": bool(touches and longest >= MIN_FLIGHT_S - 1e-9 and rise >= MIN_RISE_M)}
 
 
 def root_speed(joints: np.ndarray, fps: float = FPS) -> float:

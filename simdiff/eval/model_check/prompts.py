@@ -7,6 +7,9 @@
   type against the quartiles of the corpus's *train* clips of that ``motion_type``
   (``manifest.json``; mirrors left out: they have their original's speed). A type passes when
   the samples' median lies within the corpus clips' interquartile range.
+
+Both count the samples that never touch the floor (``never_touch``,
+:func:`simdiff.motion.metrics.never_touches`); such a sample is not a jump.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.eval.model_check.detect import MIN_FLIGHT_S, MIN_RISE_M, jump_stats, quartiles, root_speed, wilson
 from simdiff.eval.model_check.samples import PromptBatch
+from simdiff.motion.metrics import never_touches
 
 STANDING_LEVEL: str = ("median pelvis height over the frames outside every flight (feet on the ground by the "
                        "flight rule of simdiff/motion/flight.py)")
@@ -41,6 +45,7 @@ def jump_summary(joints: np.ndarray, batches: Sequence[PromptBatch]) -> dict[str
         mine = [s for s, b in zip(stats, owners) if b.prompt == prompt]
         per_prompt.append(_row(prompt, mine))
     return {"rule": {"min_flight_s": MIN_FLIGHT_S, "min_rise_m": MIN_RISE_M, "standing_level": STANDING_LEVEL,
+                     "floor": "a sample whose lowest joint stays > 0.10 m above y = 0 in every frame does not jump",
                      "interval": "Wilson 95 % over samples"},
             "per_prompt": per_prompt, "overall": _row("all", stats), "frames": int(joints.shape[1])}
 
@@ -50,6 +55,7 @@ def _row(prompt: str, stats: list[dict[str, Any]]) -> dict[str, Any]:
     frac, lo, hi = wilson(k, len(stats))
     return {"prompt": prompt, "n": len(stats), "jumps": k, "fraction": frac, "wilson95": [lo, hi],
             "with_flight": sum(s["flight_s"] >= MIN_FLIGHT_S - 1e-9 for s in stats),
+            "never_touch": sum(not s["touches_floor"] for s in stats),
             "median_flight_s": float(np.median([s["flight_s"] for s in stats])) if stats else float("nan"),
             "median_rise_m": float(np.median([s["rise_m"] for s in stats])) if stats else float("nan")}
 
@@ -95,6 +101,7 @@ def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dic
     """Per motion type: quartiles of the samples' speeds (and per prompt) against the corpus clips'."""
     owners = _per_sample(batches)
     speeds = [root_speed(j) for j in joints]
+    floating = never_touches(joints)
     out: dict[str, Any] = {"speed": "mean horizontal pelvis speed over the motion (m/s)",
                            "rule": "pass when the samples' median lies in the corpus train clips' [Q1, Q3]",
                            "types": {}}
@@ -105,5 +112,6 @@ def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dic
         out["types"][kind] = {
             "prompts": list(prompts), "samples": gen, "corpus_train": ref,
             "per_prompt": {p: quartiles([v for v, b in zip(speeds, owners) if b.prompt == p]) for p in prompts},
+            "never_touch": int(sum(f for f, b in zip(floating, owners) if b.prompt in prompts)),
             "median_in_iqr": bool(ref["n"] > 0 and ref["q1"] <= gen["median"] <= ref["q3"]) if gen["n"] else False}
     return out

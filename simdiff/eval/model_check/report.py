@@ -58,7 +58,7 @@ def _split_lines(s: dict[str, Any]) -> list[str]:
     lines += ["", "| metric | generated | ground truth | generated / GT (per replication) |", "|---|---|---|---|"]
     ratio = {"skate_ratio": "skate_ratio", "r_precision_top3": "r_precision_top3", "fid": "fid_over_floor",
              "sliding": "sliding_over_gt", "sliding_own_floor": "sliding_own_floor_over_gt"}
-    for key in ("sliding", "sliding_own_floor", "own_floor", "skate_ratio", "penetration", "floating", "r_precision_top1", "r_precision_top3", "mm_dist",
+    for key in ("sliding", "sliding_own_floor", "own_floor", "skate_ratio", "penetration", "floating", "never_touch", "r_precision_top1", "r_precision_top3", "mm_dist",
                 "fid", "diversity"):
         r = s["ratios"].get(ratio.get(key, ""))
         lines.append(f"| {key}{' (FID floor for GT)' if key == 'fid' else ''} | {_ci(s['generated'].get(key))} | "
@@ -85,12 +85,12 @@ def _jump_lines(j: dict[str, Any]) -> list[str]:
     lines = [f"{j['overall']['n']} samples of {j['frames']} frames at Earth φ. A sample jumps when a flight lasts "
              f"≥ {r['min_flight_s']} s and the pelvis rises ≥ {r['min_rise_m'] * 100:.0f} cm above its standing level "
              f"during it. Standing level: {r['standing_level']}. Interval: {r['interval']}.", "",
-             "| prompt | n | jumps | fraction [95 %] | with flight ≥ 0.2 s | median flight s | median rise m |",
-             "|---|---|---|---|---|---|---|"]
+             "| prompt | n | jumps | fraction [95 %] | with flight ≥ 0.2 s | median flight s | median rise m | never touch floor |",
+             "|---|---|---|---|---|---|---|---|"]
     for row in [*j["per_prompt"], j["overall"]]:
         lines.append(f"| {row['prompt']} | {row['n']} | {row['jumps']} | {_f(row['fraction'], 2)} "
                      f"{_f(row['wilson95'], 2)} | {row['with_flight']} | {_f(row['median_flight_s'], 2)} | "
-                     f"{_f(row['median_rise_m'], 3)} |")
+                     f"{_f(row['median_rise_m'], 3)} | {row.get('never_touch', '—')} |")
     return lines
 
 
@@ -108,10 +108,10 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
     if "skipped" in s:
         return [f"Not measured: {s['skipped']}."]
     lines = [f"Speed: {s['speed']}; {s['rule']}. Quartiles Q1 / median / Q3.", "",
-             "| type | prompts | samples | corpus train clips | median in IQR |", "|---|---|---|---|---|"]
+             "| type | prompts | samples | corpus train clips | median in IQR | never touch floor |", "|---|---|---|---|---|---|"]
     for kind, t in s["types"].items():
         lines.append(f"| {kind} | {'; '.join(t['prompts'])} | {_q(t['samples'])} | {_q(t['corpus_train'])} | "
-                     f"{'yes' if t['median_in_iqr'] else 'no'} |")
+                     f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} |")
     return lines
 
 
@@ -124,7 +124,7 @@ def _response_lines(r: dict[str, Any]) -> list[str]:
              f"**Gravity {_f(g['env'][0], 2)} vs −9.81** on the jump prompts: {g['rise_both']} of {g['n']} samples raise "
              f"both apex gain and flight time ({_f(g['rise_fraction'], 2)} {_f(g['wilson95'], 2)}; apex only "
              f"{g['rise_apex_only']}, flight only {g['rise_flight_only']}). Rollouts: "
-             + ", ".join(f"{k} {v}" for k, v in sorted(g["rollouts"].items())) + ".", "",
+             + ", ".join(f"{k} {v}" for k, v in sorted(g["rollouts"].items())) + "." + _never_touch(g), "",
              "| quantity | generated change Q1/med/Q3 | simulated change Q1/med/Q3 | median gen/sim | samples in ratio |",
              "|---|---|---|---|---|"]
     for q, v in g["ratios"].items():
@@ -135,15 +135,26 @@ def _response_lines(r: dict[str, Any]) -> list[str]:
               f"Q1/med/Q3: generated {_q(w['drift_per_10n_generated_m'])} m, simulated "
               f"{_q(w['drift_per_10n_simulated_m'])} m; median ratio {_f(w['median_ratio_generated_to_simulated'], 2)}. "
               "Rollouts: " + ", ".join(f"{k} {v}" for k, v in sorted(w["rollouts"].items())) + ".", "",
-              "| φ | downwind | generated m Q1/med/Q3 | simulated m Q1/med/Q3 |", "|---|---|---|---|"]
+              "| φ | downwind | generated m Q1/med/Q3 | simulated m Q1/med/Q3 | never touch floor |", "|---|---|---|---|---|"]
     for env, v in w["per_env"].items():
-        lines.append(f"| {env} | {v['downwind']} / {v['n']} | {_q(v['generated_m'])} | {_q(v['simulated_m'])} |")
+        lines.append(f"| {env} | {v['downwind']} / {v['n']} | {_q(v['generated_m'])} | {_q(v['simulated_m'])} | "
+                     f"{v.get('never_touch', '—')} |")
     lines += ["", "Response scores (simdiff/eval/response.py; 95 % bootstrap over samples):", "",
               "| factor | quantity | pairs / with effect | sign agreement | slope ratio |", "|---|---|---|---|---|"]
     for s in [*g["scores"], *w["scores"]]:
         lines.append(f"| {s['factor']} | {s['quantity']} | {s['n_pairs']} / {s['n_effect']} | "
                      f"{_est(s['sign_agreement'])} | {_est(s['slope_ratio'])} |")
     return lines
+
+
+def _never_touch(g: dict[str, Any]) -> str:
+    """The gravity section's floor-contact sentence (reports before it existed: none)."""
+    t = g.get("never_touch")
+    if not t:
+        return ""
+    return (f" Samples that never touch the floor ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, "
+            f"{t['earth']} at Earth; the simulator's {_f(g['env'][0], 2)} rollouts {t['simulated_low_g']} of "
+            f"{t['simulated_tracked']} tracked.")
 
 
 def _speed_of_generate(s: dict[str, Any]) -> list[str]:

@@ -9,11 +9,15 @@ where either rollout fell have no simulated effect. Effects come from
 :func:`simdiff.eval.response.score` (bootstrap over samples).
 
 * Gravity: a sample *rises* when both its apex gain (pelvis over take-off in the longest flight)
-  and its longest flight time are larger at −1.6 than at Earth. Ratio per sample: generated change
-  ÷ simulated change, over samples whose simulated change exceeds the response tolerance; the
-  check takes the median per quantity.
+  and its longest flight time are larger at −1.6 than at Earth, and its −1.6 motion touches the
+  floor (:func:`simdiff.motion.metrics.never_touches`: a sample hovering above 0.10 m all clip long
+  has "flights" by the relative flight rule but never takes off; session 50's runs did). Ratio per
+  sample: generated change ÷ simulated change, over samples that touch the floor and whose simulated
+  change exceeds the response tolerance; the check takes the median per quantity. The counts of
+  samples that never touch the floor are reported for Earth, −1.6 and the simulator's −1.6 rollouts.
 * Wind: a (sample, φ) pair drifts *downwind* when its root displacement along the wind grows
   against Earth (Δ > 0). The drift per 10 N is that Δ (|w| = 10 N), generated and simulated.
+  Samples that never touch the floor are counted per φ.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ import numpy as np
 from simdiff.eval.model_check.detect import quartiles, wilson
 from simdiff.eval.response import TOLERANCE, effects, quantities, score
 from simdiff.motion.flight import flight_stats
+from simdiff.motion.metrics import never_touches
 
 GRAVITY_QUANTITIES: dict[str, float] = {"apex_gain_m": TOLERANCE["apex_m"], "flight_s": TOLERANCE["flight_s"]}
 """Quantities of the gravity check with the |simulated change| a ratio needs."""
@@ -37,7 +42,9 @@ def motion_quantities(joints: np.ndarray, env: Sequence[float]) -> dict[str, flo
 
 
 def simulate(projector: Any, earth: np.ndarray, envs: Sequence[Sequence[float]]) -> tuple[dict, dict[str, int], list[str]]:
-    """Re-track every Earth sample under every φ; ({(i, φ): quantities | None}, statuses, first errors)."""
+    """Re-track every Earth sample under every φ; ({(i, φ): quantities | None}, statuses, first errors).
+
+    Tracked rollouts' quantities carry ``never_touch`` (1.0 / 0.0)."""
     from simdiff.sim.env import Environment
 
     jobs = [(i, tuple(float(v) for v in env)) for env in envs for i in range(len(earth))]
@@ -52,7 +59,8 @@ def simulate(projector: Any, earth: np.ndarray, envs: Sequence[Sequence[float]])
         statuses[status] = statuses.get(status, 0) + 1
         if failed and len(errors) < 3:
             errors.append(str(info))
-        out[(i, env)] = motion_quantities(np.asarray(rollout), env) if ok else None
+        out[(i, env)] = ({**motion_quantities(np.asarray(rollout), env),
+                          "never_touch": float(never_touches(np.asarray(rollout))[0])} if ok else None)
     return out, statuses, errors
 
 
@@ -71,11 +79,13 @@ def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low
     e_env, l_env = (-9.81, 0.0, 0.0), (float(low_g), 0.0, 0.0)
     sims, statuses, errors = simulate(projector, earth, [e_env, l_env])
     effs = effects(_records(ids, {e_env: earth, l_env: low}, sims))
-    rises = [e["dgen"]["apex_gain_m"] > 0 and e["dgen"]["flight_s"] > 0 for e in effs]
+    floats = dict(zip(ids, never_touches(low)))
+    grounded = [not floats[e["unit"]] for e in effs]
+    rises = [e["dgen"]["apex_gain_m"] > 0 and e["dgen"]["flight_s"] > 0 and ok for e, ok in zip(effs, grounded)]
     frac, lo, hi = wilson(sum(rises), len(rises))
     ratios: dict[str, Any] = {}
     for q, tol in GRAVITY_QUANTITIES.items():
-        pairs = [(e["dgen"][q], e["dsim"][q]) for e in effs if e["dsim"] is not None]
+        pairs = [(e["dgen"][q], e["dsim"][q]) for e, ok in zip(effs, grounded) if e["dsim"] is not None and ok]
         use = [g / s for g, s in pairs if abs(s) > tol]
         ratios[q] = {"median_ratio": float(np.median(use)) if use else float("nan"), "n_ratio": len(use),
                      "n_tracked": len(pairs), "tolerance": tol,
@@ -84,6 +94,11 @@ def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low
     return {"env": list(l_env), "n": len(effs), "rise_both": sum(rises), "rise_fraction": frac, "wilson95": [lo, hi],
             "rise_apex_only": sum(e["dgen"]["apex_gain_m"] > 0 for e in effs),
             "rise_flight_only": sum(e["dgen"]["flight_s"] > 0 for e in effs),
+            "never_touch": {"earth": int(never_touches(earth).sum()), "low_g": int(sum(floats.values())),
+                            "simulated_low_g": int(sum(v["never_touch"] for (_, env), v in sims.items()
+                                                       if env == l_env and v is not None)),
+                            "simulated_tracked": sum(v is not None for (_, env), v in sims.items() if env == l_env),
+                            "rule": "lowest joint > 0.10 m above y = 0 in every frame; such a sample never rises"},
             "ratios": ratios, "scores": score(effs, resamples=resamples, seed=seed), "rollouts": statuses,
             "rollout_errors": errors}
 
@@ -94,7 +109,8 @@ def wind_response(ids: Sequence[str], earth: np.ndarray, windy: dict[tuple[float
     e_env = (-9.81, 0.0, 0.0)
     envs = [tuple(float(v) for v in env) for env in windy]
     sims, statuses, errors = simulate(projector, earth, [e_env, *envs])
-    effs = effects(_records(ids, {e_env: earth, **{env: windy[key] for env, key in zip(envs, windy)}}, sims))
+    by_env = {env: windy[key] for env, key in zip(envs, windy)}
+    effs = effects(_records(ids, {e_env: earth, **by_env}, sims))
     along = [e["dgen"]["drift_along_wind_m"] for e in effs]
     sim_along = [e["dsim"]["drift_along_wind_m"] for e in effs if e["dsim"] is not None]
     frac, lo, hi = wilson(sum(d > 0 for d in along), len(along))
@@ -103,6 +119,7 @@ def wind_response(ids: Sequence[str], earth: np.ndarray, windy: dict[tuple[float
         g = [e["dgen"]["drift_along_wind_m"] for e in effs if tuple(e["env"]) == env]
         s = [e["dsim"]["drift_along_wind_m"] for e in effs if tuple(e["env"]) == env and e["dsim"] is not None]
         per_env[f"wx{env[1]:+g} wy{env[2]:+g}"] = {"downwind": sum(d > 0 for d in g), "n": len(g),
+                                                   "never_touch": int(never_touches(by_env[env]).sum()),
                                                    "generated_m": quartiles(g), "simulated_m": quartiles(s)}
     gen_q, sim_q = quartiles(along), quartiles(sim_along)
     return {"envs": [list(e) for e in envs], "n": len(along), "downwind": sum(d > 0 for d in along),

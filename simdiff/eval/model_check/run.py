@@ -22,8 +22,12 @@ from simdiff.errors import SimdiffError
 from simdiff.eval.model_check.config import EARTH, JUMP_PROMPTS, MOON_G, SPEED_PROMPTS, WIND_N, CheckConfig
 from simdiff.eval.model_check.samples import PromptBatch, generate_set, plan_batches, units
 from simdiff.motion.foot_lock import CLEANUP_VERSION
+from simdiff.motion.metrics import FLOOR_CLEARANCE
 
 SCHEMA: str = "simdiff.model_check/1"
+FLOOR_RULE: dict[str, float] = {"never_touch_clearance_m": FLOOR_CLEARANCE}
+"""In the fingerprints of the sections whose counts depend on floor contact (a jump or a rise needs it since
+session 51): parts stored before then are measured again."""
 
 
 def _stamp(path: str | Path, weights: str = "model.safetensors") -> dict[str, Any]:
@@ -219,7 +223,7 @@ class ModelCheck:
         from simdiff.eval.model_check.prompts import jump_summary
 
         batches = self.jump_batches()
-        return self.part("jumps", {"prompts": JUMP_PROMPTS, "options": self.config.prompts.__dict__},
+        return self.part("jumps", {"prompts": JUMP_PROMPTS, "options": self.config.prompts.__dict__, **FLOOR_RULE},
                          lambda: jump_summary(self.samples("jumps", batches, EARTH), batches))
 
     def speeds(self) -> dict[str, Any]:
@@ -247,6 +251,7 @@ class ModelCheck:
         if not c.response.enabled:
             return {"skipped": "turned off (--no-response)"}
         inputs = {"options": c.response.__dict__, "prompts": c.prompts.__dict__, "injected": self._injected is not None,
+                  **FLOOR_RULE,
                   # the only sections off Earth: environment guidance leaves the Earth sections' motions as they are
                   **({"env_guidance": c.env_guidance} if c.env_guidance != 1.0 else {})}
         jumps = self.jump_batches()

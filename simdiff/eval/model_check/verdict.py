@@ -100,7 +100,10 @@ def verdicts(f: dict[str, Any]) -> list[dict[str, Any]]:
         med, q1, q3 = (_num(f.get(f"{kind}_{k}")) for k in ("median", "corpus_q1", "corpus_q3"))
         ok = None if med is None or q1 is None or q3 is None else q1 <= med <= q3
         out.append(_verdict(f"{kind}_speed", med, [q1, q3], ok, "m/s"))
-    out.append(_at_least("gravity_rise", f.get("gravity_rise_fraction"), 0.8))
+    floats = f.get("gravity_never_touch")
+    out.append(_at_least("gravity_rise", f.get("gravity_rise_fraction"), 0.8,
+                         "" if floats is None else f"{floats} of {f.get('gravity_n')} samples never touch the floor at "
+                                                   "g = −1.6 and do not count as rising"))
     apex, flight = _num(f.get("gravity_ratio_apex")), _num(f.get("gravity_ratio_flight"))
     size_ok = None if apex is None or flight is None else apex >= 0.5 and flight >= 0.5
     out.append(_verdict("gravity_size", [apex, flight], 0.5, size_ok, "[apex gain, flight time]"))
@@ -114,7 +117,8 @@ def figures(report: dict[str, Any]) -> dict[str, Any]:
     f: dict[str, Any] = {}
     split = report.get("test_split") or {}
     gen, gt = split.get("generated") or {}, split.get("ground_truth") or {}
-    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid", "floating", "sliding_own_floor", "own_floor"):
+    for key in ("sliding", "skate_ratio", "r_precision_top3", "fid", "floating", "sliding_own_floor", "own_floor",
+                "never_touch"):
         f[key] = (gen.get(key) or {}).get("mean")
         f[f"gt_{key}"] = (gt.get(key) or {}).get("mean")
     f["jump_fraction"] = ((report.get("jumps") or {}).get("overall") or {}).get("fraction")
@@ -126,6 +130,8 @@ def figures(report: dict[str, Any]) -> dict[str, Any]:
         f[f"{kind}_corpus_q3"] = (t.get("corpus_train") or {}).get("q3")
     grav = (report.get("response") or {}).get("gravity") or {}
     f["gravity_rise_fraction"] = grav.get("rise_fraction")
+    f["gravity_never_touch"] = (grav.get("never_touch") or {}).get("low_g")
+    f["gravity_n"] = grav.get("n")
     ratios = grav.get("ratios") or {}
     f["gravity_ratio_apex"] = (ratios.get("apex_gain_m") or {}).get("median_ratio")
     f["gravity_ratio_flight"] = (ratios.get("flight_s") or {}).get("median_ratio")
