@@ -43,6 +43,12 @@ def test_metrics_json(tmp_path: Path, capsys):
     assert row["frames"] == 30 and row["penetration"] == 0.0
     lowest = joints[..., 1].min(axis=1)
     assert row["floating"] == pytest.approx(float(np.mean(np.maximum(lowest - 0.005, 0)) * 1000), rel=1e-5)
+    assert row["never_touch"] == 0
+    joints[..., 1] += 0.5  # half a metre up all clip long
+    np.save(tmp_path / "afloat.npy", joints)
+    assert main(["metrics", str(tmp_path / "afloat.npy"), str(tmp_path / "hover.npy")]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert "never_touch" in table[0] and table[1].split()[-1] == "1" and table[2].split()[-1] == "0"
 
 
 @pytest.mark.parametrize(

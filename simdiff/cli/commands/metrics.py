@@ -1,4 +1,4 @@
-"""``simdiff metrics FILE...``: physics metrics (penetration, floating, sliding, skate ratio)."""
+"""``simdiff metrics FILE...``: physics metrics (penetration, floating, sliding, skate ratio, floor contact)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=(
             "Physics metrics of each motion, on its 22 joints with the ground at y = 0 "
             "(CLoSD's joint-based protocol): penetration and floating beyond 5 mm, sliding of "
-            "the lowest joint while within 5 mm of the ground (mm per frame), GMD skate ratio."
+            "the lowest joint while within 5 mm of the ground (mm per frame), GMD skate ratio; "
+            "never_touch is 1 when no joint comes within 0.10 m of the ground in any frame."
         ),
     )
     p.add_argument("files", type=Path, nargs="+", metavar="FILE", help="motion files (any format `simdiff convert` reads)")
@@ -26,14 +27,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from simdiff.cli.feedback import slow_notice
     from simdiff.motion.io import load_joints
-    from simdiff.motion.metrics import physics_metrics
+    from simdiff.motion.metrics import never_touches, physics_metrics
 
     rows = []
     for i, path in enumerate(args.files):
         with slow_notice(f"reading {path} ({i + 1}/{len(args.files)})"):
             joints = load_joints(path, asf=args.asf)
             values = physics_metrics(joints)
-        rows.append({"file": str(path), "frames": int(joints.shape[0]), **{k: float(v) for k, v in values.items()}})
+        rows.append({"file": str(path), "frames": int(joints.shape[0]), **{k: float(v) for k, v in values.items()},
+                     "never_touch": int(never_touches(joints)[0])})
     if args.json:
         for row in rows:
             print(json.dumps(row))
