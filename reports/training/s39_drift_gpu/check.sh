@@ -2,6 +2,7 @@
 #   S_E: environment guidance (default 2; session 42); env W, STEPS: guidance and DDIM steps (default 2.5, 20; session 46);
 #   env ALPHA: adapter strength (default 0.5; session 47); env ANCHOR: model_check --anchor (default adapters; session 47)
 #   env ALSO: a second evaluator folder that scores the same test-split motions (--also-evaluator; session 48)
+#   env PYWRAP: a script that runs benchmarks/model_check.py with a patch (session 51: s51_floor/floored.py)
 #   A: selection seeds 100 101, val n 32, response on   B: val n 128 seeds 0 1, no response
 #   T: test n 256 seeds 0-4, response on                 Tq: the same without the response
 cd /work/main; . .venv/bin/activate
@@ -13,6 +14,6 @@ case $1 in
   Tq) args="--split test --n 256 --seeds 0 1 2 3 4 --no-response";;
   *) echo "check.sh: unknown stage '$1' (A, B, T or Tq)" >&2; exit 2;;
 esac
-/usr/bin/time -f "stage$1 $2 %e s" python benchmarks/model_check.py --model $3 --corpus $S/corpus3 --evaluator $S/eval \
+/usr/bin/time -f "stage$1 $2 %e s" python ${PYWRAP} benchmarks/model_check.py --model $3 --corpus $S/corpus3 --evaluator $S/eval \
   $args --jump-samples 16 --speed-samples 8 --steps ${STEPS:-20} --guidance ${W:-2.5} --alpha ${ALPHA:-0.5} --foot-lock 1 --env-guidance ${4:-2} --anchor ${ANCHOR:-adapters} ${ALSO:+--also-evaluator $ALSO} --threads 2 \
   --out $S/eval11/${1:0:1}_$2 -q

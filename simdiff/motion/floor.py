@@ -1,0 +1,46 @@
+"""Put motions on the floor as HumanML3D puts its clips: the lowest joint over the clip at y = 0.
+
+HumanML3D's processing shifts every clip vertically so that its lowest joint over all frames is at
+height 0. A generated motion need not be: the shipped model's test samples stand with their own
+floor (the 5th percentile of the lowest joint) 19 mm above y = 0 against the ground truth's 2 mm,
+and under g = −1.6 with strong environment guidance its runs float a metre up (session 50). A
+vertical shift of the whole clip changes no pose, no velocity and no contact; in the 263 features
+it moves the root height (feature 3) and the heights of the "ric" joints (features 4..66, every
+third from 5), which are heights above the floor.
+"""
+
+from __future__ import annotations
+
+import torch
+
+from simdiff.motion.features import SLICES, features_to_joints
+from simdiff.motion.foot_lock import batch_features
+
+RIC_Y: slice = slice(SLICES["ric"].start + 1, SLICES["ric"].stop, 3)
+"""The height channels of the 21 non-root joints in the features."""
+
+
+def floor_offset(features: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
+    """(B,) metres: each clip's lowest joint height over its valid frames (0 for a clip on the floor).
+
+    Args: features (B, T, 263) or (T, 263) un-normalised; lengths (B,) valid frames (None: all).
+    """
+    f, single, valid = batch_features(features, lengths, "floor_offset")
+    low = features_to_joints(f)[..., 1].amin(dim=-1)  # (B, T)
+    out = torch.where(valid, low, torch.full_like(low, float("inf"))).amin(dim=1)
+    return out[0] if single else out
+
+
+def place_on_floor(features: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
+    """The clips shifted vertically so the lowest joint over each clip's valid frames is at y = 0.
+
+    Args: features (B, T, 263) or (T, 263) un-normalised HumanML3D features (metres, Y-up, 20 fps);
+        lengths (B,) valid frames (None: all T); frames past a length are returned unchanged.
+    Returns: the same shape and dtype.
+    """
+    f, single, valid = batch_features(features, lengths, "place_on_floor")
+    d = floor_offset(f, valid.sum(dim=1))[:, None, None] * valid[..., None]  # (B, T, 1)
+    f[..., SLICES["root_y"]] -= d
+    f[..., RIC_Y] -= d
+    out = f.to(features.dtype)
+    return out[0] if single else out
