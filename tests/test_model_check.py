@@ -82,11 +82,16 @@ def test_check_writes_every_field(checked: dict) -> None:
     grav, wind = report["response"]["gravity"], report["response"]["wind"]
     assert grav["n"] == 12 and grav["rollouts"] == {"ok": 24}
     assert wind["n"] == 4 * 4 and wind["rollouts"] == {"ok": 20}  # 4 walk samples × (Earth + 4 winds)
+    runs = report["response"]["gravity_runs"]  # 4 run samples × (Earth, −1.6), same noise as the speeds section's
+    assert runs["n"] == 4 and runs["rollouts"] == {"ok": 8} and runs["never_touch"]["simulated_tracked"] == 4
+    assert grav["airborne_total_s"]["generated_change"]["n"] == 12 - grav["never_touch"]["low_g"]
+    assert report["figures"]["runs_never_touch_low_g"] == runs["never_touch"]["low_g"]
     assert {v["check"] for v in report["verdicts"]} == set(RULES)
     assert report["figures"]["generate_wall_s"] == 4.2
     md = (out / "check.md").read_text()
     assert "## Verdicts" in md and "quick preset" in md and "| jumps |" in md and "cannot carry" in md
     assert "never touch floor |" in md and "| never_touch |" in md and "Samples that never touch the floor" in md
+    assert "**Runs at g = -1.60**" in md and "Time in flight (all flights) of the run samples" in md
 
 
 def test_verdicts_follow_the_figures(checked: dict) -> None:

@@ -130,6 +130,7 @@ def _response_lines(r: dict[str, Any]) -> list[str]:
     for q, v in g["ratios"].items():
         lines.append(f"| {q} | {_q(v['generated_change'])} | {_q(v['simulated_change'])} | {_f(v['median_ratio'], 2)} | "
                      f"{v['n_ratio']} (|Δsim| > {v['tolerance']}) |")
+    lines += _airborne_lines(g, "jump") + _runs_lines(r.get("gravity_runs"))
     lines += ["", f"**Wind ±10 N** (w_x, w_y) on the walk prompts: {w['downwind']} of {w['n']} (sample, φ) pairs drift "
               f"downwind ({_f(w['downwind_fraction'], 2)} {_f(w['wilson95'], 2)}). Drift along the wind per 10 N, "
               f"Q1/med/Q3: generated {_q(w['drift_per_10n_generated_m'])} m, simulated "
@@ -155,6 +156,24 @@ def _never_touch(g: dict[str, Any]) -> str:
     return (f" Samples that never touch the floor ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, "
             f"{t['earth']} at Earth; the simulator's {_f(g['env'][0], 2)} rollouts {t['simulated_low_g']} of "
             f"{t['simulated_tracked']} tracked.")
+
+
+def _airborne_lines(g: dict[str, Any], what: str) -> list[str]:
+    a = g.get("airborne_total_s")
+    if not a:
+        return []
+    return ["", f"Time in flight (all flights) of the {what} samples that touch the floor, change at {_f(g['env'][0], 2)} "
+                f"vs Earth, Q1/med/Q3: generated {_q(a['generated_change'])} s, simulated {_q(a['simulated_change'])} s."]
+
+
+def _runs_lines(g: dict[str, Any] | None) -> list[str]:
+    """The run prompts under low gravity: floor contact and flight time against the simulator's (no verdict)."""
+    if not g:
+        return []
+    t = g["never_touch"]
+    return ["", f"**Runs at g = {_f(g['env'][0], 2)}** (the run prompts, same noise as at Earth; no verdict): "
+                f"{t['low_g']} of {g['n']} samples never touch the floor ({t['earth']} at Earth; the simulator's "
+                f"rollouts {t['simulated_low_g']} of {t['simulated_tracked']} tracked)."] + _airborne_lines(g, "run")[1:]
 
 
 def _speed_of_generate(s: dict[str, Any]) -> list[str]:

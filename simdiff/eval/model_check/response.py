@@ -15,6 +15,9 @@ where either rollout fell have no simulated effect. Effects come from
   sample: generated change ÷ simulated change, over samples that touch the floor and whose simulated
   change exceeds the response tolerance; the check takes the median per quantity. The counts of
   samples that never touch the floor are reported for Earth, −1.6 and the simulator's −1.6 rollouts.
+  The same function runs on the run prompts (``gravity_runs``, no verdict): session 50's environment
+  guidance 4 raised the jumps as the simulator does but lifted whole runs off the floor; the
+  never-touch counts and the change of time in flight against the simulator's show that.
 * Wind: a (sample, φ) pair drifts *downwind* when its root displacement along the wind grows
   against Earth (Δ > 0). The drift per 10 N is that Δ (|w| = 10 N), generated and simulated.
   Samples that never touch the floor are counted per φ.
@@ -37,8 +40,10 @@ GRAVITY_QUANTITIES: dict[str, float] = {"apex_gain_m": TOLERANCE["apex_m"], "fli
 
 
 def motion_quantities(joints: np.ndarray, env: Sequence[float]) -> dict[str, float]:
-    """:func:`simdiff.eval.response.quantities` plus ``apex_gain_m`` (:func:`simdiff.motion.flight.flight_stats`)."""
-    return {**quantities(joints, env), "apex_gain_m": flight_stats(joints)["apex_gain_m"]}
+    """:func:`simdiff.eval.response.quantities` plus ``apex_gain_m`` and ``flight_total_s`` (all flights, s;
+    :func:`simdiff.motion.flight.flight_stats`)."""
+    stats = flight_stats(joints)
+    return {**quantities(joints, env), "apex_gain_m": stats["apex_gain_m"], "flight_total_s": stats["flight_total_s"]}
 
 
 def simulate(projector: Any, earth: np.ndarray, envs: Sequence[Sequence[float]]) -> tuple[dict, dict[str, int], list[str]]:
@@ -99,8 +104,17 @@ def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low
                                                        if env == l_env and v is not None)),
                             "simulated_tracked": sum(v is not None for (_, env), v in sims.items() if env == l_env),
                             "rule": "lowest joint > 0.10 m above y = 0 in every frame; such a sample never rises"},
+            "airborne_total_s": _airborne(effs, grounded),
             "ratios": ratios, "scores": score(effs, resamples=resamples, seed=seed), "rollouts": statuses,
             "rollout_errors": errors}
+
+
+def _airborne(effs: list[dict[str, Any]], grounded: list[bool]) -> dict[str, Any]:
+    """Change of the time spent in flight (all flights, s) at low g: generated and simulated quartiles, over the
+    samples that touch the floor (the simulated change over those the simulator tracked)."""
+    use = [e for e, ok in zip(effs, grounded) if ok]
+    return {"generated_change": quartiles([e["dgen"]["flight_total_s"] for e in use]),
+            "simulated_change": quartiles([e["dsim"]["flight_total_s"] for e in use if e["dsim"] is not None])}
 
 
 def wind_response(ids: Sequence[str], earth: np.ndarray, windy: dict[tuple[float, ...], np.ndarray], projector: Any, *,

@@ -1,8 +1,8 @@
 """Run a model check: load once, measure each section (cached in ``parts/``), write check.json + check.md.
 
 Sections (see the package docstring): ``test_split``, ``jumps``, ``speeds`` and, for continuous
-SimDiff models, ``response`` (gravity, wind). Each section's result is stored atomically in
-``<out>/parts/<section>.json`` with a fingerprint of everything that determines it (model file
+SimDiff models, ``response`` (gravity on the jump prompts and, without a verdict, on the run
+prompts; wind). Each section's result is stored atomically in ``<out>/parts/<section>.json`` with a fingerprint of everything that determines it (model file
 stamp, settings, corpus, evaluator); a rerun reuses a part whose fingerprint matches, so an
 interrupted check resumes after its last finished section.
 """
@@ -258,12 +258,18 @@ class ModelCheck:
         grav = self.part("gravity", {**inputs, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: gravity_response(
             units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, (MOON_G, 0.0, 0.0)), MOON_G,
             self.projector, resamples=c.response.resamples, seed=c.seeds[0]))
+        runs = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["run"]]  # session 50's floating runs
+        grav_runs = self.part("gravity_runs", {**inputs, "g": MOON_G, "run_prompts": SPEED_PROMPTS["run"]},
+                              lambda: gravity_response(units(runs), self.samples("runs", runs, EARTH),
+                                                       self.samples("runs", runs, (MOON_G, 0.0, 0.0)), MOON_G,
+                                                       self.projector, resamples=c.response.resamples,
+                                                       seed=c.seeds[0]))
         walk = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["walk"]]
         winds = [(EARTH[0], WIND_N, 0.0), (EARTH[0], -WIND_N, 0.0), (EARTH[0], 0.0, WIND_N), (EARTH[0], 0.0, -WIND_N)]
         wind = self.part("wind", {**inputs, "wind": winds, "walk_prompts": SPEED_PROMPTS["walk"]}, lambda: wind_response(
             units(walk), self.samples("walks", walk, EARTH), {w: self.samples("walks", walk, w) for w in winds},
             self.projector, resamples=c.response.resamples, seed=c.seeds[0]))
-        return {"gravity": grav, "wind": wind, "simulator": "the projector's flight clock (flights follow gravity)"
+        return {"gravity": grav, "gravity_runs": grav_runs, "wind": wind, "simulator": "the projector's flight clock (flights follow gravity)"
                 if self._injected is None else "injected projector (tests)"}
 
     # --- all --------------------------------------------------------------------------------

@@ -132,6 +132,8 @@ def figures(report: dict[str, Any]) -> dict[str, Any]:
     f["gravity_rise_fraction"] = grav.get("rise_fraction")
     f["gravity_never_touch"] = (grav.get("never_touch") or {}).get("low_g")
     f["gravity_n"] = grav.get("n")
+    runs = (report.get("response") or {}).get("gravity_runs") or {}
+    f["runs_never_touch_low_g"] = (runs.get("never_touch") or {}).get("low_g")
     ratios = grav.get("ratios") or {}
     f["gravity_ratio_apex"] = (ratios.get("apex_gain_m") or {}).get("median_ratio")
     f["gravity_ratio_flight"] = (ratios.get("flight_s") or {}).get("median_ratio")
