@@ -57,6 +57,7 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
     assert meta["threads"] == 1
     assert (meta["model"]["trained_on"], meta["model"]["weights_licence"]) == ("unknown", "unknown")  # no provenance.json
+    assert meta["samples"][0]["touches_floor"] is True and abs(meta["samples"][0]["lowest_m"]) < 0.1
 
 
 def test_generate_reports_the_models_provenance(tmp_path: Path, capsys) -> None:
@@ -284,3 +285,20 @@ def test_generate_env_guidance_on_a_backbone_is_one_line(tmp_path: Path, capsys)
     err = capsys.readouterr().err
     assert code == 2 and "env guidance needs a SimDiff model with a continuous Sim Encoder" in err
     assert err.count("\n") == 1
+
+
+def test_a_sample_that_never_touches_the_floor_is_warned_about(tmp_path: Path, capsys) -> None:
+    torch.manual_seed(0)
+    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())
+    mean = torch.zeros(263)
+    mean[3] = 1.5  # root height
+    mean[5:67:3] = 1.2  # every other joint's height: the whole body about a metre up
+    MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 0.01)).save(tmp_path / "m")
+    code = main(["generate", "a person runs", "--frames", "8", "--steps", "1", "--model", str(tmp_path / "m"),
+                 "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    err = capsys.readouterr().err
+    assert code == 0
+    assert err.startswith("simdiff: warning: sample 0 never comes within 0.10 m of the floor (lowest joint 1.1")
+    assert len(err.strip().splitlines()) == 1
+    rec = json.loads((tmp_path / "o" / "generation.json").read_text())["samples"][0]
+    assert rec["touches_floor"] is False and 1.1 < rec["lowest_m"] < 1.3

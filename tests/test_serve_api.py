@@ -126,6 +126,7 @@ def test_generate_matches_direct_sampling(server, model_dir):
     assert joints.shape == (40, 22, 3) and out["fps"] == 20 and out["parents"] == list(PARENTS)
     meta = out["meta"]
     assert meta["source"] == "generate" and meta["frames"] == 40 and meta["seconds"] == 2.0 and meta["env_used"]
+    assert isinstance(meta["touches_floor"], bool) and isinstance(meta["lowest_m"], float)
     assert meta["params"]["text"] == "a person jumps forward" and meta["params"]["steps"] == STEPS
 
     gen = MotionGenerator.load(model_dir, load_text=False)

@@ -215,6 +215,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
     simdiff_model = bool(generator.is_simdiff)
     records = [{"index": s.index, "seed": s.seed, "environment": None if s.env is None else _env_dict(s.env),
                 "frames": int(s.joints.shape[0]), "files": {kind: p.name for kind, p in written.items()},
+                **floor_contact(s.joints),
                 **({"simulated": _simulated_summary(s.simulated)} if s.simulated is not None else {})}
                for s, written in zip(samples, files)]
     return {
@@ -253,6 +254,15 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "timings_s": timer.rounded(timer.wall),
         "cpu_s": timer.rounded(timer.cpu),
     }
+
+
+def floor_contact(joints: np.ndarray) -> dict:
+    """``lowest_m`` (the lowest joint's lowest height over the clip, m) and ``touches_floor`` (some joint comes within
+    :data:`simdiff.motion.metrics.FLOOR_CLEARANCE` of y = 0; :func:`simdiff.motion.metrics.never_touches`)."""
+    from simdiff.motion.metrics import never_touches
+
+    return {"lowest_m": round(float(np.asarray(joints)[..., 1].min()), 4),
+            "touches_floor": not bool(never_touches(joints)[0])}
 
 
 def _simulated_summary(sim: SimulatedMotion) -> dict:

@@ -244,10 +244,12 @@ class MotionService:
             number = self._count
         features = out.clips()[0].detach().cpu().numpy().astype(np.float32)
         joints = features_to_joints(features)
+        from simdiff.product.pipeline import floor_contact
+
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
                 "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": params.foot_lock,
                 "env_guidance": params.env_guidance if uses_env else None,
-                "elapsed_s": round(elapsed, 3),
+                "elapsed_s": round(elapsed, 3), **floor_contact(joints),
                 "queue_position": position, "waited_s": round(waited, 3)}
         if params.simulate:
             from simdiff.product.pipeline import normalizer_of
