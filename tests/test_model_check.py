@@ -91,7 +91,7 @@ def test_check_writes_every_field(checked: dict) -> None:
     md = (out / "check.md").read_text()
     assert "## Verdicts" in md and "quick preset" in md and "| jumps |" in md and "cannot carry" in md
     assert "never touch floor |" in md and "| never_touch |" in md and "Samples that never touch the floor" in md
-    assert "**Runs at g = -1.60**" in md and "Time in flight (all flights) of the run samples" in md
+    assert "**Runs at g = -1.60**" in md and "Time in flight (all flights) of the run samples" in md and "tracked). Rollouts: ok 8." in md
 
 
 def test_verdicts_follow_the_figures(checked: dict) -> None:
