@@ -24,7 +24,7 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.eval.model_check.detect import MIN_FLIGHT_S, MIN_RISE_M, jump_stats, quartiles, root_speed, wilson
 from simdiff.eval.model_check.samples import PromptBatch
-from simdiff.motion.metrics import never_touches
+from simdiff.motion.metrics import FLOOR_CLEARANCE, never_touches
 
 STANDING_LEVEL: str = ("median pelvis height over the frames outside every flight (feet on the ground by the "
                        "flight rule of simdiff/motion/flight.py)")
@@ -45,7 +45,7 @@ def jump_summary(joints: np.ndarray, batches: Sequence[PromptBatch]) -> dict[str
         mine = [s for s, b in zip(stats, owners) if b.prompt == prompt]
         per_prompt.append(_row(prompt, mine))
     return {"rule": {"min_flight_s": MIN_FLIGHT_S, "min_rise_m": MIN_RISE_M, "standing_level": STANDING_LEVEL,
-                     "floor": "a sample whose lowest joint stays > 0.10 m above y = 0 in every frame does not jump",
+                     "floor": f"a sample whose lowest joint stays > {FLOOR_CLEARANCE:.2f} m above y = 0 in every frame does not jump",
                      "interval": "Wilson 95 % over samples"},
             "per_prompt": per_prompt, "overall": _row("all", stats), "frames": int(joints.shape[1])}
 

@@ -33,7 +33,7 @@ import numpy as np
 from simdiff.eval.model_check.detect import quartiles, wilson
 from simdiff.eval.response import TOLERANCE, effects, quantities, score
 from simdiff.motion.flight import flight_stats
-from simdiff.motion.metrics import never_touches
+from simdiff.motion.metrics import FLOOR_CLEARANCE, never_touches
 
 GRAVITY_QUANTITIES: dict[str, float] = {"apex_gain_m": TOLERANCE["apex_m"], "flight_s": TOLERANCE["flight_s"]}
 """Quantities of the gravity check with the |simulated change| a ratio needs."""
@@ -103,7 +103,7 @@ def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low
                             "simulated_low_g": int(sum(v["never_touch"] for (_, env), v in sims.items()
                                                        if env == l_env and v is not None)),
                             "simulated_tracked": sum(v is not None for (_, env), v in sims.items() if env == l_env),
-                            "rule": "lowest joint > 0.10 m above y = 0 in every frame; such a sample never rises"},
+                            "rule": f"lowest joint > {FLOOR_CLEARANCE:.2f} m above y = 0 in every frame; such a sample never rises"},
             "airborne_total_s": _airborne(effs, grounded),
             "ratios": ratios, "scores": score(effs, resamples=resamples, seed=seed), "rollouts": statuses,
             "rollout_errors": errors}
