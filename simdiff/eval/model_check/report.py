@@ -49,7 +49,7 @@ def _split_lines(s: dict[str, Any]) -> list[str]:
         return [f"Not measured: {(s or {}).get('skipped', 'no result')}."]
     n = s["samples_per_replication"]
     size_note = (f"the whole split in batches of {s['batch_size']} ({n} of {s['split_size']}; fewer than the "
-                 f"{s['n_requested']} asked)") if s["whole_split"] else f"{n} of {s['split_size']} test motions"
+                 f"{s['n_requested']} asked)") if s["whole_split"] else f"{n} of {s['split_size']} {s['split']} motions"
     lines = [f"Split `{s['split']}`, {size_note} per replication, {s['replications']} replications (seeds "
              f"{', '.join(map(str, s['seeds']))}), samples at the GT lengths for the GT captions, {s['env']}. "
              f"Mean ± Student-t 95 % half-width over replications. FID floor: {s['fid_floor']}."]
