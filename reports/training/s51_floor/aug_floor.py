@@ -1,8 +1,10 @@
 """Session 51: do the simulator-replayed training clips float? For each augmentation set, per motion type of the
 source clip and per gravity band: clips whose lowest joint never comes within 0.10 m of y = 0
 (simdiff.motion.metrics.never_touches) and the change of time in flight (all flights, simdiff.motion.flight) against
-the same source's Earth replay.  usage: python aug_floor.py CORPUS AUG_DIR..."""
+the same source's Earth replay.  usage: python aug_floor.py CORPUS AUG_DIR... (env SPLIT: the list of kept clips
+read, default first_try)"""
 import json
+import os
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -16,7 +18,7 @@ corpus = Path(sys.argv[1])
 types = {c["id"]: c["motion_type"] for c in json.loads((corpus / "manifest.json").read_text())["clips"]}
 for aug in map(Path, sys.argv[2:]):
     env = json.loads((aug / "env.json").read_text())
-    ids = (aug / "first_try.txt").read_text().split()
+    ids = (aug / f"{os.environ.get('SPLIT', 'first_try')}.txt").read_text().split()
     earth_flight, rows = {}, []
     for i in ids:
         e = env.get(i)
