@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import torch
 
-from simdiff.motion.features import SLICES, features_to_joints
+from simdiff.motion.features import SLICES
 from simdiff.motion.foot_lock import batch_features
 
 RIC_Y: slice = slice(SLICES["ric"].start + 1, SLICES["ric"].stop, 3)
@@ -26,9 +26,15 @@ def floor_offset(features: torch.Tensor, lengths: torch.Tensor | None = None) ->
     Args: features (B, T, 263) or (T, 263) un-normalised; lengths (B,) valid frames (None: all).
     """
     f, single, valid = batch_features(features, lengths, "floor_offset")
-    low = features_to_joints(f)[..., 1].amin(dim=-1)  # (B, T)
-    out = torch.where(valid, low, torch.full_like(low, float("inf"))).amin(dim=1)
+    out = _lowest(f, valid)
     return out[0] if single else out
+
+
+def _lowest(f: torch.Tensor, valid: torch.Tensor) -> torch.Tensor:
+    """(B,) lowest joint height over the valid frames, read straight from the height channels (the heading
+    rotation of the "ric" channels is about Y, so heights need no forward kinematics)."""
+    low = torch.cat([f[..., SLICES["root_y"]], f[..., RIC_Y]], dim=-1).amin(dim=-1)  # (B, T)
+    return torch.where(valid, low, torch.full_like(low, float("inf"))).amin(dim=1)
 
 
 def place_on_floor(features: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
@@ -39,7 +45,7 @@ def place_on_floor(features: torch.Tensor, lengths: torch.Tensor | None = None) 
     Returns: the same shape and dtype.
     """
     f, single, valid = batch_features(features, lengths, "place_on_floor")
-    d = floor_offset(f, valid.sum(dim=1))[:, None, None] * valid[..., None]  # (B, T, 1)
+    d = _lowest(f, valid)[:, None, None] * valid[..., None]  # (B, T, 1)
     f[..., SLICES["root_y"]] -= d
     f[..., RIC_Y] -= d
     out = f.to(features.dtype)
