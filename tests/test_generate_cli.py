@@ -53,7 +53,7 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     assert np.load(tmp_path / "o" / "sample0_joints.npy").shape == (10, 22, 3)
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
     assert (meta["alpha"], meta["alpha_source"], meta["steps"], meta["frames"]) == (0.5, "sampling.json", 2, 10)
-    assert meta["foot_lock"] == 1.0
+    assert meta["foot_lock"] == 1.0 and meta["foot_cleanup"] == 3  # lock, swing clearance, floating clip dropped
     assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
     assert meta["threads"] == 1
     assert (meta["model"]["trained_on"], meta["model"]["weights_licence"]) == ("unknown", "unknown")  # no provenance.json

@@ -195,3 +195,21 @@ def test_never_touches_the_floor_only_when_every_valid_frame_is_clear() -> None:
     assert never_touches(batch, [40, 30, 40, 40]).tolist() == [True, True, False, False]  # the landing is padding
     assert never_touches(afloat).tolist() == [True]  # one motion (T, 22, 3)
     assert never_touches(torch.from_numpy(batch), clearance=0.6).tolist() == [False] * 4
+
+
+def test_glides_only_when_the_body_travels_on_feet_that_never_lift() -> None:
+    from simdiff.motion.metrics import GLIDE_LIFT, GLIDE_SPEED, glides
+    from simdiff.motion.synthetic import walk
+
+    assert (GLIDE_SPEED, GLIDE_LIFT) == (0.5, 0.05)
+    statue = standing(60, 0.0)
+    statue[..., 0] += np.linspace(0.0, 6.0, 60)[:, None]  # carried 6 m in 3 s (2 m/s), no joint moves otherwise
+    slow = standing(60, 0.0)
+    slow[..., 0] += np.linspace(0.0, 0.6, 60)[:, None]  # 0.2 m/s: a shuffle, not a glide
+    gait = walk(60, speed=1.4)  # travels and lifts its feet
+    batch = np.stack([statue, slow, gait, standing(60, 0.0)])
+    assert glides(batch).tolist() == [True, False, False, False]
+    assert glides(torch.from_numpy(statue)).tolist() == [True]
+    late = statue.copy()
+    late[40:, 7, 1] += 0.3  # a foot lifts only after frame 40
+    assert glides(np.stack([late, late]), [40, 60]).tolist() == [True, False]

@@ -91,6 +91,8 @@ def test_check_writes_every_field(checked: dict) -> None:
     md = (out / "check.md").read_text()
     assert "## Verdicts" in md and "quick preset" in md and "| jumps |" in md and "cannot carry" in md
     assert "never touch floor |" in md and "| never_touch |" in md and "Samples that never touch the floor" in md
+    assert "Samples that glide (pelvis faster than 0.5 m/s" in md and "| never touch floor | glide |" in md
+    assert grav["glides"]["low_g"] >= 0 and runs["glides"]["earth"] >= 0
     assert "**Runs at g = -1.60**" in md and "Time in flight (all flights) of the run samples" in md and "tracked). Rollouts: ok 8." in md
 
 
@@ -217,6 +219,20 @@ def test_gravity_response_does_not_count_a_floating_sample_as_rising() -> None:
     assert "1 of 3 samples never touch the floor" in by["gravity_rise"]["detail"]
 
 
+def test_gravity_response_does_not_count_a_gliding_sample_as_rising() -> None:
+    earth = np.stack([jump(120, height=0.3, start=40, airtime=0.5)] * 3)
+    low = np.stack([jump(120, height=0.45, start=40, airtime=0.75)] * 3)
+    statue = np.repeat(low[2, :1], 120, axis=0)  # the first pose carried 2 m/s along x: feet never lift
+    statue[..., 0] += np.linspace(0.0, 12.0, 120)[:, None]
+    low[2] = statue
+    out = gravity_response(["a", "b", "c"], earth, low, -1.6, _Physics(apex=0.6, drift=0.0), resamples=20)
+    assert out["glides"]["low_g"] == 1 and out["glides"]["earth"] == 0 and "0.5 m/s" in out["glides"]["rule"]
+    assert out["rise_both"] == 2 and out["ratios"]["apex_gain_m"]["n_tracked"] == 2
+    f = figures({"response": {"gravity": out, "gravity_runs": out}})
+    assert f["gravity_glides"] == f["runs_glides_low_g"] == 1
+    assert "; 1 glide and do not either" in {v["check"]: v for v in verdicts(f)}["gravity_rise"]["detail"]
+
+
 def test_wind_response_counts_downwind_drift() -> None:
     earth = np.stack([walk(80, speed=1.0)] * 2)
     winds = {}
@@ -295,6 +311,7 @@ def test_env_guidance_measures_only_the_response_again(checked: dict, tmp_path: 
     assert all(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))  # Earth motions: unchanged
     assert not report["response"]["gravity"].get("cached") and not report["response"]["wind"].get("cached")
     assert report["settings"]["env_guidance"] == 3.0 and "env guidance 3.0" in (tmp_path / "out" / "check.md").read_text()
+    assert "foot_cleanup" not in report["settings"]  # recorded (the cleanup's version) only when a foot lock ran
     with pytest.raises(SimdiffError, match="--env-guidance must be a finite number ≥ 0, got -1"):
         CheckConfig(**{**config.__dict__, "env_guidance": -1.0}).validate()
 

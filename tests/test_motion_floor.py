@@ -8,7 +8,7 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import features_to_joints, joints_to_features
-from simdiff.motion.floor import floor_offset, place_on_floor
+from simdiff.motion.floor import drop_floating, floor_offset, place_on_floor
 from simdiff.motion.synthetic import jump, walk
 
 
@@ -52,6 +52,46 @@ def test_batches_respect_lengths_and_keep_padding() -> None:
     assert float(ja[:, 0, 1].max() - ja[:, 0, 1].min()) == pytest.approx(float(jb[:, 0, 1].max() - jb[:, 0, 1].min()))
 
 
+def _raised(f: torch.Tensor, metres: float) -> torch.Tensor:
+    out = f.clone()
+    out[:, 3] += metres
+    out[:, 5:67:3] += metres
+    return out
+
+
+def test_drop_floating_moves_only_clips_that_never_touch_the_floor() -> None:
+    from simdiff.motion.metrics import never_touches
+
+    base = place_on_floor(_features(walk(40)))
+    batch = torch.stack([_raised(base, 0.05), _raised(base, 1.2), _raised(base, 0.11)])  # touches, floats, floats
+    assert never_touches(features_to_joints(batch.double())).tolist() == [False, True, True]
+    dropped = drop_floating(batch)
+    assert dropped.dtype == batch.dtype and torch.equal(dropped[0], batch[0])  # a touching clip bit for bit
+    low = features_to_joints(dropped.double())[..., 1].amin(dim=(-1, -2))
+    assert low.tolist() == pytest.approx([0.05, 0.0, 0.0], abs=1e-5)
+    assert not never_touches(features_to_joints(dropped.double())).any()
+    assert torch.equal(drop_floating(dropped), dropped)  # idempotent
+    # only the valid frames decide: a clip touching the floor only in its padding is dropped
+    padded = _raised(base, 0.5)
+    padded[30:, 3] -= 0.5
+    padded[30:, 5:67:3] -= 0.5
+    out = drop_floating(padded[None], torch.tensor([30]))[0]
+    assert float(floor_offset(out[:30])) == pytest.approx(0.0, abs=1e-6) and torch.equal(out[30:], padded[30:])
+
+
+def test_the_foot_cleanup_drops_a_floating_clip_and_only_when_on() -> None:
+    from simdiff.motion.foot_lock import clean_feet
+
+    base = place_on_floor(_features(walk(40)))
+    floating = _raised(base, 0.8)
+    assert float(floor_offset(clean_feet(floating))) == pytest.approx(0.0, abs=1e-6)
+    assert float(floor_offset(clean_feet(floating, strength=0.0))) == pytest.approx(0.8 + float(floor_offset(base)), abs=1e-5)
+    on_floor = clean_feet(base)
+    assert float(floor_offset(on_floor)) < 0.10  # a clip on the floor is cleaned as before, not shifted
+
+
 def test_bad_shape_is_one_line() -> None:
     with pytest.raises(SimdiffError, match="place_on_floor needs"):
         place_on_floor(torch.zeros(10, 200))
+    with pytest.raises(SimdiffError, match="drop_floating needs"):
+        drop_floating(torch.zeros(10, 200))

@@ -15,6 +15,7 @@ import torch
 
 from simdiff.motion.features import SLICES
 from simdiff.motion.foot_lock import batch_features
+from simdiff.motion.metrics import FLOOR_CLEARANCE
 
 RIC_Y: slice = slice(SLICES["ric"].start + 1, SLICES["ric"].stop, 3)
 """The height channels of the 21 non-root joints in the features."""
@@ -44,8 +45,28 @@ def place_on_floor(features: torch.Tensor, lengths: torch.Tensor | None = None) 
         lengths (B,) valid frames (None: all T); frames past a length are returned unchanged.
     Returns: the same shape and dtype.
     """
-    f, single, valid = batch_features(features, lengths, "place_on_floor")
-    d = _lowest(f, valid)[:, None, None] * valid[..., None]  # (B, T, 1)
+    return _shift_down(features, lengths, "place_on_floor", only_above=None)
+
+
+def drop_floating(features: torch.Tensor, lengths: torch.Tensor | None = None,
+                  clearance: float = FLOOR_CLEARANCE) -> torch.Tensor:
+    """Only the clips that never touch the floor, put on it: a clip whose lowest joint stays more than
+    ``clearance`` m above y = 0 in every valid frame (:func:`simdiff.motion.metrics.never_touches`) is shifted
+    down so its lowest joint over the clip is at y = 0; every other clip is returned unchanged, bit for bit.
+
+    Args and returns as :func:`place_on_floor`.
+    """
+    return _shift_down(features, lengths, "drop_floating", only_above=clearance)
+
+
+def _shift_down(features: torch.Tensor, lengths: torch.Tensor | None, name: str,
+                only_above: float | None) -> torch.Tensor:
+    """The clips lowered by their lowest joint height (all, or only those whose lowest joint is above ``only_above``)."""
+    f, single, valid = batch_features(features, lengths, name)
+    low = _lowest(f, valid)
+    if only_above is not None:
+        low = torch.where(low > only_above, low, torch.zeros_like(low))
+    d = low[:, None, None] * valid[..., None]  # (B, T, 1)
     f[..., SLICES["root_y"]] -= d
     f[..., RIC_Y] -= d
     out = f.to(features.dtype)

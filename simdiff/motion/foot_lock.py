@@ -9,7 +9,8 @@ same amount); poses, heights, the root's yaw and the contact channels are untouc
 exactly as generated. It is the classic root-trajectory part of foot-skate cleanup, not inverse kinematics: two
 planted feet that slide apart (a split) keep the lower one in place, not both. The generator's ``foot_lock``
 applies :func:`clean_feet`: this lock, then :mod:`simdiff.motion.foot_clearance` (swinging feet that drag along
-the floor are lifted clear of it, the knee re-solved), both at the same strength.
+the floor are lifted clear of it, the knee re-solved), both at the same strength, and since session 52 lowers a
+clip that never touches the floor onto it (:func:`simdiff.motion.floor.drop_floating`).
 """
 
 from __future__ import annotations
@@ -24,9 +25,10 @@ from simdiff.motion.skeleton import FOOT_LEFT, FOOT_RIGHT
 CONTACT_JOINTS: tuple[int, int, int, int] = (*FOOT_LEFT, *FOOT_RIGHT)
 """Joints of the four contact channels, in channel order (left ankle, left toe, right ankle, right toe)."""
 
-CLEANUP_VERSION: int = 2
+CLEANUP_VERSION: int = 3
 """What the generator's ``foot_lock`` does: 1 the lock alone (sessions 36-37), 2 the lock and the swing-foot
-clearance (:func:`clean_feet`). Cached measurements made with a foot lock carry it in their fingerprint."""
+clearance (sessions 38-51), 3 those and a floating clip dropped onto the floor (session 52; :func:`clean_feet`).
+Cached measurements made with a foot lock carry it in their fingerprint."""
 
 CONTACT_THRESHOLD: float = 0.5
 """A contact channel above this marks its joint as planted (the channels are 0/1 in the data)."""
@@ -102,10 +104,14 @@ def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, stren
 
 def clean_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, strength: float = 1.0) -> torch.Tensor:
     """The generator's foot cleanup at ``strength``: planted feet locked (:func:`lock_feet`), then swinging feet
-    lifted clear of the floor (:func:`simdiff.motion.foot_clearance.clear_swing_feet`). Shapes as :func:`lock_feet`."""
+    lifted clear of the floor (:func:`simdiff.motion.foot_clearance.clear_swing_feet`), then, whatever the
+    strength > 0, a clip that never comes within 0.10 m of the floor lowered onto it
+    (:func:`simdiff.motion.floor.drop_floating`; clips that touch it are not moved). Shapes as :func:`lock_feet`."""
+    from simdiff.motion.floor import drop_floating
     from simdiff.motion.foot_clearance import clear_swing_feet
 
-    return clear_swing_feet(lock_feet(features, lengths, strength), lengths, strength)
+    cleaned = clear_swing_feet(lock_feet(features, lengths, strength), lengths, strength)
+    return drop_floating(cleaned, lengths) if strength > 0 else cleaned
 
 
 def lock_feet_numpy(features: np.ndarray, strength: float = 1.0) -> np.ndarray:

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     import torch
 
 from simdiff.errors import SimdiffError
-from simdiff.motion.skeleton import FPS, NUM_JOINTS
+from simdiff.motion.skeleton import FOOT_LEFT, FOOT_RIGHT, FPS, NUM_JOINTS
 
 GROUND_TOLERANCE: float = 0.005
 """Metres of slack for penetration, floating and sliding contact (5 mm)."""
@@ -276,3 +276,31 @@ def phys_err(metrics: dict[str, float], gt_floating: float) -> float:
     if missing:
         raise SimdiffError(f"phys_err needs {', '.join(missing)}")
     return float(metrics["penetration"] + metrics["sliding"] + abs(metrics["floating"] - gt_floating))
+
+
+GLIDE_SPEED: float = 0.5
+"""m/s: a motion whose pelvis travels faster than this on average (horizontal) is moving somewhere."""
+GLIDE_LIFT: float = 0.05
+"""Metres: a foot joint whose height changes by less than this over the clip never lifts."""
+
+
+def glides(
+    joints: np.ndarray | torch.Tensor,
+    lengths: Sequence[int] | np.ndarray | torch.Tensor | None = None,
+) -> np.ndarray:
+    """(B,) bool: the body travels (mean horizontal pelvis speed > :data:`GLIDE_SPEED`) while no foot joint ever
+    lifts (each of the four foot joints' height range over the valid frames < :data:`GLIDE_LIFT`).
+
+    A frozen pose carried along, which no legged body can do; session 52's runs under g = −1.6 at environment
+    guidance 4 were such statues, a metre up before the foot cleanup dropped them, skating after. A standing or
+    in-place motion (slow pelvis) never glides. Joints (B, T, 22, 3) or (T, 22, 3), metres, Y-up, 20 fps; lengths (B,).
+    """
+    arr, lens = _prepare(joints, lengths)
+    out = np.zeros(len(lens), dtype=bool)
+    feet = [*FOOT_LEFT, *FOOT_RIGHT]
+    for b, n in enumerate(lens):
+        clip = arr[b, :n].astype(np.float64)
+        speed = np.linalg.norm(np.diff(clip[:, 0, [0, 2]], axis=0), axis=-1).mean() * FPS
+        lift = np.ptp(clip[:, feet, 1], axis=0).max()
+        out[b] = speed > GLIDE_SPEED and lift < GLIDE_LIFT
+    return out

@@ -211,6 +211,8 @@ def model_provenance(model_dir: Path) -> dict:
 def metadata(request: GenerationRequest, generator, model_dir: Path, samples: list[Sample],
              files: list[dict[str, Path]], videos: list[Path], timer: Timer, alpha_source: str = "default") -> dict:
     """The ``generation.json`` record of one run (file names relative to the output folder)."""
+    from simdiff.motion.foot_lock import CLEANUP_VERSION
+
     cfg = generator.config
     simdiff_model = bool(generator.is_simdiff)
     records = [{"index": s.index, "seed": s.seed, "environment": None if s.env is None else _env_dict(s.env),
@@ -244,6 +246,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "alpha": request.alpha if simdiff_model else None,
         "alpha_source": alpha_source if simdiff_model else None,
         "foot_lock": request.foot_lock,
+        "foot_cleanup": CLEANUP_VERSION if request.foot_lock else None,
         "env_guidance": request.env_guidance if simdiff_model else None,
         "anchor": request.anchor if simdiff_model else None,
         "features_layout": FEATURES_NOTE,

@@ -77,7 +77,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="strength of the environment adapters, 0 = ignore φ (default 1, or the model's sampling.json)")
     smp.add_argument("--foot-lock", type=float, metavar="S",
                      help="foot cleanup, strength 0..1: move the root so the feet the motion marks planted do not "
-                          "slide, and lift swinging feet that drag along the floor 2 cm clear of it "
+                          "slide, lift swinging feet that drag along the floor 2 cm clear of it, and lower a motion "
+                          "that never comes within 0.10 m of the floor onto it "
                           "(0 = off; default 0, or the model's sampling.json)")
     smp.add_argument("--env-guidance", type=float, metavar="S",
                      help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off; "

@@ -136,10 +136,11 @@ def _response_lines(r: dict[str, Any]) -> list[str]:
               f"Q1/med/Q3: generated {_q(w['drift_per_10n_generated_m'])} m, simulated "
               f"{_q(w['drift_per_10n_simulated_m'])} m; median ratio {_f(w['median_ratio_generated_to_simulated'], 2)}. "
               "Rollouts: " + ", ".join(f"{k} {v}" for k, v in sorted(w["rollouts"].items())) + ".", "",
-              "| φ | downwind | generated m Q1/med/Q3 | simulated m Q1/med/Q3 | never touch floor |", "|---|---|---|---|---|"]
+              "| φ | downwind | generated m Q1/med/Q3 | simulated m Q1/med/Q3 | never touch floor | glide |",
+              "|---|---|---|---|---|---|"]
     for env, v in w["per_env"].items():
         lines.append(f"| {env} | {v['downwind']} / {v['n']} | {_q(v['generated_m'])} | {_q(v['simulated_m'])} | "
-                     f"{v.get('never_touch', '—')} |")
+                     f"{v.get('never_touch', '—')} | {v.get('glides', '—')} |")
     lines += ["", "Response scores (simdiff/eval/response.py; 95 % bootstrap over samples):", "",
               "| factor | quantity | pairs / with effect | sign agreement | slope ratio |", "|---|---|---|---|---|"]
     for s in [*g["scores"], *w["scores"]]:
@@ -155,7 +156,15 @@ def _never_touch(g: dict[str, Any]) -> str:
         return ""
     return (f" Samples that never touch the floor ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, "
             f"{t['earth']} at Earth; the simulator's {_f(g['env'][0], 2)} rollouts {t['simulated_low_g']} of "
-            f"{t['simulated_tracked']} tracked.")
+            f"{t['simulated_tracked']} tracked." + _glides(g))
+
+
+def _glides(g: dict[str, Any]) -> str:
+    """The gravity sections' gliding sentence (reports before session 52: none)."""
+    t = g.get("glides")
+    if not t:
+        return ""
+    return f" Samples that glide ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, {t['earth']} at Earth."
 
 
 def _airborne_lines(g: dict[str, Any], what: str) -> list[str]:
@@ -174,7 +183,7 @@ def _runs_lines(g: dict[str, Any] | None) -> list[str]:
     return ["", f"**Runs at g = {_f(g['env'][0], 2)}** (the run prompts, same noise as at Earth; no verdict): "
                 f"{t['low_g']} of {g['n']} samples never touch the floor ({t['earth']} at Earth; the simulator's "
                 f"rollouts {t['simulated_low_g']} of {t['simulated_tracked']} tracked). Rollouts: "
-                + ", ".join(f"{k} {v}" for k, v in sorted(g["rollouts"].items())) + "."] + _airborne_lines(g, "run")[1:]
+                + ", ".join(f"{k} {v}" for k, v in sorted(g["rollouts"].items())) + "." + _glides(g)] + _airborne_lines(g, "run")[1:]
 
 
 def _speed_of_generate(s: dict[str, Any]) -> list[str]:

@@ -15,12 +15,14 @@ where either rollout fell have no simulated effect. Effects come from
   sample: generated change ÷ simulated change, over samples that touch the floor and whose simulated
   change exceeds the response tolerance; the check takes the median per quantity. The counts of
   samples that never touch the floor are reported for Earth, −1.6 and the simulator's −1.6 rollouts.
+  A sample that *glides* (:func:`simdiff.motion.metrics.glides`: the body travels while no foot joint ever
+  lifts) does not rise either and is left out of the ratios (session 52's runs at environment guidance 4).
   The same function runs on the run prompts (``gravity_runs``, no verdict): session 50's environment
   guidance 4 raised the jumps as the simulator does but lifted whole runs off the floor; the
   never-touch counts and the change of time in flight against the simulator's show that.
 * Wind: a (sample, φ) pair drifts *downwind* when its root displacement along the wind grows
   against Earth (Δ > 0). The drift per 10 N is that Δ (|w| = 10 N), generated and simulated.
-  Samples that never touch the floor are counted per φ.
+  Samples that never touch the floor, and those that glide, are counted per φ.
 """
 
 from __future__ import annotations
@@ -33,7 +35,10 @@ import numpy as np
 from simdiff.eval.model_check.detect import quartiles, wilson
 from simdiff.eval.response import TOLERANCE, effects, quantities, score
 from simdiff.motion.flight import flight_stats
-from simdiff.motion.metrics import FLOOR_CLEARANCE, never_touches
+from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT, GLIDE_SPEED, glides, never_touches
+
+GLIDE_RULE: str = (f"pelvis faster than {GLIDE_SPEED} m/s while no foot joint's height changes by {GLIDE_LIFT} m; "
+                   "such a sample never rises")
 
 GRAVITY_QUANTITIES: dict[str, float] = {"apex_gain_m": TOLERANCE["apex_m"], "flight_s": TOLERANCE["flight_s"]}
 """Quantities of the gravity check with the |simulated change| a ratio needs."""
@@ -85,7 +90,8 @@ def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low
     sims, statuses, errors = simulate(projector, earth, [e_env, l_env])
     effs = effects(_records(ids, {e_env: earth, l_env: low}, sims))
     floats = dict(zip(ids, never_touches(low)))
-    grounded = [not floats[e["unit"]] for e in effs]
+    glide = dict(zip(ids, glides(low)))
+    grounded = [not floats[e["unit"]] and not glide[e["unit"]] for e in effs]
     rises = [e["dgen"]["apex_gain_m"] > 0 and e["dgen"]["flight_s"] > 0 and ok for e, ok in zip(effs, grounded)]
     frac, lo, hi = wilson(sum(rises), len(rises))
     ratios: dict[str, Any] = {}
@@ -104,6 +110,7 @@ def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low
                                                        if env == l_env and v is not None)),
                             "simulated_tracked": sum(v is not None for (_, env), v in sims.items() if env == l_env),
                             "rule": f"lowest joint > {FLOOR_CLEARANCE:.2f} m above y = 0 in every frame; such a sample never rises"},
+            "glides": {"earth": int(glides(earth).sum()), "low_g": int(sum(glide.values())), "rule": GLIDE_RULE},
             "airborne_total_s": _airborne(effs, grounded),
             "ratios": ratios, "scores": score(effs, resamples=resamples, seed=seed), "rollouts": statuses,
             "rollout_errors": errors}
@@ -134,6 +141,7 @@ def wind_response(ids: Sequence[str], earth: np.ndarray, windy: dict[tuple[float
         s = [e["dsim"]["drift_along_wind_m"] for e in effs if tuple(e["env"]) == env and e["dsim"] is not None]
         per_env[f"wx{env[1]:+g} wy{env[2]:+g}"] = {"downwind": sum(d > 0 for d in g), "n": len(g),
                                                    "never_touch": int(never_touches(by_env[env]).sum()),
+                                                   "glides": int(glides(by_env[env]).sum()),
                                                    "generated_m": quartiles(g), "simulated_m": quartiles(s)}
     gen_q, sim_q = quartiles(along), quartiles(sim_along)
     return {"envs": [list(e) for e in envs], "n": len(along), "downwind": sum(d > 0 for d in along),

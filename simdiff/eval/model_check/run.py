@@ -22,12 +22,14 @@ from simdiff.errors import SimdiffError
 from simdiff.eval.model_check.config import EARTH, JUMP_PROMPTS, MOON_G, SPEED_PROMPTS, WIND_N, CheckConfig
 from simdiff.eval.model_check.samples import PromptBatch, generate_set, plan_batches, units
 from simdiff.motion.foot_lock import CLEANUP_VERSION
-from simdiff.motion.metrics import FLOOR_CLEARANCE
+from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT, GLIDE_SPEED
 
 SCHEMA: str = "simdiff.model_check/1"
 FLOOR_RULE: dict[str, float] = {"never_touch_clearance_m": FLOOR_CLEARANCE}
 """In the fingerprints of the sections whose counts depend on floor contact (a jump or a rise needs it since
 session 51): parts stored before then are measured again."""
+GLIDE_RULE: dict[str, float] = {"glide_speed_m_s": GLIDE_SPEED, "glide_lift_m": GLIDE_LIFT}
+"""In the response sections' fingerprints: a gliding sample does not rise since session 52."""
 
 
 def _stamp(path: str | Path, weights: str = "model.safetensors") -> dict[str, Any]:
@@ -251,7 +253,7 @@ class ModelCheck:
         if not c.response.enabled:
             return {"skipped": "turned off (--no-response)"}
         inputs = {"options": c.response.__dict__, "prompts": c.prompts.__dict__, "injected": self._injected is not None,
-                  **FLOOR_RULE,
+                  **FLOOR_RULE, **GLIDE_RULE,
                   # the only sections off Earth: environment guidance leaves the Earth sections' motions as they are
                   **({"env_guidance": c.env_guidance} if c.env_guidance != 1.0 else {})}
         jumps = self.jump_batches()
@@ -293,7 +295,8 @@ class ModelCheck:
                                f"this is a {kind} model (leave it at adapters)")
         report: dict[str, Any] = {"schema": SCHEMA, "model": {**_stamp(c.model), "kind": kind},
                                   "corpus": str(Path(c.corpus).resolve()), "evaluator": _stamp(c.evaluator),
-                                  "settings": c.as_dict(), "provenance": provenance(c.seeds[0], c.device, self.command)}
+                                  "settings": {**c.as_dict(), **({"foot_cleanup": CLEANUP_VERSION} if c.foot_lock else {})},
+                                  "provenance": provenance(c.seeds[0], c.device, self.command)}
         start = time.perf_counter()
         try:
             report["test_split"] = self.test_split()

@@ -100,10 +100,11 @@ def verdicts(f: dict[str, Any]) -> list[dict[str, Any]]:
         med, q1, q3 = (_num(f.get(f"{kind}_{k}")) for k in ("median", "corpus_q1", "corpus_q3"))
         ok = None if med is None or q1 is None or q3 is None else q1 <= med <= q3
         out.append(_verdict(f"{kind}_speed", med, [q1, q3], ok, "m/s"))
-    floats = f.get("gravity_never_touch")
+    floats, glide = f.get("gravity_never_touch"), f.get("gravity_glides")
     out.append(_at_least("gravity_rise", f.get("gravity_rise_fraction"), 0.8,
                          "" if floats is None else f"{floats} of {f.get('gravity_n')} samples never touch the floor at "
-                                                   "g = −1.6 and do not count as rising"))
+                                                   "g = −1.6 and do not count as rising"
+                                                   + ("" if glide is None else f"; {glide} glide and do not either")))
     apex, flight = _num(f.get("gravity_ratio_apex")), _num(f.get("gravity_ratio_flight"))
     size_ok = None if apex is None or flight is None else apex >= 0.5 and flight >= 0.5
     out.append(_verdict("gravity_size", [apex, flight], 0.5, size_ok, "[apex gain, flight time]"))
@@ -134,6 +135,8 @@ def figures(report: dict[str, Any]) -> dict[str, Any]:
     f["gravity_n"] = grav.get("n")
     runs = (report.get("response") or {}).get("gravity_runs") or {}
     f["runs_never_touch_low_g"] = (runs.get("never_touch") or {}).get("low_g")
+    f["gravity_glides"] = (grav.get("glides") or {}).get("low_g")
+    f["runs_glides_low_g"] = (runs.get("glides") or {}).get("low_g")
     ratios = grav.get("ratios") or {}
     f["gravity_ratio_apex"] = (ratios.get("apex_gain_m") or {}).get("median_ratio")
     f["gravity_ratio_flight"] = (ratios.get("flight_s") or {}).get("median_ratio")
