@@ -301,4 +301,26 @@ def test_a_sample_that_never_touches_the_floor_is_warned_about(tmp_path: Path, c
     assert err.startswith("simdiff: warning: sample 0 never comes within 0.10 m of the floor (lowest joint 1.1")
     assert len(err.strip().splitlines()) == 1
     rec = json.loads((tmp_path / "o" / "generation.json").read_text())["samples"][0]
-    assert rec["touches_floor"] is False and 1.1 < rec["lowest_m"] < 1.3
+    assert rec["touches_floor"] is False and 1.1 < rec["lowest_m"] < 1.3 and rec["glides"] is False
+    # the foot cleanup (cleanup 3) drops such a sample onto the floor: no warning, lowest joint at y = 0
+    code = main(["generate", "a person runs", "--frames", "8", "--steps", "1", "--model", str(tmp_path / "m"),
+                 "--out", str(tmp_path / "o2"), "--threads", "1", "--format", "npy", "-q", "--foot-lock", "1"])
+    assert code == 0 and capsys.readouterr().err == ""
+    rec = json.loads((tmp_path / "o2" / "generation.json").read_text())["samples"][0]
+    assert rec["touches_floor"] is True and rec["lowest_m"] == 0.0
+
+
+def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
+    torch.manual_seed(0)
+    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())
+    mean = torch.zeros(263)
+    mean[1] = 0.1  # root forward velocity 0.1 m/frame = 2 m/s
+    mean[3] = 0.9  # root height
+    mean[4:67] = torch.tensor([0.0, 0.05, 0.0] * 21)  # every joint 5 cm above the floor, fixed: a statue
+    MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 1e-4)).save(tmp_path / "m")
+    code = main(["generate", "a person runs", "--frames", "20", "--steps", "1", "--model", str(tmp_path / "m"),
+                 "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    err = capsys.readouterr().err
+    assert code == 0 and err.startswith("simdiff: warning: sample 0 glides: it travels while no foot lifts 0.05 m")
+    assert len(err.strip().splitlines()) == 1
+    assert json.loads((tmp_path / "o" / "generation.json").read_text())["samples"][0]["glides"] is True

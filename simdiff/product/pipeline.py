@@ -260,12 +260,13 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
 
 
 def floor_contact(joints: np.ndarray) -> dict:
-    """``lowest_m`` (the lowest joint's lowest height over the clip, m) and ``touches_floor`` (some joint comes within
-    :data:`simdiff.motion.metrics.FLOOR_CLEARANCE` of y = 0; :func:`simdiff.motion.metrics.never_touches`)."""
-    from simdiff.motion.metrics import never_touches
+    """``lowest_m`` (the lowest joint's lowest height over the clip, m), ``touches_floor`` (some joint comes within
+    :data:`simdiff.motion.metrics.FLOOR_CLEARANCE` of y = 0; :func:`simdiff.motion.metrics.never_touches`) and
+    ``glides`` (the body travels while no foot ever lifts; :func:`simdiff.motion.metrics.glides`)."""
+    from simdiff.motion.metrics import glides, never_touches
 
     return {"lowest_m": round(float(np.asarray(joints)[..., 1].min()), 4),
-            "touches_floor": not bool(never_touches(joints)[0])}
+            "touches_floor": not bool(never_touches(joints)[0]), "glides": bool(glides(joints)[0])}
 
 
 def _simulated_summary(sim: SimulatedMotion) -> dict:

@@ -1,24 +1,16 @@
 """Session 52: run a script (benchmarks/model_check.py, float_probe.py) with every generated motion that never touches
 the floor lowered onto it after the foot cleanup (simdiff.motion.floor.drop_floating) -- rule 32's candidate before
-any plumbing.
+the package's cleanup 3 did the same.
 
 usage: python reports/training/s52_runs_lowg/dropped.py SCRIPT [ARGS...]
 The model check's fingerprint carries foot_cleanup "2+drop", so no stored part of the plain runs is reused."""
-import runpy
 import sys
+from pathlib import Path
 
-import simdiff.eval.model_check.run as R
-import simdiff.motion.foot_lock as FL
-from simdiff.motion.floor import drop_floating
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "s51_floor"))
+from floored import run_with  # noqa: E402
 
-_clean = FL.clean_feet
+from simdiff.motion.floor import drop_floating  # noqa: E402
 
-
-def clean_then_drop(features, lengths=None, strength=1.0):
-    return drop_floating(_clean(features, lengths, strength), lengths)
-
-
-FL.clean_feet = clean_then_drop  # the generator imports it from the module at call time
-R.CLEANUP_VERSION = "2+drop"
-sys.argv = sys.argv[1:]
-runpy.run_path(sys.argv[0], run_name="__main__")
+if __name__ == "__main__":
+    run_with(drop_floating, "2+drop")

@@ -17,13 +17,15 @@ def row(folder: Path) -> str:
              f"{air['generated_change']['median']:+.2f} / {air['simulated_change']['median']:+.2f}",
              f"{g['never_touch']['low_g']}", f"{runs['never_touch']['low_g']} of {runs['n']}",
              f"{run_air['median']:+.2f} (n {run_air['n']})", f"{w['downwind']} of {w['n']}",
-             f"{w['median_ratio_generated_to_simulated']:.2f}"]
+             f"{w['median_ratio_generated_to_simulated']:.2f}",
+             f"{g.get('glides', {}).get('low_g', '—')} / {runs.get('glides', {}).get('low_g', '—')}"]
     return "| " + " | ".join(cells) + " |"
 
 
 if __name__ == "__main__":
     print("| run | jump rise | gen ÷ sim apex / flight | jumps' time in flight change gen / sim (s) | jumps never touching at −1.6 "
-          "| runs never touching at −1.6 | runs' time in flight change (gen) | wind downwind | wind drift gen ÷ sim |")
-    print("|" + "---|" * 9)
+          "| runs never touching at −1.6 | runs' time in flight change (gen) | wind downwind | wind drift gen ÷ sim "
+          "| gliding at −1.6: jumps / runs |")
+    print("|" + "---|" * 10)
     for arg in sys.argv[1:]:
         print(row(Path(arg)))

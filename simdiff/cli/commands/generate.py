@@ -198,13 +198,17 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
         raise SimdiffError(f"{folder} has categorical environments; use `simdiff sample --env-index` with it")
     meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet, alpha_source,
                                  simulate=args.simulate, force=args.force, finisher=finisher)
-    from simdiff.motion.metrics import FLOOR_CLEARANCE
+    from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT
 
     for rec in meta["samples"]:
         if not rec["touches_floor"]:
             print(f"simdiff: warning: sample {rec['index']} never comes within {FLOOR_CLEARANCE:.2f} m of the floor "
                   f"(lowest joint {rec['lowest_m']:.2f} m): it floats; under a φ far from Earth or a strong "
                   "--env-guidance the model extrapolates", file=sys.stderr)
+        elif rec.get("glides"):
+            print(f"simdiff: warning: sample {rec['index']} glides: it travels while no foot lifts {GLIDE_LIFT:.2f} m "
+                  "(a frozen pose carried along); under a φ far from Earth or a strong --env-guidance the model "
+                  "extrapolates", file=sys.stderr)
     for rec in meta["samples"] if args.simulate else []:
         sim = rec["simulated"]
         name = rec["files"].get("tracking", f"sample {rec['index']}").removesuffix("_tracking.json")
