@@ -37,7 +37,7 @@ from simdiff.eval.response import TOLERANCE, effects, quantities, score
 from simdiff.motion.flight import flight_stats
 from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT, GLIDE_SPEED, glides, never_touches
 
-GLIDE_RULE: str = (f"pelvis faster than {GLIDE_SPEED} m/s while no foot joint's height changes by {GLIDE_LIFT} m; "
+GLIDE_TEXT: str = (f"pelvis faster than {GLIDE_SPEED} m/s while no foot joint's height changes by {GLIDE_LIFT} m; "
                    "such a sample never rises")
 
 GRAVITY_QUANTITIES: dict[str, float] = {"apex_gain_m": TOLERANCE["apex_m"], "flight_s": TOLERANCE["flight_s"]}
@@ -110,7 +110,7 @@ def gravity_response(ids: Sequence[str], earth: np.ndarray, low: np.ndarray, low
                                                        if env == l_env and v is not None)),
                             "simulated_tracked": sum(v is not None for (_, env), v in sims.items() if env == l_env),
                             "rule": f"lowest joint > {FLOOR_CLEARANCE:.2f} m above y = 0 in every frame; such a sample never rises"},
-            "glides": {"earth": int(glides(earth).sum()), "low_g": int(sum(glide.values())), "rule": GLIDE_RULE},
+            "glides": {"earth": int(glides(earth).sum()), "low_g": int(sum(glide.values())), "rule": GLIDE_TEXT},
             "airborne_total_s": _airborne(effs, grounded),
             "ratios": ratios, "scores": score(effs, resamples=resamples, seed=seed), "rollouts": statuses,
             "rollout_errors": errors}
