@@ -99,8 +99,8 @@ def test_shipped_default_model_generates() -> None:
     assert 1.0 < height < 2.2, height  # a trained model makes a human-sized figure
 
 
-SHIPPED_TEST_REPORT = Path(__file__).parents[1] / "reports/training/s49_mask_frames/test/J40m/check.json"
-"""The test-split model check of the shipped model at its shipped settings (session 49; update when shipping anew)."""
+SHIPPED_TEST_REPORT = Path(__file__).parents[1] / "reports/training/s52_runs_lowg/test/J40m_se3_drop/check.json"
+"""The test-split model check of the shipped model at its shipped settings (session 52; update when shipping anew)."""
 
 
 @pytest.mark.skipif(not SHIPPED_TEST_REPORT.is_file(), reason="the shipped model's test report is not in this checkout")
@@ -116,6 +116,9 @@ def test_shipped_settings_are_the_measured_ones() -> None:
     for key in ("steps", "guidance", "alpha", "foot_lock", "env_guidance"):
         assert key in stored and stored[key] == measured[key], key
     assert stored.get("anchor", "adapters") == measured.get("anchor", "adapters")
+    from simdiff.motion.foot_lock import CLEANUP_VERSION
+
+    assert measured.get("foot_cleanup") == CLEANUP_VERSION  # measured with the foot cleanup users get
     assert report["test_split"]["split"] == "test" and len(measured["seeds"]) >= 5
     assert report["model"]["size"] == (DEFAULT_MODEL_DIR / "model.safetensors").stat().st_size
     # and with the shipped config.json (mask_frames changes batched samples without touching the weights)
