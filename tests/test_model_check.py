@@ -200,6 +200,8 @@ def test_gravity_response_on_synthetic_jumps() -> None:
     apex = out["ratios"]["apex_gain_m"]
     assert apex["n_ratio"] == 3  # simulated change 0.6 − 0.3 = 0.3; generated +0.15, +0.15, −0.1
     assert apex["median_ratio"] == pytest.approx(0.5, abs=0.05)
+    lo, hi = apex["ci95"]  # bootstrap over the 3 samples' ratios (+0.5, +0.5, −0.33)
+    assert lo <= apex["median_ratio"] <= hi and lo == pytest.approx(-1 / 3, abs=0.05) and hi == pytest.approx(0.5, abs=0.05)
     assert out["ratios"]["flight_s"]["median_ratio"] > 0
     assert out["never_touch"]["earth"] == out["never_touch"]["low_g"] == out["never_touch"]["simulated_low_g"] == 0
     assert out["never_touch"]["simulated_tracked"] == 3

@@ -128,7 +128,8 @@ def _response_lines(r: dict[str, Any]) -> list[str]:
              "| quantity | generated change Q1/med/Q3 | simulated change Q1/med/Q3 | median gen/sim | samples in ratio |",
              "|---|---|---|---|---|"]
     for q, v in g["ratios"].items():
-        lines.append(f"| {q} | {_q(v['generated_change'])} | {_q(v['simulated_change'])} | {_f(v['median_ratio'], 2)} | "
+        ci = f" {_f(v['ci95'], 2)}" if "ci95" in v else ""
+        lines.append(f"| {q} | {_q(v['generated_change'])} | {_q(v['simulated_change'])} | {_f(v['median_ratio'], 2)}{ci} | "
                      f"{v['n_ratio']} (|Δsim| > {v['tolerance']}) |")
     lines += _airborne_lines(g, "jump") + _runs_lines(r.get("gravity_runs"))
     lines += ["", f"**Wind ±10 N** (w_x, w_y) on the walk prompts: {w['downwind']} of {w['n']} (sample, φ) pairs drift "

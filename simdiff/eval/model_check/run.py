@@ -30,6 +30,8 @@ FLOOR_RULE: dict[str, float] = {"never_touch_clearance_m": FLOOR_CLEARANCE}
 session 51): parts stored before then are measured again."""
 GLIDE_RULE: dict[str, float] = {"glide_speed_m_s": GLIDE_SPEED, "glide_lift_m": GLIDE_LIFT}
 """In the response sections' fingerprints: a gliding sample does not rise since session 52."""
+RATIO_CI: dict[str, str] = {"size_ratio_ci95": "percentile bootstrap over samples"}
+"""In the gravity sections' fingerprints: their size ratios carry a 95 % interval since session 52."""
 
 
 def _stamp(path: str | Path, weights: str = "model.safetensors") -> dict[str, Any]:
@@ -257,11 +259,11 @@ class ModelCheck:
                   # the only sections off Earth: environment guidance leaves the Earth sections' motions as they are
                   **({"env_guidance": c.env_guidance} if c.env_guidance != 1.0 else {})}
         jumps = self.jump_batches()
-        grav = self.part("gravity", {**inputs, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: gravity_response(
+        grav = self.part("gravity", {**inputs, **RATIO_CI, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: gravity_response(
             units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, (MOON_G, 0.0, 0.0)), MOON_G,
             self.projector, resamples=c.response.resamples, seed=c.seeds[0]))
         runs = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["run"]]  # session 50's floating runs
-        grav_runs = self.part("gravity_runs", {**inputs, "g": MOON_G, "run_prompts": SPEED_PROMPTS["run"]},
+        grav_runs = self.part("gravity_runs", {**inputs, **RATIO_CI, "g": MOON_G, "run_prompts": SPEED_PROMPTS["run"]},
                               lambda: gravity_response(units(runs), self.samples("runs", runs, EARTH),
                                                        self.samples("runs", runs, (MOON_G, 0.0, 0.0)), MOON_G,
                                                        self.projector, resamples=c.response.resamples,
