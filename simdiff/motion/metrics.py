@@ -299,8 +299,6 @@ def glides(
     out = np.zeros(len(lens), dtype=bool)
     feet = [*FOOT_LEFT, *FOOT_RIGHT]
     for b, n in enumerate(lens):
-        if n < 2:  # one frame travels nowhere
-            continue
         clip = arr[b, :n].astype(np.float64)
         speed = np.linalg.norm(np.diff(clip[:, 0, [0, 2]], axis=0), axis=-1).mean() * FPS
         lift = np.ptp(clip[:, feet, 1], axis=0).max()
