@@ -35,6 +35,8 @@ class Generation:
     features: Tensor
     normalized: Tensor
     lengths: Tensor
+    fell_back: Tensor | None = None
+    """(B,) bool: the rows re-sampled at ``env_guidance_fallback`` (None when no fallback was asked for)."""
 
     def clips(self) -> list[Tensor]:
         """Un-normalised features cut to each length: list of (L_i, 263)."""
@@ -110,6 +112,7 @@ class MotionGenerator:
         foot_lock: float = 0.0,
         env_guidance: float = 1.0,
         anchor: str = "adapters",
+        env_guidance_fallback: float | None = None,
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -130,6 +133,9 @@ class MotionGenerator:
             env_guidance: s_e ≥ 0 (1 = off): the adapters' answer to φ against Earth without wind is pushed s_e
                 times as far (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only. Motions under
                 Earth without wind are unchanged; the others cost one more network pass per step.
+            env_guidance_fallback: s_e for the samples that come out physically impossible at ``env_guidance`` (their
+                raw output never comes within 0.10 m of the floor, or glides: :func:`simdiff.motion.metrics.glides`);
+                the batch is sampled again with the same seed at this s_e and those rows replaced (None: off).
             anchor: ``"adapters"`` (default) or ``"backbone"``: the text guidance runs on the backbone alone and only
                 the adapters' answer to φ against Earth without wind (times s_e) is added, so motions under Earth
                 without wind are the backbone's (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only.
@@ -151,6 +157,12 @@ class MotionGenerator:
             if not continuous:
                 raise SimdiffError("env guidance needs a SimDiff model with a continuous Sim Encoder; "
                                    "this model has none (leave it at 1)")
+        if env_guidance_fallback is not None:
+            env_guidance_fallback = float(env_guidance_fallback)
+            if not (env_guidance_fallback >= 0.0 and env_guidance_fallback < float("inf")):
+                raise SimdiffError(f"env guidance fallback must be a finite number ≥ 0, got {env_guidance_fallback}")
+            if not continuous:
+                raise SimdiffError("env guidance fallback needs a SimDiff model with a continuous Sim Encoder")
         if anchor not in ANCHORS:
             raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose {' or '.join(ANCHORS)}")
         if anchor != "adapters" and not continuous:
@@ -161,20 +173,26 @@ class MotionGenerator:
         frames = int(lens.max())
         mask = (torch.arange(frames)[None] < lens[:, None]).to(self.device)
         cond = Condition(text=text, frame_mask=mask, alpha=float(alpha), **self._env(b, env, env_index))
-        generator = None
-        if seed is not None:
-            generator = torch.Generator(device=self.device).manual_seed(int(seed))
-        scheduler = make_scheduler(sampler, steps, eta)
-        x = sample(self.network, scheduler, cond, frames, nfeats=self.config.backbone.nfeats, guidance=guidance,
-                   batched_cfg=batched_cfg, generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps,
-                   progress=progress, env_guidance=env_guidance, anchor=anchor)
+        def run(push: float) -> Tensor:
+            generator = None if seed is None else torch.Generator(device=self.device).manual_seed(int(seed))
+            return sample(self.network, make_scheduler(sampler, steps, eta), cond, frames,
+                          nfeats=self.config.backbone.nfeats, guidance=guidance, batched_cfg=batched_cfg,
+                          generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps, progress=progress,
+                          env_guidance=push, anchor=anchor)
+
+        x = run(env_guidance)
+        fell_back = None
+        if env_guidance_fallback is not None:
+            fell_back = impossible(x * self.std + self.mean, lens).to(x.device)
+            if env_guidance_fallback != env_guidance and bool(fell_back.any()):
+                x = torch.where(fell_back[:, None, None], run(env_guidance_fallback), x)
         features = (x * self.std + self.mean) * mask[..., None]
         if foot_lock and frames >= 2:  # one frame has no step to correct
             from simdiff.motion.foot_lock import clean_feet
 
             features = clean_feet(features, lens, foot_lock) * mask[..., None]
             x = torch.where(mask[..., None], (features - self.mean) / self.std, x)
-        return Generation(features=features, normalized=x, lengths=lens)
+        return Generation(features=features, normalized=x, lengths=lens, fell_back=fell_back)
 
     def _env(self, b: int, env: Sequence[float] | Tensor | None,
              env_index: int | Sequence[int] | Tensor | None) -> dict[str, Tensor | None]:
@@ -197,3 +215,19 @@ class MotionGenerator:
         if idx.shape[0] not in (1, b):
             raise SimdiffError(f"env_index must be 1 or {b} integers")
         return {"env_index": idx.expand(b).to(self.device)}
+
+
+def impossible(features: Tensor, lengths: Tensor) -> Tensor:
+    """(B,) bool: raw samples no body could perform — never within 0.10 m of the floor, or gliding (the pelvis
+    travels while no foot joint lifts; :mod:`simdiff.motion.metrics`). Features (B, T, 263) un-normalised; clips
+    under 2 frames are never flagged."""
+    from simdiff.motion.features import features_to_joints
+    from simdiff.motion.metrics import glides, never_touches
+
+    out = torch.zeros(len(lengths), dtype=torch.bool)
+    rows = [i for i, n in enumerate(lengths.tolist()) if n >= 2]
+    if rows:
+        joints = features_to_joints(features[rows].detach().double().cpu()).numpy()
+        lens = lengths[rows].cpu().numpy()
+        out[rows] = torch.from_numpy(never_touches(joints, lens) | glides(joints, lens))
+    return out
