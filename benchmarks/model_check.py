@@ -51,6 +51,8 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--foot-lock", type=float, default=0.0, help="foot-lock strength in [0, 1] (0: off)")
     p.add_argument("--env-guidance", type=float, default=1.0,
                    help="environment guidance s_e of SimDiff models (1: off; changes only motions off Earth)")
+    p.add_argument("--env-guidance-fallback", type=float, default=None, metavar="S",
+                   help="s_e for the prompt samples that float or glide at --env-guidance (re-sampled; default off)")
     p.add_argument("--anchor", default="adapters", choices=ANCHORS,
                    help="what the text guidance runs on (backbone: the adapters add only their answer to φ vs Earth)")
     p.add_argument("--workers", type=int, default=0, help="simulator processes (0: all cores)")
@@ -94,6 +96,7 @@ def main(argv: list[str] | None = None) -> int:
         config = CheckConfig(model=args.model, corpus=args.corpus, evaluator=args.evaluator, out=out, seeds=args.seeds,
                              steps=args.steps, guidance=args.guidance, alpha=args.alpha,
                              foot_lock=args.foot_lock, env_guidance=args.env_guidance, anchor=args.anchor,
+                             env_guidance_fallback=args.env_guidance_fallback,
                              more_evaluators=list(args.also_evaluator), device=args.device,
                              split=SplitOptions(split=args.split, n=args.n),
                              prompts=PromptOptions(jump_samples=args.jump_samples, speed_samples=args.speed_samples,

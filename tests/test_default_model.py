@@ -67,6 +67,14 @@ def test_sampling_defaults(tmp_path: Path) -> None:
                                given={"env_guidance"}).env_guidance == 1.0
     with pytest.raises(SimdiffError, match="env_guidance must be ≥ 0, got -2"):
         with_model_defaults(build_request("walk"), {"env_guidance": -2.0}, given=set())
+    assert with_model_defaults(build_request("walk"), {}, given=set()).env_guidance_fallback is None
+    assert with_model_defaults(build_request("walk"), {"env_guidance_fallback": 3}, given=set()).env_guidance_fallback == 3.0
+    assert with_model_defaults(build_request("walk", env_guidance_fallback=2), {"env_guidance_fallback": 3},
+                               given={"env_guidance_fallback"}).env_guidance_fallback == 2.0
+    with pytest.raises(SimdiffError, match="env_guidance_fallback must be ≥ 0, got -1"):
+        with_model_defaults(build_request("walk"), {"env_guidance_fallback": -1}, given=set())
+    with pytest.raises(SimdiffError, match="--env-guidance-fallback must be ≥ 0, got -1"):
+        build_request("walk", env_guidance_fallback=-1)
     assert with_model_defaults(build_request("walk"), {"anchor": "backbone"}, given=set()).anchor == "backbone"
     assert with_model_defaults(build_request("walk"), {}, given=set()).anchor == "adapters"
     assert with_model_defaults(build_request("walk", anchor="adapters"), {"anchor": "backbone"},

@@ -310,6 +310,27 @@ def test_a_sample_that_never_touches_the_floor_is_warned_about(tmp_path: Path, c
     assert rec["touches_floor"] is True and rec["lowest_m"] == 0.0
 
 
+def test_env_guidance_fallback_is_recorded_per_sample(tmp_path: Path, capsys) -> None:
+    torch.manual_seed(0)
+    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())
+    mean = torch.zeros(263)
+    mean[3] = 1.5
+    mean[5:67:3] = 1.2  # every raw sample floats: each one is re-sampled at the fallback
+    MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 0.01)).save(tmp_path / "m")
+    args = ["generate", "a person runs", "--frames", "8", "--steps", "1", "--model", str(tmp_path / "m"),
+            "--gravity", "-1.6", "--env-guidance", "4", "--threads", "1", "--format", "npy", "-q"]
+    assert main([*args, "--env-guidance-fallback", "2", "--out", str(tmp_path / "o")]) == 0
+    meta = json.loads((tmp_path / "o" / "generation.json").read_text())
+    assert meta["env_guidance_fallback"] == 2.0 and meta["samples"][0]["fell_back"] is True
+    assert main([*args, "--out", str(tmp_path / "p")]) == 0
+    meta = json.loads((tmp_path / "p" / "generation.json").read_text())
+    assert meta["env_guidance_fallback"] is None and "fell_back" not in meta["samples"][0]
+    capsys.readouterr()
+    assert main([*args, "--env-guidance-fallback", "-1", "--out", str(tmp_path / "q")]) == 2
+    err = capsys.readouterr().err
+    assert "--env-guidance-fallback must be ≥ 0, got -1" in err and err.count("\n") == 1
+
+
 def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
     torch.manual_seed(0)
     config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())

@@ -192,6 +192,21 @@ class _Physics:
             yield out, {"success": True, "status": "ok"}
 
 
+def test_env_guidance_fallback_measures_only_the_response_again(checked: dict, tmp_path: Path) -> None:
+    import shutil
+
+    shutil.copytree(checked["root"] / "out" / "parts", tmp_path / "out" / "parts")
+    config = _config(checked["paths"], tmp_path / "out")
+    config.env_guidance, config.env_guidance_fallback = 3.0, 2.0
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert all(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))
+    assert not report["response"]["gravity"].get("cached")
+    assert report["settings"]["env_guidance_fallback"] == 2.0
+    with pytest.raises(SimdiffError, match="--env-guidance-fallback must be a finite number ≥ 0, got -1"):
+        CheckConfig(**{**config.__dict__, "env_guidance_fallback": -1.0}).validate()
+
+
 def test_gravity_response_on_synthetic_jumps() -> None:
     earth = np.stack([jump(120, height=0.3, start=40, airtime=0.5)] * 3)
     low = np.stack([jump(120, height=0.45, start=40, airtime=0.75)] * 2 + [jump(120, height=0.2, start=40)])

@@ -362,6 +362,11 @@ def test_generate_env_guidance_from_sampling_json_or_the_request(server, model_d
     for bad in (-1, 11, "x"):
         status, out, _ = call(server, "/api/generate", {**moon, "env_guidance": bad})
         assert status == 400 and "env_guidance" in out["error"]
+    status, fb, _ = call(server, "/api/generate", {**moon, "env_guidance": 3, "env_guidance_fallback": 2})
+    assert status == 200 and fb["meta"]["env_guidance_fallback"] == 2.0 and isinstance(fb["meta"]["fell_back"], bool)
+    assert plain["meta"]["env_guidance_fallback"] is None and "fell_back" not in plain["meta"]
+    status, out, _ = call(server, "/api/generate", {**moon, "env_guidance_fallback": -1})
+    assert status == 400 and "env_guidance_fallback" in out["error"]
 
 
 def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):

@@ -65,6 +65,7 @@ class Sample:
         env: φ it was generated under; None for a backbone-only model.
         features: (T, 263) float32 un-normalised features.
         joints: (T, 22, 3) float32 positions in metres, Y-up.
+        fell_back: re-sampled at the request's ``env_guidance_fallback`` (None: no fallback asked for).
     """
 
     column: int
@@ -74,6 +75,7 @@ class Sample:
     features: np.ndarray
     joints: np.ndarray
     simulated: "SimulatedMotion | None" = None
+    fell_back: bool | None = None
 
 
 def _progress(quiet: bool):
@@ -111,7 +113,8 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
             yield t
             bar.update(1)
 
-    features = []
+    features: list[np.ndarray] = []
+    fell_back: list[bool | None] = []
     try:
         with timer.stage("sample"):
             for c, k in runs:
@@ -121,16 +124,19 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
                     alpha=request.alpha, sampler=request.sampler, steps=request.steps, guidance=request.guidance,
                     seed=request.seed + k, text_embeddings=text, progress=progress, foot_lock=request.foot_lock,
                     **({"env_guidance": request.env_guidance} if request.env_guidance != 1.0 else {}),
+                    **({"env_guidance_fallback": request.env_guidance_fallback}
+                       if request.env_guidance_fallback is not None and env is not None else {}),
                     **({"anchor": request.anchor} if request.anchor != "adapters" else {}),
                 )
                 features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
+                fell_back.append(None if out.fell_back is None else bool(out.fell_back[0]))
     finally:
         bar.close()
     samples = []
     with timer.stage("decode"):
-        for (c, k), f in zip(runs, features):
+        for (c, k), f, back in zip(runs, features, fell_back):
             joints = np.asarray(features_to_joints(f), dtype=np.float32)
-            samples.append(Sample(c, k, request.seed + k, envs[c], f, joints))
+            samples.append(Sample(c, k, request.seed + k, envs[c], f, joints, fell_back=back))
     return samples
 
 
@@ -218,6 +224,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
     records = [{"index": s.index, "seed": s.seed, "environment": None if s.env is None else _env_dict(s.env),
                 "frames": int(s.joints.shape[0]), "files": {kind: p.name for kind, p in written.items()},
                 **floor_contact(s.joints),
+                **({"fell_back": s.fell_back} if s.fell_back is not None else {}),
                 **({"simulated": _simulated_summary(s.simulated)} if s.simulated is not None else {})}
                for s, written in zip(samples, files)]
     return {
@@ -248,6 +255,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "foot_lock": request.foot_lock,
         "foot_cleanup": CLEANUP_VERSION if request.foot_lock else None,
         "env_guidance": request.env_guidance if simdiff_model else None,
+        "env_guidance_fallback": request.env_guidance_fallback if simdiff_model else None,
         "anchor": request.anchor if simdiff_model else None,
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",

@@ -46,6 +46,8 @@ class GenerationRequest:
         alpha: adapter strength α (0 = backbone only).
         foot_lock: foot-lock strength in [0, 1] (0: off; :mod:`simdiff.motion.foot_lock`).
         env_guidance: environment guidance s_e ≥ 0 (1: off; :mod:`simdiff.diffusion.guidance`).
+        env_guidance_fallback: s_e ≥ 0 for samples that come out floating or gliding at ``env_guidance``
+            (re-sampled with the same seed; None: off; :meth:`simdiff.model.generator.MotionGenerator.generate`).
         anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:data:`ANCHORS`).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
@@ -63,6 +65,7 @@ class GenerationRequest:
     alpha: float = 1.0
     foot_lock: float = 0.0
     env_guidance: float = 1.0
+    env_guidance_fallback: float | None = None
     anchor: str = "adapters"
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
@@ -220,9 +223,10 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
 
     Args:
         stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance``,
+            ``env_guidance_fallback``,
             ``anchor`` (see :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
-            ``foot_lock``, ``env_guidance``, ``anchor``).
+            ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``).
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -232,8 +236,11 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     else:
         steps = steps_for(sampler, stored.get("steps"))  # type: ignore[arg-type]
     anchor = request.anchor if "anchor" in given else check_anchor("anchor", stored.get("anchor", request.anchor))
+    fallback = request.env_guidance_fallback
+    if "env_guidance_fallback" not in given and stored.get("env_guidance_fallback") is not None:
+        fallback = check_finite("env_guidance_fallback", stored["env_guidance_fallback"], 0.0)
     return replace(
-        request, sampler=sampler, steps=steps, anchor=anchor,
+        request, sampler=sampler, steps=steps, anchor=anchor, env_guidance_fallback=fallback,
         **{name: getattr(request, name) if name in given else stored_setting(stored, name, getattr(request, name))
            for name in STORED_NUMBERS},
     )
@@ -260,6 +267,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                   length_s: float | None = None, frames: int | None = None, seed: int = 0, num_samples: int = 1,
                   sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
                   foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
+                  env_guidance_fallback: float | None = None,
                   compare: str | None = None, formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
@@ -282,6 +290,8 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         alpha=check_finite("--alpha", alpha),
         foot_lock=check_unit("--foot-lock", foot_lock),
         env_guidance=check_finite("--env-guidance", env_guidance, 0.0),
+        env_guidance_fallback=(None if env_guidance_fallback is None
+                               else check_finite("--env-guidance-fallback", env_guidance_fallback, 0.0)),
         anchor=check_anchor("--anchor", anchor),
         formats=parse_formats(formats, no_video),
         force=bool(force),

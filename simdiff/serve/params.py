@@ -52,6 +52,8 @@ class GenerateParams:
             ``sampling.json`` value (1, off, without one).
         anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:mod:`simdiff.diffusion.guidance`),
             or None for the model's ``sampling.json`` value (``adapters`` without one).
+        env_guidance_fallback: s_e for a sample that floats or glides at ``env_guidance`` (re-sampled), or None for
+            the model's ``sampling.json`` value (off without one).
     """
 
     text: str
@@ -67,6 +69,7 @@ class GenerateParams:
     foot_lock: float | None = None
     env_guidance: float | None = None
     anchor: str | None = None
+    env_guidance_fallback: float | None = None
 
     @property
     def frames(self) -> int:
@@ -83,7 +86,7 @@ def limits() -> dict[str, Any]:
     return {
         "gravity": list(GRAVITY_RANGE), "wind": MAX_WIND, "alpha": list(ALPHA_RANGE), "seconds": MAX_SECONDS,
         "fps": FPS, "steps": MAX_STEPS, "guidance": list(GUIDANCE_RANGE), "text": MAX_TEXT,
-        "env_guidance": list(ENV_GUIDANCE_RANGE),
+        "env_guidance": list(ENV_GUIDANCE_RANGE), "env_guidance_fallback": list(ENV_GUIDANCE_RANGE),
     }
 
 
@@ -166,6 +169,10 @@ def parse_generate(body: Any) -> GenerateParams:
     anchor = body.get("anchor")
     if anchor is not None:
         anchor = check_anchor("anchor", anchor)
+    fallback = body.get("env_guidance_fallback")
+    if fallback is not None:
+        fallback = _number(body, "env_guidance_fallback", 1.0)
+        _check_range("env_guidance_fallback", fallback, *ENV_GUIDANCE_RANGE)
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
                           guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance,
-                          anchor=anchor, **wind)
+                          anchor=anchor, env_guidance_fallback=fallback, **wind)

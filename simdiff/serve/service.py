@@ -157,13 +157,18 @@ class MotionService:
             lock = params.foot_lock if params.foot_lock is not None else stored_setting(stored, "foot_lock", 0.0)
             push = params.env_guidance if params.env_guidance is not None else stored_setting(stored, "env_guidance", 1.0)
             anchor = params.anchor if params.anchor is not None else check_anchor("anchor", stored.get("anchor", "adapters"))
+            fallback = params.env_guidance_fallback
+            if fallback is None and stored.get("env_guidance_fallback") is not None:
+                fallback = stored_setting(stored, "env_guidance_fallback", 1.0)
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
             alpha, lock = (1.0 if params.alpha is None else params.alpha), (params.foot_lock or 0.0)
             push = 1.0 if params.env_guidance is None else params.env_guidance
             anchor = params.anchor or "adapters"
-        return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor)
+            fallback = params.env_guidance_fallback
+        return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor,
+                       env_guidance_fallback=fallback)
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -238,7 +243,8 @@ class MotionService:
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
                                      guidance=params.guidance, seed=params.seed, progress=self._progress,
                                      foot_lock=params.foot_lock,
-                                     **({"env_guidance": params.env_guidance, "anchor": params.anchor} if uses_env else {}))
+                                     **({"env_guidance": params.env_guidance, "anchor": params.anchor,
+                                         "env_guidance_fallback": params.env_guidance_fallback} if uses_env else {}))
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count
@@ -249,6 +255,8 @@ class MotionService:
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
                 "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": params.foot_lock,
                 "env_guidance": params.env_guidance if uses_env else None,
+                "env_guidance_fallback": params.env_guidance_fallback if uses_env else None,
+                **({"fell_back": bool(out.fell_back[0])} if out.fell_back is not None else {}),
                 "elapsed_s": round(elapsed, 3), **floor_contact(joints),
                 "queue_position": position, "waited_s": round(waited, 3)}
         if params.simulate:

@@ -83,6 +83,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--env-guidance", type=float, metavar="S",
                      help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off; "
                           "motions under Earth without wind are unchanged (default 1, or the model's sampling.json)")
+    smp.add_argument("--env-guidance-fallback", type=float, metavar="S",
+                     help="environment guidance for the samples that come out floating (never within 0.10 m of the "
+                          "floor) or gliding (travelling while no foot lifts 5 cm) at --env-guidance: they are "
+                          "sampled again with the same seed at S (default off, or the model's sampling.json)")
     smp.add_argument("--anchor", choices=ANCHORS,
                      help="what the text guidance runs on: the network with its adapters (adapters), or the backbone "
                           "alone, the adapters adding only their answer to φ against Earth without wind (backbone); "
@@ -125,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
         guidance=2.5 if args.guidance is None else args.guidance, alpha=1.0 if args.alpha is None else args.alpha,
         foot_lock=0.0 if args.foot_lock is None else args.foot_lock,
         env_guidance=1.0 if args.env_guidance is None else args.env_guidance, anchor=args.anchor or "adapters",
+        env_guidance_fallback=args.env_guidance_fallback,
         compare=args.compare, formats=args.format,
         no_video=args.no_video, force=args.force,
     )
@@ -154,8 +159,8 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     from simdiff.model.provenance import read_provenance
 
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
-    given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance", "anchor")
-             if getattr(args, name) is not None}
+    given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance",
+                               "env_guidance_fallback", "anchor") if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")
     for env in request.envs:

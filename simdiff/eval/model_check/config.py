@@ -90,7 +90,9 @@ class CheckConfig:
         steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models; foot_lock: the
             generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`); env_guidance: environment
             guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth);
-            anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:mod:`simdiff.diffusion.guidance`).
+            anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:mod:`simdiff.diffusion.guidance`);
+            env_guidance_fallback: s_e for the prompt samples that float or glide at ``env_guidance`` (re-sampled;
+            None: off). The test split is generated at Earth without wind, where any s_e gives the same motion.
         more_evaluators: further evaluator folders that score the same test-split motions (each motion generated
             once); the verdicts use ``evaluator``. FID differences between models or settings depend on which
             evaluator was trained (session 47), so a claimed FID change should hold under a second one.
@@ -108,6 +110,7 @@ class CheckConfig:
     foot_lock: float = 0.0
     env_guidance: float = 1.0
     anchor: str = "adapters"
+    env_guidance_fallback: float | None = None
     more_evaluators: list[str] = field(default_factory=list)
     device: str = "cpu"
     quick: bool = False
@@ -133,6 +136,8 @@ class CheckConfig:
             raise SimdiffError(f"--foot-lock must be in [0, 1], got {self.foot_lock}")
         if not 0.0 <= self.env_guidance < float("inf"):
             raise SimdiffError(f"--env-guidance must be a finite number ≥ 0, got {self.env_guidance}")
+        if self.env_guidance_fallback is not None and not 0.0 <= self.env_guidance_fallback < float("inf"):
+            raise SimdiffError(f"--env-guidance-fallback must be a finite number ≥ 0, got {self.env_guidance_fallback}")
         from simdiff.diffusion.guidance import ANCHORS
 
         if self.anchor not in ANCHORS:

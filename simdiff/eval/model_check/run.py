@@ -179,7 +179,8 @@ class ModelCheck:
             c = self.config
             self._sets[key] = generate_set(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
                                            steps=c.steps, guidance=c.guidance, progress=self.progress,
-                                           foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor)
+                                           foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor,
+                                           env_guidance_fallback=c.env_guidance_fallback)
         return self._sets[key]
 
     # --- sections ---------------------------------------------------------------------------
@@ -257,7 +258,8 @@ class ModelCheck:
         inputs = {"options": c.response.__dict__, "prompts": c.prompts.__dict__, "injected": self._injected is not None,
                   **FLOOR_RULE, **GLIDE_RULE,
                   # the only sections off Earth: environment guidance leaves the Earth sections' motions as they are
-                  **({"env_guidance": c.env_guidance} if c.env_guidance != 1.0 else {})}
+                  **({"env_guidance": c.env_guidance} if c.env_guidance != 1.0 else {}),
+                  **({"env_guidance_fallback": c.env_guidance_fallback} if c.env_guidance_fallback is not None else {})}
         jumps = self.jump_batches()
         grav = self.part("gravity", {**inputs, **RATIO_CI, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: gravity_response(
             units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, (MOON_G, 0.0, 0.0)), MOON_G,
@@ -292,6 +294,9 @@ class ModelCheck:
         if c.env_guidance != 1.0 and kind != "continuous":
             raise SimdiffError(f"{c.model}: --env-guidance needs a SimDiff model with a continuous Sim Encoder; "
                                f"this is a {kind} model (leave it at 1)")
+        if c.env_guidance_fallback is not None and kind != "continuous":
+            raise SimdiffError(f"{c.model}: --env-guidance-fallback needs a SimDiff model with a continuous Sim Encoder; "
+                               f"this is a {kind} model (leave it out)")
         if c.anchor != "adapters" and kind != "continuous":
             raise SimdiffError(f"{c.model}: --anchor {c.anchor} needs a SimDiff model with a continuous Sim Encoder; "
                                f"this is a {kind} model (leave it at adapters)")

@@ -41,7 +41,8 @@ def units(batches: Sequence[PromptBatch]) -> list[str]:
 
 def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *, env: Sequence[float] | None,
                  alpha: float, steps: int, guidance: float, progress: bool = False,
-                 foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters") -> np.ndarray:
+                 foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
+                 env_guidance_fallback: float | None = None) -> np.ndarray:
     """Generate every batch; returns joints (N, length, 22, 3) float32, metres, Y-up, 20 fps.
 
     ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone (``env_guidance`` then
@@ -56,6 +57,8 @@ def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *,
         kwargs["env_guidance"] = env_guidance
     if anchor != "adapters":
         kwargs["anchor"] = anchor
+    if env_guidance_fallback is not None:
+        kwargs["env_guidance_fallback"] = env_guidance_fallback
     out = []
     for b in tqdm(batches, desc="prompts", disable=not progress, dynamic_ncols=True, leave=False):
         gen = generator.generate([b.prompt] * b.count, length, sampler="ddim", steps=steps, guidance=guidance,
