@@ -45,7 +45,8 @@ def jump_summary(joints: np.ndarray, batches: Sequence[PromptBatch]) -> dict[str
         mine = [s for s, b in zip(stats, owners) if b.prompt == prompt]
         per_prompt.append(_row(prompt, mine))
     return {"rule": {"min_flight_s": MIN_FLIGHT_S, "min_rise_m": MIN_RISE_M, "standing_level": STANDING_LEVEL,
-                     "floor": f"a sample whose lowest joint stays > {FLOOR_CLEARANCE:.2f} m above y = 0 in every frame does not jump",
+                     "floor": f"a sample whose lowest joint stays > {FLOOR_CLEARANCE:.2f} m above y = 0 in every "
+                              "frame does not jump",
                      "interval": "Wilson 95 % over samples"},
             "per_prompt": per_prompt, "overall": _row("all", stats), "frames": int(joints.shape[1])}
 

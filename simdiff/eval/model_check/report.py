@@ -181,10 +181,11 @@ def _runs_lines(g: dict[str, Any] | None) -> list[str]:
     if not g:
         return []
     t = g["never_touch"]
+    rollouts = ", ".join(f"{k} {v}" for k, v in sorted(g["rollouts"].items()))
     return ["", f"**Runs at g = {_f(g['env'][0], 2)}** (the run prompts, same noise as at Earth; no verdict): "
                 f"{t['low_g']} of {g['n']} samples never touch the floor ({t['earth']} at Earth; the simulator's "
-                f"rollouts {t['simulated_low_g']} of {t['simulated_tracked']} tracked). Rollouts: "
-                + ", ".join(f"{k} {v}" for k, v in sorted(g["rollouts"].items())) + "." + _glides(g)] + _airborne_lines(g, "run")[1:]
+                f"rollouts {t['simulated_low_g']} of {t['simulated_tracked']} tracked). Rollouts: {rollouts}."
+                + _glides(g)] + _airborne_lines(g, "run")[1:]
 
 
 def _speed_of_generate(s: dict[str, Any]) -> list[str]:
