@@ -47,7 +47,7 @@ def test_fallback_replaces_only_the_impossible_rows_with_the_fallback_sample() -
     assert out.fell_back.tolist() == [True, True]
     assert torch.equal(out.features, plain2.features)  # the same seed: each row is the fallback's own sample
     same = gen.generate(["a person runs"] * 2, 12, env_guidance=4.0, env_guidance_fallback=4.0, **kw)
-    assert torch.equal(same.features, plain4.features)
+    assert torch.equal(same.features, plain4.features) and same.fell_back.tolist() == [False, False]
 
 
 def test_a_possible_sample_keeps_its_s_e() -> None:

@@ -183,9 +183,11 @@ class MotionGenerator:
         x = run(env_guidance)
         fell_back = None
         if env_guidance_fallback is not None:
-            fell_back = impossible(x * self.std + self.mean, lens).to(x.device)
-            if env_guidance_fallback != env_guidance and bool(fell_back.any()):
-                x = torch.where(fell_back[:, None, None], run(env_guidance_fallback), x)
+            fell_back = torch.zeros(b, dtype=torch.bool, device=x.device)  # the same s_e: nothing to re-sample
+            if env_guidance_fallback != env_guidance:
+                fell_back = impossible(x * self.std + self.mean, lens).to(x.device)
+                if bool(fell_back.any()):
+                    x = torch.where(fell_back[:, None, None], run(env_guidance_fallback), x)
         features = (x * self.std + self.mean) * mask[..., None]
         if foot_lock and frames >= 2:  # one frame has no step to correct
             from simdiff.motion.foot_lock import clean_feet
