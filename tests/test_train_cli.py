@@ -203,3 +203,80 @@ def test_export_backbone_writes_the_frozen_backbone_bit_identical(runs, tmp_path
     assert main(["train", "export-backbone", "--model", str(out), "--out", str(tmp_path / "again")]) == 2
     err = capsys.readouterr().err
     assert "already a backbone-only model" in err and err.count("\n") == 1
+
+
+def _perturbed_copy(src, dst, key: str = "backbone.", scale: float = 0.01):
+    """A copy of model folder ``src`` whose weights under ``key`` moved by seeded noise (a stand-in parent)."""
+    from safetensors.torch import load_file, save_file
+
+    shutil.copytree(src, dst)
+    weights = load_file(str(dst / "model.safetensors"))
+    g = torch.Generator().manual_seed(0)
+    weights = {k: v + scale * torch.randn(v.shape, generator=g) if k.startswith(key) and v.is_floating_point() else v
+               for k, v in weights.items()}
+    save_file(weights, str(dst / "model.safetensors"))
+    return dst
+
+
+def test_extrapolate_moves_only_the_backbone_along_the_fine_tune(runs, tmp_path, capsys) -> None:
+    from safetensors.torch import load_file
+
+    from simdiff.model import MotionGenerator
+    from simdiff.model.provenance import read_provenance
+
+    model = tmp_path / "model"
+    shutil.copytree(runs / "ad" / "model", model)
+    (model / "sampling.json").write_text('{"guidance": 2.5}')
+    parent = _perturbed_copy(runs / "ad" / "model", tmp_path / "parent")
+    for lam in (0.0, 2.0):
+        out = tmp_path / f"x{lam}"
+        assert main(["train", "extrapolate", "--model", str(model), "--parent", str(parent), "--lam", str(lam),
+                     "--out", str(out)]) == 0
+        m, p, x = (load_file(str(d / "model.safetensors")) for d in (model, parent, out))
+        assert set(x) == set(m)
+        for k, v in m.items():
+            if k.startswith("backbone.") and v.is_floating_point() and not torch.equal(v, p[k]):
+                assert torch.allclose(x[k], v + lam * (v - p[k]), atol=1e-6)
+                assert torch.equal(x[k], v) == (lam == 0.0)
+            else:  # adapters, Sim Encoder, normaliser, buffers the parent shares
+                assert torch.equal(x[k], v), k
+        recipe = json.loads((out / "extrapolation.json").read_text())
+        assert recipe["lambda"] == lam and recipe["parent"] == str(parent) and len(recipe["model_sha256"]) == 64
+        assert (out / "sampling.json").read_text() == '{"guidance": 2.5}'
+    gen = MotionGenerator.load(tmp_path / "x2.0", load_text=False)
+    assert gen.is_simdiff
+    prov = read_provenance(tmp_path / "x2.0")
+    assert prov is not None and [p.what for p in prov.trained_on] == ["backbone", "adapters"]  # no duplicate record
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("change, message", [
+    ("lam", "finite number"),
+    ("heads", "backbone num_heads is 2"),
+    ("mean", "normalizer.mean differs"),
+    ("same", "must differ from the model"),
+])
+def test_extrapolate_errors_are_one_line(runs, tmp_path, capsys, change, message) -> None:
+    from safetensors.torch import load_file, save_file
+
+    model, parent = runs / "ad" / "model", tmp_path / "parent"
+    shutil.copytree(model, parent)
+    lam, out = "2", tmp_path / "out"
+    if change == "lam":
+        lam = "nan"
+    elif change == "heads":
+        cfg = json.loads((parent / "config.json").read_text())
+        cfg["backbone"]["num_heads"] = 2
+        (parent / "config.json").write_text(json.dumps(cfg))
+    elif change == "mean":
+        weights = load_file(str(parent / "model.safetensors"))
+        weights["normalizer.mean"] = weights["normalizer.mean"] + 1.0
+        save_file(weights, str(parent / "model.safetensors"))
+    else:
+        out = parent
+    capsys.readouterr()
+    assert main(["train", "extrapolate", "--model", str(model), "--parent", str(parent), "--lam", lam,
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+    assert not (tmp_path / "out").exists()

@@ -1,5 +1,5 @@
-"""``simdiff train backbone|adapters|export-backbone``: train the MDM backbone, or SimDiff's adapters on a
-frozen one; export a SimDiff model's backbone on its own.
+"""``simdiff train backbone|adapters|export-backbone|extrapolate``: train the MDM backbone, or SimDiff's adapters on
+a frozen one; export a SimDiff model's backbone on its own; extrapolate a backbone fine-tune.
 
 Multi-process: ``torchrun --nproc_per_node N -m simdiff train backbone ...`` (gloo on CPU,
 nccl on CUDA); ``--batch-size`` is the global batch.
@@ -83,12 +83,29 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     e.add_argument("--model", type=Path, required=True, help="SimDiff model folder (model.safetensors + config.json)")
     e.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
     e.set_defaults(func=run_export)
+    x = group.add_parser("extrapolate", help="move a fine-tuned backbone further along its fine-tune (task arithmetic)",
+                         description="Write MODEL with its backbone weights at model + LAMBDA x (model - parent): "
+                                     "LAMBDA 0 copies MODEL, LAMBDA > 0 goes further in the direction the fine-tune "
+                                     "from PARENT moved them. Adapters, Mean/Std, config and sampling.json are MODEL's; "
+                                     "extrapolation.json records the recipe.")
+    x.add_argument("--model", type=Path, required=True, help="the fine-tuned model folder (SimDiff or backbone-only)")
+    x.add_argument("--parent", type=Path, required=True, help="the model folder it was fine-tuned from")
+    x.add_argument("--lam", type=float, required=True, metavar="LAMBDA", help="extrapolation factor (e.g. 2)")
+    x.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
+    x.set_defaults(func=run_extrapolate)
 
 
 def run_export(args: argparse.Namespace) -> int:
     from simdiff.model.checkpoint import export_backbone
 
     print(f"wrote {export_backbone(args.model, args.out)}")
+    return 0
+
+
+def run_extrapolate(args: argparse.Namespace) -> int:
+    from simdiff.model.extrapolate import extrapolate_backbone
+
+    print(f"wrote {extrapolate_backbone(args.model, args.parent, args.lam, args.out)}")
     return 0
 
 
