@@ -345,3 +345,20 @@ def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
     assert code == 0 and err.startswith("simdiff: warning: sample 0 glides: it travels while no foot lifts 0.05 m")
     assert len(err.strip().splitlines()) == 1
     assert json.loads((tmp_path / "o" / "generation.json").read_text())["samples"][0]["glides"] is True
+
+
+def test_generate_reports_an_extrapolated_backbone(tmp_path: Path, capsys) -> None:
+    model = save_tiny(tmp_path / "m")
+    argv = ["generate", "a person waves", "--frames", "8", "--steps", "2", "--model", str(model), "--threads", "1",
+            "--format", "npy", "--no-video", "-q"]
+    assert main([*argv, "--out", str(tmp_path / "o")]) == 0, capsys.readouterr().err
+    assert "extrapolation" not in json.loads((tmp_path / "o" / "generation.json").read_text())["model"]
+    (model / "extrapolation.json").write_text(json.dumps({"lambda": 1.5, "parent": "p"}))
+    assert main([*argv, "--out", str(tmp_path / "x")]) == 0, capsys.readouterr().err
+    meta = json.loads((tmp_path / "x" / "generation.json").read_text())["model"]
+    assert meta["extrapolation"] == {"lambda": 1.5, "parent": "p"}
+    (model / "extrapolation.json").write_text("{oops")  # malformed: one line, before any sampling
+    assert main([*argv, "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "extrapolation.json: not valid JSON" in err and err.count("\n") == 1
+    assert not (tmp_path / "bad" / "generation.json").exists()

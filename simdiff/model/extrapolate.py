@@ -83,6 +83,22 @@ def extrapolate_backbone(model: str | os.PathLike[str], parent: str | os.PathLik
     return dst
 
 
+def read_recipe(model_dir: str | os.PathLike[str]) -> dict | None:
+    """``model_dir/extrapolation.json`` (None when absent); invalid JSON is one :class:`SimdiffError` line naming it."""
+    import json
+
+    path = Path(model_dir) / RECIPE_NAME
+    if not path.is_file():
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise SimdiffError(f"{path}: not valid JSON ({exc})") from None
+    if not isinstance(data, dict) or not isinstance(data.get("lambda"), (int, float)):
+        raise SimdiffError(f"{path}: expected an object with a numeric 'lambda'")
+    return data
+
+
 def _write_provenance(src: Path, par: Path, dst: Path) -> None:
     """The model's records, then the parent's backbone records it does not already hold (the licence over all)."""
     from simdiff.model.provenance import Provenance, read_provenance, write_provenance

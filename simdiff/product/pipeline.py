@@ -205,13 +205,17 @@ def _env_dict(env: Environment) -> dict:
 
 
 def model_provenance(model_dir: Path) -> dict:
-    """``trained_on`` and ``weights_licence`` from the model's ``provenance.json`` ("unknown" without one)."""
+    """``trained_on`` and ``weights_licence`` from the model's ``provenance.json`` ("unknown" without one), and the
+    recipe of ``extrapolation.json`` when its backbone was extrapolated (``simdiff train extrapolate``)."""
+    from simdiff.model.extrapolate import read_recipe
     from simdiff.model.provenance import UNKNOWN, read_provenance
 
     prov = read_provenance(model_dir)
+    recipe = read_recipe(model_dir)
+    extra = {} if recipe is None else {"extrapolation": recipe}
     if prov is None:
-        return {"trained_on": UNKNOWN, "weights_licence": UNKNOWN}
-    return {"trained_on": [p.to_dict() for p in prov.trained_on], "weights_licence": prov.weights_licence}
+        return {"trained_on": UNKNOWN, "weights_licence": UNKNOWN, **extra}
+    return {"trained_on": [p.to_dict() for p in prov.trained_on], "weights_licence": prov.weights_licence, **extra}
 
 
 def metadata(request: GenerationRequest, generator, model_dir: Path, samples: list[Sample],

@@ -158,7 +158,10 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     stored = sampling_defaults(args.model)
     from simdiff.model.provenance import read_provenance
 
+    from simdiff.model.extrapolate import read_recipe
+
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
+    read_recipe(folder)  # likewise extrapolation.json
     given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance",
                                "env_guidance_fallback", "anchor") if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
