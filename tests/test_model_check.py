@@ -79,6 +79,9 @@ def test_check_writes_every_field(checked: dict) -> None:
     assert report["speeds"]["types"]["walk"]["never_touch"] >= 0
     speeds = report["speeds"]["types"]
     assert speeds["walk"]["samples"]["n"] == 4 and speeds["walk"]["corpus_train"]["n"] >= 1
+    walking = speeds["walk"]["jumping"]  # walk samples that jump, the corpus's walks beside them
+    assert walking["n"] == 4 and 0 <= walking["jumps"] <= 4 and walking["corpus_train_n"] >= 1
+    assert "jumping (corpus)" in (out / "check.md").read_text()
     grav, wind = report["response"]["gravity"], report["response"]["wind"]
     assert grav["n"] == 12 and grav["rollouts"] == {"ok": 24}
     assert wind["n"] == 4 * 4 and wind["rollouts"] == {"ok": 20}  # 4 walk samples × (Earth + 4 winds)
@@ -160,6 +163,21 @@ def test_jump_detection_on_ballistic_pelvis() -> None:
     still = walk(60, speed=0.0, amplitude=0.0, bounce=0.0)
     assert standing_level(still) == pytest.approx(float(still[0, 0, 1]))
     assert root_speed(walk(80, speed=1.3)) == pytest.approx(1.3, rel=0.02)
+
+
+def test_speed_summary_counts_walks_that_jump() -> None:
+    from simdiff.eval.model_check.prompts import speed_summary
+
+    batches = plan_batches(["a person walks"], 3, [0])
+    joints = np.stack([walk(80, speed=1.2), walk(80, speed=1.0), jump(80, height=0.4)])
+    assert [bool(jump_stats(j)["jump"]) for j in joints] == [False, False, True]
+    out = speed_summary(joints, batches, {"walk": ["a person walks"]}, {"walk": [1.0, 1.2, 1.4]},
+                        {"walk": [False, False, False, True]})
+    walking = out["types"]["walk"]["jumping"]
+    assert (walking["jumps"], walking["n"], walking["corpus_train_fraction"], walking["corpus_train_n"]) == (1, 3, 0.25, 4)
+    assert walking["wilson95"][0] < 1 / 3 < walking["wilson95"][1]
+    bare = speed_summary(joints, batches, {"walk": ["a person walks"]}, {"walk": [1.0]})  # no corpus rates given
+    assert bare["types"]["walk"]["jumping"]["corpus_train_fraction"] is None
 
 
 def test_wilson_and_batches() -> None:

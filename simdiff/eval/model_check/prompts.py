@@ -6,7 +6,9 @@
 * Speeds (:func:`speed_summary`): quartiles of the samples' mean horizontal root speed per motion
   type against the quartiles of the corpus's *train* clips of that ``motion_type``
   (``manifest.json``; mirrors left out: they have their original's speed). A type passes when
-  the samples' median lies within the corpus clips' interquartile range.
+  the samples' median lies within the corpus clips' interquartile range. Beside it (no verdict): how many
+  walk / run samples jump by the jump rule, against the corpus clips' rate over the samples' length (session 53:
+  a model pushed to jump more can start hopping when asked to walk).
 
 Both count the samples that never touch the floor (``never_touch``,
 :func:`simdiff.motion.metrics.never_touches`); such a sample is not a jump.
@@ -62,7 +64,14 @@ def _row(prompt: str, stats: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def corpus_speeds(corpus: str | Path, types: Sequence[str], limit: int = 0, seed: int = 0) -> dict[str, list[float]]:
-    """Mean horizontal root speeds (m/s) of the corpus's train clips per ``motion_type`` (originals only).
+    """Mean horizontal root speeds (m/s) of the corpus's train clips per ``motion_type`` (originals only)."""
+    return {kind: [s for s, _ in rows] for kind, rows in corpus_clips(corpus, types, limit, seed).items()}
+
+
+def corpus_clips(corpus: str | Path, types: Sequence[str], limit: int = 0, seed: int = 0,
+                 frames: int = 0) -> dict[str, list[tuple[float, bool]]]:
+    """(mean horizontal root speed m/s, jumps by :func:`jump_stats`) of the corpus's train clips per ``motion_type``
+    (originals only); the jump rule reads each clip's first ``frames`` frames (0: all), the samples' length.
 
     Args:
         corpus: a corpus folder with ``manifest.json`` (``clips`` with ``id``, ``split``, ``motion_type``,
@@ -81,27 +90,30 @@ def corpus_speeds(corpus: str | Path, types: Sequence[str], limit: int = 0, seed
     if not isinstance(clips, list) or not all(isinstance(c, dict) and "motion_type" in c for c in clips):
         raise SimdiffError(f"{path}: clips without 'motion_type' (build the corpus with `simdiff data build`)")
     rng = np.random.default_rng(seed)
-    out: dict[str, list[float]] = {}
+    out: dict[str, list[tuple[float, bool]]] = {}
     for kind in types:
         ids = sorted(c["id"] for c in clips if c.get("split") == "train" and c["motion_type"] == kind
                      and not c.get("mirror_of"))
         if limit and len(ids) > limit:
             ids = sorted(rng.choice(ids, limit, replace=False).tolist())
-        speeds = []
+        rows = []
         for clip_id in ids:
             f = Path(corpus) / "new_joints" / f"{clip_id}.npy"
             if not f.is_file():
                 raise SimdiffError(f"{f}: missing (listed in manifest.json)")
-            speeds.append(root_speed(np.load(f)))
-        out[kind] = speeds
+            joints = np.load(f)
+            rows.append((root_speed(joints), bool(jump_stats(joints[:frames] if frames else joints)["jump"])))
+        out[kind] = rows
     return out
 
 
 def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dict[str, Sequence[str]],
-                  corpus: dict[str, list[float]]) -> dict[str, Any]:
-    """Per motion type: quartiles of the samples' speeds (and per prompt) against the corpus clips'."""
+                  corpus: dict[str, list[float]], corpus_jumps: dict[str, list[bool]] | None = None) -> dict[str, Any]:
+    """Per motion type: quartiles of the samples' speeds (and per prompt) against the corpus clips'; how many samples
+    jump (a walk or run that jumps is not what was asked; the corpus clips' rate beside it when given)."""
     owners = _per_sample(batches)
     speeds = [root_speed(j) for j in joints]
+    jumping = [bool(jump_stats(j)["jump"]) for j in joints]
     floating = never_touches(joints)
     out: dict[str, Any] = {"speed": "mean horizontal pelvis speed over the motion (m/s)",
                            "rule": "pass when the samples' median lies in the corpus train clips' [Q1, Q3]",
@@ -114,5 +126,16 @@ def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dic
             "prompts": list(prompts), "samples": gen, "corpus_train": ref,
             "per_prompt": {p: quartiles([v for v, b in zip(speeds, owners) if b.prompt == p]) for p in prompts},
             "never_touch": int(sum(f for f, b in zip(floating, owners) if b.prompt in prompts)),
+            "jumping": _jumping([k for k, b in zip(jumping, owners) if b.prompt in prompts],
+                                None if corpus_jumps is None else corpus_jumps.get(kind, [])),
             "median_in_iqr": bool(ref["n"] > 0 and ref["q1"] <= gen["median"] <= ref["q3"]) if gen["n"] else False}
     return out
+
+
+def _jumping(samples: list[bool], corpus: list[bool] | None) -> dict[str, Any]:
+    """Samples that jump by the jump rule (with a Wilson 95 % interval) and the corpus clips' fraction."""
+    k = sum(samples)
+    frac, lo, hi = wilson(k, len(samples))
+    return {"n": len(samples), "jumps": k, "fraction": frac, "wilson95": [lo, hi],
+            "corpus_train_fraction": sum(corpus) / len(corpus) if corpus else None,
+            "corpus_train_n": None if corpus is None else len(corpus)}

@@ -108,11 +108,20 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
     if "skipped" in s:
         return [f"Not measured: {s['skipped']}."]
     lines = [f"Speed: {s['speed']}; {s['rule']}. Quartiles Q1 / median / Q3.", "",
-             "| type | prompts | samples | corpus train clips | median in IQR | never touch floor |", "|---|---|---|---|---|---|"]
+             "| type | prompts | samples | corpus train clips | median in IQR | never touch floor | jumping (corpus) |",
+             "|---|---|---|---|---|---|---|"]
     for kind, t in s["types"].items():
         lines.append(f"| {kind} | {'; '.join(t['prompts'])} | {_q(t['samples'])} | {_q(t['corpus_train'])} | "
-                     f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} |")
+                     f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} | {_jumping(t.get('jumping'))} |")
     return lines
+
+
+def _jumping(j: dict[str, Any] | None) -> str:
+    """'k of n (corpus f)' for the walk / run samples that jump; '—' in reports made before session 53."""
+    if j is None:
+        return "—"
+    ref = j.get("corpus_train_fraction")
+    return f"{j['jumps']} of {j['n']}" + ("" if ref is None else f" (corpus {_f(ref, 3)})")
 
 
 def _response_lines(r: dict[str, Any]) -> list[str]:

@@ -28,6 +28,8 @@ SCHEMA: str = "simdiff.model_check/1"
 FLOOR_RULE: dict[str, float] = {"never_touch_clearance_m": FLOOR_CLEARANCE}
 """In the fingerprints of the sections whose counts depend on floor contact (a jump or a rise needs it since
 session 51): parts stored before then are measured again."""
+JUMPING_RULE: dict[str, int] = {"walk_run_jumping": 1}
+"""In the speeds section's fingerprint: it counts the walk / run samples that jump since session 53."""
 GLIDE_RULE: dict[str, float] = {"glide_speed_m_s": GLIDE_SPEED, "glide_lift_m": GLIDE_LIFT}
 """In the response sections' fingerprints: a gliding sample does not rise since session 52."""
 RATIO_CI: dict[str, str] = {"size_ratio_ci95": "percentile bootstrap over samples"}
@@ -232,19 +234,21 @@ class ModelCheck:
                          lambda: jump_summary(self.samples("jumps", batches, EARTH), batches))
 
     def speeds(self) -> dict[str, Any]:
-        from simdiff.eval.model_check.prompts import corpus_speeds, speed_summary
+        from simdiff.eval.model_check.prompts import corpus_clips, speed_summary
 
         c = self.config
 
         def measure() -> dict[str, Any]:
             try:
-                corpus = corpus_speeds(c.corpus, list(SPEED_PROMPTS), c.prompts.corpus_clips, c.seeds[0])
+                clips = corpus_clips(c.corpus, list(SPEED_PROMPTS), c.prompts.corpus_clips, c.seeds[0], c.prompts.length)
             except SimdiffError as exc:
                 return {"skipped": str(exc)}
             batches = self.speed_batches()
-            return speed_summary(self.samples("speeds", batches, EARTH), batches, SPEED_PROMPTS, corpus)
+            return speed_summary(self.samples("speeds", batches, EARTH), batches, SPEED_PROMPTS,
+                                 {k: [v for v, _ in rows] for k, rows in clips.items()},
+                                 {k: [j for _, j in rows] for k, rows in clips.items()})
 
-        return self.part("speeds", {"prompts": SPEED_PROMPTS, "options": c.prompts.__dict__,
+        return self.part("speeds", {"prompts": SPEED_PROMPTS, "options": c.prompts.__dict__, **JUMPING_RULE,
                                     "corpus": _stamp(c.corpus, "manifest.json")}, measure)
 
     def response(self) -> dict[str, Any]:
