@@ -180,6 +180,29 @@ def test_speed_summary_counts_walks_that_jump() -> None:
     assert bare["types"]["walk"]["jumping"]["corpus_train_fraction"] is None
 
 
+def test_generate_set_flags_keeps_the_generators_fallback_rows_in_order() -> None:
+    import torch
+
+    from simdiff.eval.model_check.samples import generate_set_flags
+
+    class Fake:  # 2 rows per call; the first call re-samples its second row, the second call reports nothing
+        calls = 0
+
+        def generate(self, texts, length, **kwargs):
+            from simdiff.model.generator import Generation
+
+            Fake.calls += 1
+            flags = torch.tensor([False, True]) if Fake.calls == 1 else None
+            feats = torch.zeros(len(texts), length, 263)
+            return Generation(features=feats, normalized=feats, lengths=torch.full((len(texts),), length),
+                              fell_back=flags)
+
+    batches = plan_batches(["a", "b"], 2, [0])
+    joints, flags = generate_set_flags(Fake(), batches, 4, env=(-1.6, 0.0, 0.0), alpha=0.5, steps=2, guidance=1.0,
+                                       env_guidance=4.0, env_guidance_fallback=3.0)
+    assert joints.shape == (4, 4, 22, 3) and flags.tolist() == [False, True, False, False]
+
+
 def test_wilson_and_batches() -> None:
     frac, lo, hi = wilson(7, 10)
     assert frac == 0.7 and 0.39 < lo < 0.40 and 0.89 < hi < 0.90  # the Wilson score interval of 7/10
@@ -221,6 +244,12 @@ def test_env_guidance_fallback_measures_only_the_response_again(checked: dict, t
     assert all(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))
     assert not report["response"]["gravity"].get("cached")
     assert report["settings"]["env_guidance_fallback"] == 2.0
+    response = report["response"]  # how many samples off Earth were re-sampled at the fallback s_e
+    for section, n in (("gravity", 12), ("gravity_runs", 4), ("wind", 16)):
+        f = response[section]["fell_back"]
+        assert f["s_e"] == 2.0 and f["of"] == n and 0 <= f["samples"] <= n, section
+    assert "Re-sampled at the fallback s_e 2.00" in (tmp_path / "out" / "check.md").read_text()
+    assert "fell_back" not in json.loads((checked["root"] / "out" / "check.json").read_text())["response"]["gravity"]
     with pytest.raises(SimdiffError, match="--env-guidance-fallback must be a finite number ≥ 0, got -1"):
         CheckConfig(**{**config.__dict__, "env_guidance_fallback": -1.0}).validate()
 

@@ -145,7 +145,7 @@ def _response_lines(r: dict[str, Any]) -> list[str]:
               f"downwind ({_f(w['downwind_fraction'], 2)} {_f(w['wilson95'], 2)}). Drift along the wind per 10 N, "
               f"Q1/med/Q3: generated {_q(w['drift_per_10n_generated_m'])} m, simulated "
               f"{_q(w['drift_per_10n_simulated_m'])} m; median ratio {_f(w['median_ratio_generated_to_simulated'], 2)}. "
-              "Rollouts: " + ", ".join(f"{k} {v}" for k, v in sorted(w["rollouts"].items())) + ".", "",
+              "Rollouts: " + ", ".join(f"{k} {v}" for k, v in sorted(w["rollouts"].items())) + "." + _fell_back(w), "",
               "| φ | downwind | generated m Q1/med/Q3 | simulated m Q1/med/Q3 | never touch floor | glide |",
               "|---|---|---|---|---|---|"]
     for env, v in w["per_env"].items():
@@ -174,7 +174,14 @@ def _glides(g: dict[str, Any]) -> str:
     t = g.get("glides")
     if not t:
         return ""
-    return f" Samples that glide ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, {t['earth']} at Earth."
+    return (f" Samples that glide ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, {t['earth']} at Earth."
+            + _fell_back(g))
+
+
+def _fell_back(r: dict[str, Any]) -> str:
+    """How many samples off Earth were re-sampled at the fallback s_e (reports before session 53 or without one: none)."""
+    f = r.get("fell_back")
+    return "" if not f else f" Re-sampled at the fallback s_e {_f(f['s_e'], 2)} (floating or gliding): {f['samples']} of {f['of']}."
 
 
 def _airborne_lines(g: dict[str, Any], what: str) -> list[str]:

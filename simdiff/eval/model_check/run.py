@@ -20,7 +20,7 @@ import numpy as np
 
 from simdiff.errors import SimdiffError
 from simdiff.eval.model_check.config import EARTH, JUMP_PROMPTS, MOON_G, SPEED_PROMPTS, WIND_N, CheckConfig
-from simdiff.eval.model_check.samples import PromptBatch, generate_set, plan_batches, units
+from simdiff.eval.model_check.samples import PromptBatch, generate_set_flags, plan_batches, units
 from simdiff.motion.foot_lock import CLEANUP_VERSION
 from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT, GLIDE_SPEED
 
@@ -93,7 +93,7 @@ class ModelCheck:
         self._injected = projector
         self._projector = projector
         self._generator: Any = None
-        self._sets: dict[tuple[str, tuple[float, ...] | None], np.ndarray] = {}
+        self._sets: dict[tuple[str, tuple[float, ...] | None], tuple[np.ndarray, np.ndarray]] = {}
         self.timings: dict[str, float] = {}
 
     # --- resources --------------------------------------------------------------------------
@@ -179,11 +179,21 @@ class ModelCheck:
         key = (name, self.env(phi))
         if key not in self._sets:
             c = self.config
-            self._sets[key] = generate_set(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
-                                           steps=c.steps, guidance=c.guidance, progress=self.progress,
-                                           foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor,
-                                           env_guidance_fallback=c.env_guidance_fallback)
-        return self._sets[key]
+            self._sets[key] = generate_set_flags(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
+                                                 steps=c.steps, guidance=c.guidance, progress=self.progress,
+                                                 foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor,
+                                                 env_guidance_fallback=c.env_guidance_fallback)
+        return self._sets[key][0]
+
+    def fell_back(self, name: str, phis: Sequence[Sequence[float]]) -> dict[str, Any]:
+        """``{"fell_back": {"s_e": S, "samples": k, "of": n}}``: how many of the (already generated) samples of set
+        ``name`` under ``phis`` were re-sampled at the fallback s_e; ``{}`` without a fallback."""
+        s_e = self.config.env_guidance_fallback
+        if s_e is None:
+            return {}
+        flags = [self._sets[(name, self.env(phi))][1] for phi in phis]
+        return {"fell_back": {"s_e": s_e, "samples": int(sum(f.sum() for f in flags)),
+                              "of": int(sum(len(f) for f in flags))}}
 
     # --- sections ---------------------------------------------------------------------------
     def test_split(self) -> dict[str, Any]:
@@ -263,22 +273,24 @@ class ModelCheck:
                   **FLOOR_RULE, **GLIDE_RULE,
                   # the only sections off Earth: environment guidance leaves the Earth sections' motions as they are
                   **({"env_guidance": c.env_guidance} if c.env_guidance != 1.0 else {}),
-                  **({"env_guidance_fallback": c.env_guidance_fallback} if c.env_guidance_fallback is not None else {})}
+                  **({"env_guidance_fallback": c.env_guidance_fallback, "fallbacks_counted": 1}
+                     if c.env_guidance_fallback is not None else {})}
         jumps = self.jump_batches()
-        grav = self.part("gravity", {**inputs, **RATIO_CI, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: gravity_response(
-            units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, (MOON_G, 0.0, 0.0)), MOON_G,
-            self.projector, resamples=c.response.resamples, seed=c.seeds[0]))
+        moon = (MOON_G, 0.0, 0.0)
+        grav = self.part("gravity", {**inputs, **RATIO_CI, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: {**gravity_response(
+            units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, moon), MOON_G,
+            self.projector, resamples=c.response.resamples, seed=c.seeds[0]), **self.fell_back("jumps", [moon])})
         runs = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["run"]]  # session 50's floating runs
         grav_runs = self.part("gravity_runs", {**inputs, **RATIO_CI, "g": MOON_G, "run_prompts": SPEED_PROMPTS["run"]},
-                              lambda: gravity_response(units(runs), self.samples("runs", runs, EARTH),
-                                                       self.samples("runs", runs, (MOON_G, 0.0, 0.0)), MOON_G,
-                                                       self.projector, resamples=c.response.resamples,
-                                                       seed=c.seeds[0]))
+                              lambda: {**gravity_response(units(runs), self.samples("runs", runs, EARTH),
+                                                          self.samples("runs", runs, moon), MOON_G,
+                                                          self.projector, resamples=c.response.resamples,
+                                                          seed=c.seeds[0]), **self.fell_back("runs", [moon])})
         walk = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["walk"]]
         winds = [(EARTH[0], WIND_N, 0.0), (EARTH[0], -WIND_N, 0.0), (EARTH[0], 0.0, WIND_N), (EARTH[0], 0.0, -WIND_N)]
-        wind = self.part("wind", {**inputs, "wind": winds, "walk_prompts": SPEED_PROMPTS["walk"]}, lambda: wind_response(
+        wind = self.part("wind", {**inputs, "wind": winds, "walk_prompts": SPEED_PROMPTS["walk"]}, lambda: {**wind_response(
             units(walk), self.samples("walks", walk, EARTH), {w: self.samples("walks", walk, w) for w in winds},
-            self.projector, resamples=c.response.resamples, seed=c.seeds[0]))
+            self.projector, resamples=c.response.resamples, seed=c.seeds[0]), **self.fell_back("walks", winds)})
         return {"gravity": grav, "gravity_runs": grav_runs, "wind": wind, "simulator": "the projector's flight clock (flights follow gravity)"
                 if self._injected is None else "injected projector (tests)"}
 

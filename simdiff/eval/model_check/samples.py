@@ -48,6 +48,17 @@ def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *,
     ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone (``env_guidance`` then
     and ``anchor`` must stay at their defaults).
     """
+    return generate_set_flags(generator, batches, length, env=env, alpha=alpha, steps=steps, guidance=guidance,
+                              progress=progress, foot_lock=foot_lock, env_guidance=env_guidance, anchor=anchor,
+                              env_guidance_fallback=env_guidance_fallback)[0]
+
+
+def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: int, *, env: Sequence[float] | None,
+                       alpha: float, steps: int, guidance: float, progress: bool = False, foot_lock: float = 0.0,
+                       env_guidance: float = 1.0, anchor: str = "adapters",
+                       env_guidance_fallback: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`generate_set`'s joints and (N,) bool: the samples re-sampled at ``env_guidance_fallback`` (the
+    generator's ``Generation.fell_back``; all False without a fallback)."""
     from tqdm import tqdm
 
     from simdiff.motion.features import features_to_joints
@@ -59,9 +70,11 @@ def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *,
         kwargs["anchor"] = anchor
     if env_guidance_fallback is not None:
         kwargs["env_guidance_fallback"] = env_guidance_fallback
-    out = []
+    out, flags = [], []
     for b in tqdm(batches, desc="prompts", disable=not progress, dynamic_ncols=True, leave=False):
         gen = generator.generate([b.prompt] * b.count, length, sampler="ddim", steps=steps, guidance=guidance,
                                  seed=b.noise_seed, foot_lock=foot_lock, **kwargs)
         out.append(np.asarray(features_to_joints(gen.features.detach().cpu().double()), dtype=np.float32))
-    return np.concatenate(out)
+        fell = getattr(gen, "fell_back", None)
+        flags.append(np.zeros(b.count, dtype=bool) if fell is None else fell.detach().cpu().numpy().astype(bool))
+    return np.concatenate(out), np.concatenate(flags)
