@@ -8,4 +8,4 @@ S=/work/scratch/s39
 mkdir -p $S/eval11/T_3_J40m_se4_fb3_c53/parts
 cp $S/eval11/T_3_J40m_se4_fb3/parts/{test_split,jumps}.json $S/eval11/T_3_J40m_se4_fb3_c53/parts/
 FB=3 STEPS=50 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh T 3_J40m_se4_fb3_c53 /work/scratch/s49/J40m_model 4
-python reports/training/s52_runs_lowg/test_summary.py T_3_J40m_se4_fb3_c53 T_3_J40m_se4_fb3
+. .venv/bin/activate && python reports/training/s52_runs_lowg/test_summary.py T_3_J40m_se4_fb3_c53 T_3_J40m_se4_fb3
