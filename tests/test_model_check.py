@@ -174,7 +174,8 @@ def test_speed_summary_counts_walks_that_jump() -> None:
     out = speed_summary(joints, batches, {"walk": ["a person walks"]}, {"walk": [1.0, 1.2, 1.4]},
                         {"walk": [False, False, False, True]})
     walking = out["types"]["walk"]["jumping"]
-    assert (walking["jumps"], walking["n"], walking["corpus_train_fraction"], walking["corpus_train_n"]) == (1, 3, 0.25, 4)
+    assert (walking["jumps"], walking["n"]) == (1, 3)
+    assert (walking["corpus_train_fraction"], walking["corpus_train_n"]) == (0.25, 4)
     assert walking["wilson95"][0] < 1 / 3 < walking["wilson95"][1]
     bare = speed_summary(joints, batches, {"walk": ["a person walks"]}, {"walk": [1.0]})  # no corpus rates given
     assert bare["types"]["walk"]["jumping"]["corpus_train_fraction"] is None

@@ -1,8 +1,9 @@
 """Extrapolate a fine-tune in weight space (task arithmetic): backbone θ = θ_model + λ·(θ_model − θ_parent).
 
 ``model`` must be ``parent`` fine-tuned (same architecture and feature Mean/Std); λ 0 copies ``model``, λ > 0 goes
-further in the direction the fine-tune moved the weights (session 53: the backbone fine-tuned with jump clips drawn
-8× as often, extrapolated, jumps more), λ in [−1, 0) goes back towards ``parent``. Only the backbone changes: a
+further in the direction the fine-tune moved the weights (session 53: session 41's jump-weighted fine-tune at λ 1
+doubled its gain in Earth jumps on val, `reports/training/s53_extrapolate/`), λ in [−1, 0) goes back towards
+``parent``. Only the backbone changes: a
 SimDiff model's Sim Encoder and Motion Adapters, its normaliser, config and ``sampling.json`` are ``model``'s.
 The output folder records the recipe in ``extrapolation.json`` and both models' training data in ``provenance.json``.
 """
@@ -59,8 +60,8 @@ def extrapolate_backbone(model: str | os.PathLike[str], parent: str | os.PathLik
     theirs = dataclasses.replace(parent_config.backbone, mask_frames=False)
     if mine != theirs:
         field = next(f.name for f in dataclasses.fields(mine) if getattr(mine, f.name) != getattr(theirs, f.name))
-        raise SimdiffError(f"{par}: backbone {field} is {getattr(theirs, field)}, the model's is {getattr(mine, field)}; "
-                           "extrapolation needs the same architecture")
+        raise SimdiffError(f"{par}: backbone {field} is {getattr(theirs, field)}, the model's is "
+                           f"{getattr(mine, field)}; extrapolation needs the same architecture")
     for key in ("normalizer.mean", "normalizer.std"):
         a, b = extra.get(key), parent_extra.get(key)
         if a is None or b is None or not torch.equal(a, b):

@@ -156,9 +156,8 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
 
     folder = check_model_dir(args.model)
     stored = sampling_defaults(args.model)
-    from simdiff.model.provenance import read_provenance
-
     from simdiff.model.extrapolate import read_recipe
+    from simdiff.model.provenance import read_provenance
 
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
     read_recipe(folder)  # likewise extrapolation.json

@@ -86,8 +86,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     x = group.add_parser("extrapolate", help="move a fine-tuned backbone further along its fine-tune (task arithmetic)",
                          description="Write MODEL with its backbone weights at model + LAMBDA x (model - parent): "
                                      "LAMBDA 0 copies MODEL, LAMBDA > 0 goes further in the direction the fine-tune "
-                                     "from PARENT moved them. Adapters, Mean/Std, config and sampling.json are MODEL's; "
-                                     "extrapolation.json records the recipe.")
+                                     "from PARENT moved them. Adapters, Mean/Std, config and sampling.json are "
+                                     "MODEL's; extrapolation.json records the recipe.")
     x.add_argument("--model", type=Path, required=True, help="the fine-tuned model folder (SimDiff or backbone-only)")
     x.add_argument("--parent", type=Path, required=True, help="the model folder it was fine-tuned from")
     x.add_argument("--lam", type=float, required=True, metavar="LAMBDA", help="extrapolation factor (e.g. 2)")

@@ -112,7 +112,8 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
              "|---|---|---|---|---|---|---|"]
     for kind, t in s["types"].items():
         lines.append(f"| {kind} | {'; '.join(t['prompts'])} | {_q(t['samples'])} | {_q(t['corpus_train'])} | "
-                     f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} | {_jumping(t.get('jumping'))} |")
+                     f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} | "
+                     f"{_jumping(t.get('jumping'))} |")
     return lines
 
 
@@ -174,14 +175,16 @@ def _glides(g: dict[str, Any]) -> str:
     t = g.get("glides")
     if not t:
         return ""
-    return (f" Samples that glide ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, {t['earth']} at Earth."
-            + _fell_back(g))
+    return (f" Samples that glide ({t['rule']}): {t['low_g']} of {g['n']} at {_f(g['env'][0], 2)}, "
+            f"{t['earth']} at Earth." + _fell_back(g))
 
 
 def _fell_back(r: dict[str, Any]) -> str:
-    """How many samples off Earth were re-sampled at the fallback s_e (reports before session 53 or without one: none)."""
+    """How many samples off Earth were re-sampled at the fallback s_e (none before session 53 or without one)."""
     f = r.get("fell_back")
-    return "" if not f else f" Re-sampled at the fallback s_e {_f(f['s_e'], 2)} (floating or gliding): {f['samples']} of {f['of']}."
+    if not f:
+        return ""
+    return f" Re-sampled at the fallback s_e {_f(f['s_e'], 2)} (floating or gliding): {f['samples']} of {f['of']}."
 
 
 def _airborne_lines(g: dict[str, Any], what: str) -> list[str]:

@@ -250,7 +250,8 @@ class ModelCheck:
 
         def measure() -> dict[str, Any]:
             try:
-                clips = corpus_clips(c.corpus, list(SPEED_PROMPTS), c.prompts.corpus_clips, c.seeds[0], c.prompts.length)
+                clips = corpus_clips(c.corpus, list(SPEED_PROMPTS), c.prompts.corpus_clips, c.seeds[0],
+                                     c.prompts.length)
             except SimdiffError as exc:
                 return {"skipped": str(exc)}
             batches = self.speed_batches()
@@ -277,9 +278,11 @@ class ModelCheck:
                      if c.env_guidance_fallback is not None else {})}
         jumps = self.jump_batches()
         moon = (MOON_G, 0.0, 0.0)
-        grav = self.part("gravity", {**inputs, **RATIO_CI, "g": MOON_G, "jump_prompts": JUMP_PROMPTS}, lambda: {**gravity_response(
-            units(jumps), self.samples("jumps", jumps, EARTH), self.samples("jumps", jumps, moon), MOON_G,
-            self.projector, resamples=c.response.resamples, seed=c.seeds[0]), **self.fell_back("jumps", [moon])})
+        grav = self.part("gravity", {**inputs, **RATIO_CI, "g": MOON_G, "jump_prompts": JUMP_PROMPTS},
+                         lambda: {**gravity_response(units(jumps), self.samples("jumps", jumps, EARTH),
+                                                     self.samples("jumps", jumps, moon), MOON_G, self.projector,
+                                                     resamples=c.response.resamples, seed=c.seeds[0]),
+                                  **self.fell_back("jumps", [moon])})
         runs = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["run"]]  # session 50's floating runs
         grav_runs = self.part("gravity_runs", {**inputs, **RATIO_CI, "g": MOON_G, "run_prompts": SPEED_PROMPTS["run"]},
                               lambda: {**gravity_response(units(runs), self.samples("runs", runs, EARTH),
@@ -288,9 +291,11 @@ class ModelCheck:
                                                           seed=c.seeds[0]), **self.fell_back("runs", [moon])})
         walk = [b for b in self.speed_batches() if b.prompt in SPEED_PROMPTS["walk"]]
         winds = [(EARTH[0], WIND_N, 0.0), (EARTH[0], -WIND_N, 0.0), (EARTH[0], 0.0, WIND_N), (EARTH[0], 0.0, -WIND_N)]
-        wind = self.part("wind", {**inputs, "wind": winds, "walk_prompts": SPEED_PROMPTS["walk"]}, lambda: {**wind_response(
-            units(walk), self.samples("walks", walk, EARTH), {w: self.samples("walks", walk, w) for w in winds},
-            self.projector, resamples=c.response.resamples, seed=c.seeds[0]), **self.fell_back("walks", winds)})
+        wind = self.part("wind", {**inputs, "wind": winds, "walk_prompts": SPEED_PROMPTS["walk"]},
+                         lambda: {**wind_response(units(walk), self.samples("walks", walk, EARTH),
+                                                  {w: self.samples("walks", walk, w) for w in winds}, self.projector,
+                                                  resamples=c.response.resamples, seed=c.seeds[0]),
+                                  **self.fell_back("walks", winds)})
         return {"gravity": grav, "gravity_runs": grav_runs, "wind": wind, "simulator": "the projector's flight clock (flights follow gravity)"
                 if self._injected is None else "injected projector (tests)"}
 
