@@ -33,14 +33,6 @@ def _backbone(network: nn.Module) -> nn.Module:
     return network.backbone if isinstance(network, SimDiffNet) else network
 
 
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 def extrapolate_backbone(model: str | os.PathLike[str], parent: str | os.PathLike[str], lam: float,
                          out: str | os.PathLike[str]) -> Path:
     """Write ``out``: ``model`` with its backbone weights moved to θ_model + lam·(θ_model − θ_parent).
@@ -77,10 +69,12 @@ def extrapolate_backbone(model: str | os.PathLike[str], parent: str | os.PathLik
         if (src / name).is_file():
             write_bytes(dst / name, (src / name).read_bytes())
     _write_provenance(src, par, dst)
+    digest = {name: hashlib.sha256((folder / WEIGHTS_NAME).read_bytes()).hexdigest()
+              for name, folder in (("model", src), ("parent", par))}
     write_json(dst / RECIPE_NAME, {
         "rule": "backbone = model + lambda * (model - parent); everything else the model's",
-        "lambda": lam, "model": str(src), "model_sha256": _sha256(src / WEIGHTS_NAME),
-        "parent": str(par), "parent_sha256": _sha256(par / WEIGHTS_NAME)})
+        "lambda": lam, "model": str(src), "model_sha256": digest["model"],
+        "parent": str(par), "parent_sha256": digest["parent"]})
     return dst
 
 

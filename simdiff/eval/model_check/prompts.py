@@ -63,11 +63,6 @@ def _row(prompt: str, stats: list[dict[str, Any]]) -> dict[str, Any]:
             "median_rise_m": float(np.median([s["rise_m"] for s in stats])) if stats else float("nan")}
 
 
-def corpus_speeds(corpus: str | Path, types: Sequence[str], limit: int = 0, seed: int = 0) -> dict[str, list[float]]:
-    """Mean horizontal root speeds (m/s) of the corpus's train clips per ``motion_type`` (originals only)."""
-    return {kind: [s for s, _ in rows] for kind, rows in corpus_clips(corpus, types, limit, seed).items()}
-
-
 def corpus_clips(corpus: str | Path, types: Sequence[str], limit: int = 0, seed: int = 0,
                  frames: int = 0) -> dict[str, list[tuple[float, bool]]]:
     """(mean horizontal root speed m/s, jumps by :func:`jump_stats`) of the corpus's train clips per ``motion_type``

@@ -39,26 +39,16 @@ def units(batches: Sequence[PromptBatch]) -> list[str]:
     return [f"{b.prompt}#{b.seed}#{k}" for b in batches for k in range(b.count)]
 
 
-def generate_set(generator: Any, batches: Sequence[PromptBatch], length: int, *, env: Sequence[float] | None,
-                 alpha: float, steps: int, guidance: float, progress: bool = False,
-                 foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
-                 env_guidance_fallback: float | None = None) -> np.ndarray:
-    """Generate every batch; returns joints (N, length, 22, 3) float32, metres, Y-up, 20 fps.
-
-    ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone (``env_guidance`` then
-    and ``anchor`` must stay at their defaults).
-    """
-    return generate_set_flags(generator, batches, length, env=env, alpha=alpha, steps=steps, guidance=guidance,
-                              progress=progress, foot_lock=foot_lock, env_guidance=env_guidance, anchor=anchor,
-                              env_guidance_fallback=env_guidance_fallback)[0]
-
-
 def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: int, *, env: Sequence[float] | None,
                        alpha: float, steps: int, guidance: float, progress: bool = False, foot_lock: float = 0.0,
                        env_guidance: float = 1.0, anchor: str = "adapters",
                        env_guidance_fallback: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`generate_set`'s joints and (N,) bool: the samples re-sampled at ``env_guidance_fallback`` (the
-    generator's ``Generation.fell_back``; all False without a fallback)."""
+    """Generate every batch; returns joints (N, length, 22, 3) float32 (metres, Y-up, 20 fps) and (N,) bool: the
+    samples re-sampled at ``env_guidance_fallback`` (the generator's ``Generation.fell_back``; all False without one).
+
+    ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone (``env_guidance`` then
+    and ``anchor`` must stay at their defaults).
+    """
     from tqdm import tqdm
 
     from simdiff.motion.features import features_to_joints
