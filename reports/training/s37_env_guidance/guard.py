@@ -14,7 +14,8 @@ E = os.environ.get("SIMDIFF_SCRATCH", "/work/scratch/s29")  # session 39: the co
 model = sys.argv[4] if len(sys.argv) > 4 else "simdiff/assets/default_model"  # session 38: another model folder
 c = CheckConfig(model=model, corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=out, seeds=[0],
                 steps=int(os.environ.get("STEPS", "20")), guidance=float(os.environ.get("W", "2.5")),  # session 46
-                alpha=0.5, foot_lock=1.0, env_guidance=se, anchor=os.environ.get("ANCHOR", "adapters"),  # session 47
+                alpha=float(os.environ.get("ALPHA", "0.5")), foot_lock=1.0, env_guidance=se,  # ALPHA: session 54
+                anchor=os.environ.get("ANCHOR", "adapters"),  # session 47
                 split=SplitOptions(split="val", n=128), prompts=PromptOptions(jump_samples=16, speed_samples=8),
                 response=ResponseOptions(enabled=False))
 rep = ModelCheck(c.validate(), progress=False, command=sys.argv).run()
