@@ -55,6 +55,8 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
                    help="s_e for the prompt samples that float or glide at --env-guidance (re-sampled; default off)")
     p.add_argument("--anchor", default="adapters", choices=ANCHORS,
                    help="what the text guidance runs on (backbone: the adapters add only their answer to φ vs Earth)")
+    p.add_argument("--anchor-alpha", type=float, default=0.0, metavar="A",
+                   help="with --anchor backbone: the adapter strength of its text guidance (0: the backbone alone)")
     p.add_argument("--workers", type=int, default=0, help="simulator processes (0: all cores)")
     p.add_argument("--no-response", action="store_true", help="skip the physics-response section")
     p.add_argument("--speed", action="store_true", help="also run benchmarks/bench_generate.py (3 runs)")
@@ -96,7 +98,7 @@ def main(argv: list[str] | None = None) -> int:
         config = CheckConfig(model=args.model, corpus=args.corpus, evaluator=args.evaluator, out=out, seeds=args.seeds,
                              steps=args.steps, guidance=args.guidance, alpha=args.alpha,
                              foot_lock=args.foot_lock, env_guidance=args.env_guidance, anchor=args.anchor,
-                             env_guidance_fallback=args.env_guidance_fallback,
+                             env_guidance_fallback=args.env_guidance_fallback, anchor_alpha=args.anchor_alpha,
                              more_evaluators=list(args.also_evaluator), device=args.device,
                              split=SplitOptions(split=args.split, n=args.n),
                              prompts=PromptOptions(jump_samples=args.jump_samples, speed_samples=args.speed_samples,

@@ -125,6 +125,30 @@ def test_formula_and_reference_rows_are_the_backbone(batched: bool, scale: float
         assert (out[0] - backbone[0]).abs().max() > 1e-3 and (out[2] - backbone[2]).abs().max() > 1e-3
 
 
+@pytest.mark.parametrize("a", [0.25, 0.5])
+def test_anchor_alpha_runs_the_text_guidance_at_a_and_the_push_at_alpha(a: float) -> None:
+    sd, c = simdiff_net(), cond()  # α 0.5 in the condition
+    x, t = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(2)), torch.tensor([900, 500, 20])
+    earth = torch.tensor([REFERENCE_ENV] * 3)
+    with torch.no_grad():
+        out = GuidedDenoiser(sd, 2.5, env_scale=4.0, anchor="backbone", anchor_alpha=a)(x, t, c)
+        text = GuidedDenoiser(sd, 2.5)(x, t, with_env(c, ENVS, alpha=a))  # the adapters anchor at α = a
+        push = sd(x, t, c) - sd(x, t, with_env(c, earth))  # at the condition's α
+        plain = GuidedDenoiser(sd, 2.5)(x, t, c)
+    assert torch.allclose(out, text + 4.0 * push, atol=1e-4)
+    assert torch.equal(out[1], text[1])  # φ = φ_ref: exactly the adapters anchor at α = a
+    if a == 0.5:  # a equal to α: at Earth the plain adapters anchor, bit for bit
+        assert torch.equal(out[1], plain[1])
+
+
+def test_anchor_alpha_is_checked_in_one_line() -> None:
+    for bad in (-0.1, float("nan"), float("inf")):
+        with pytest.raises(SimdiffError, match="anchor alpha must be a finite number ≥ 0"):
+            GuidedDenoiser(simdiff_net(), 2.5, anchor="backbone", anchor_alpha=bad)
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone anchor"):
+        GuidedDenoiser(simdiff_net(), 2.5, anchor="adapters", anchor_alpha=0.25)
+
+
 def test_the_default_anchor_is_unchanged() -> None:
     sd, c = simdiff_net(), cond()
     x, t = torch.randn(3, 8, 263), torch.tensor([300, 300, 300])

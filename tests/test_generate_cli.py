@@ -278,6 +278,34 @@ def test_generate_backbone_anchor_from_the_option_or_sampling_json(tmp_path: Pat
     assert "anchor must be adapters or backbone, got 'sim'" in err and err.count("\n") == 1
 
 
+def test_generate_anchor_alpha_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
+    from simdiff.serve.testing import write_tiny_model
+
+    model = write_tiny_model(tmp_path / "reacting")
+    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
+            "--format", "npy", "--no-video", "-q", "--alpha", "0.5"]
+
+    def run(name: str, *extra: str) -> np.ndarray:
+        assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
+        return np.load(tmp_path / name / "sample0_features.npy")
+
+    given = run("given", "--anchor", "backbone", "--anchor-alpha", "0.25")
+    assert np.array_equal(given, run("quarter", "--alpha", "0.25"))  # Earth without wind: α 0.25's motion
+    assert not np.allclose(given, run("backbone", "--anchor", "backbone"), atol=1e-4)
+    assert json.loads((tmp_path / "given" / "generation.json").read_text())["anchor_alpha"] == 0.25
+    (model / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": 0.25}')
+    assert np.array_equal(run("stored"), given)
+    assert np.array_equal(run("adapters", "--anchor", "adapters"), run("plain0", "--anchor", "adapters",
+                                                                       "--anchor-alpha", "0"))  # stored value dropped
+    assert main([*argv, "--anchor", "adapters", "--anchor-alpha", "0.25", "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "--anchor-alpha 0.25 needs the backbone anchor" in err and err.count("\n") == 1
+    (model / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": -1}')
+    assert main([*argv, "--out", str(tmp_path / "bad2")]) == 2
+    err = capsys.readouterr().err
+    assert "anchor_alpha must be ≥ 0, got -1" in err and err.count("\n") == 1
+
+
 def test_generate_env_guidance_on_a_backbone_is_one_line(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "backbone", sim=False)
     code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--model", str(model), "--threads", "1",

@@ -392,6 +392,14 @@ def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: P
     assert not any(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))  # Earth motions change too
     assert report["settings"]["anchor"] == "backbone"
     assert "guidance anchor backbone" in (tmp_path / "out" / "check.md").read_text()
+    config.anchor_alpha = 0.25  # another Earth motion again: nothing of the α-0 anchor's run is reused
+    report = ModelCheck(config.validate(), text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert not any(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))
+    assert report["settings"]["anchor_alpha"] == 0.25
+    assert "guidance anchor backbone at α 0.25" in (tmp_path / "out" / "check.md").read_text()
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone anchor"):
+        CheckConfig(**{**config.__dict__, "anchor": "adapters"}).validate()
 
 
 def test_a_config_change_measures_every_section_again(checked: dict, tmp_path: Path) -> None:

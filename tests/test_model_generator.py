@@ -74,6 +74,21 @@ def test_backbone_anchor_gives_the_backbone_at_earth_and_is_validated() -> None:
         backbone.generate(["walk"], 12, steps=2, anchor="backbone")
 
 
+def test_anchor_alpha_gives_alpha_a_at_earth_and_is_validated() -> None:
+    gen = reacting_generator()
+    envs = [[-9.81, 0.0, 0.0], [-1.6, 0.0, 0.0]]
+    anchored = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1, env_guidance=2.0,
+                            anchor="backbone", anchor_alpha=0.25).features
+    quarter = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.25, steps=3, seed=1).features
+    backbone = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1, env_guidance=2.0,
+                            anchor="backbone").features
+    assert torch.equal(anchored[0], quarter[0]) and not torch.allclose(anchored[0], backbone[0], atol=1e-4)
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone anchor"):
+        gen.generate(["walk"], 12, env=envs[1], steps=2, anchor_alpha=0.25)
+    with pytest.raises(SimdiffError, match="anchor alpha must be a finite number"):
+        gen.generate(["walk"], 12, env=envs[1], steps=2, anchor="backbone", anchor_alpha=-1.0)
+
+
 def test_load_pretrained_missing_folder(tmp_path) -> None:
     with pytest.raises(SimdiffError, match="config.json"):
         load_pretrained(tmp_path / "nope")

@@ -369,6 +369,21 @@ def test_generate_env_guidance_from_sampling_json_or_the_request(server, model_d
     assert status == 400 and "env_guidance_fallback" in out["error"]
 
 
+def test_generate_anchor_alpha_from_sampling_json_or_the_request(server, model_dir):
+    earth = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5}
+    status, given, _ = call(server, "/api/generate", {**earth, "anchor": "backbone", "anchor_alpha": 0.25})
+    assert status == 200 and given["meta"]["params"]["anchor_alpha"] == 0.25
+    assert given["joints"] == call(server, "/api/generate", {**earth, "alpha": 0.25})[1]["joints"]
+    (model_dir / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": 0.25}')
+    try:
+        status, stored, _ = call(server, "/api/generate", earth)
+        assert status == 200 and stored["joints"] == given["joints"]
+    finally:
+        (model_dir / "sampling.json").unlink()
+    status, out, _ = call(server, "/api/generate", {**earth, "anchor_alpha": -1})
+    assert status == 400 and "anchor_alpha must be in" in out["error"]
+
+
 def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):
     earth = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5}
     status, plain, _ = call(server, "/api/generate", earth)

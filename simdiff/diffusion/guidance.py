@@ -8,6 +8,9 @@
   ``"backbone"`` guides the text with the backbone alone (α 0) and adds the adapters' answer to φ against the
   reference: x̃₀ = x₀⁰(∅) + s·(x₀⁰(c) − x₀⁰(∅)) + s_e·(x₀(c, φ) − x₀(c, φ_ref)). At the reference φ it is exactly
   the backbone; elsewhere only the change of φ, not the adapters' answer to Earth itself, moves the motion.
+  ``anchor_alpha`` a > 0 runs that text guidance with the adapters at strength a instead (x₀⁰ → x₀ᵃ, the environment
+  term still at the condition's α): at the reference φ it is exactly the adapters anchor at α = a (session 54: the
+  adapters' answer to Earth costs FID and jumps, their answer to φ is what the environment needs).
 """
 
 from __future__ import annotations
@@ -33,6 +36,17 @@ ANCHORS: tuple[str, ...] = ("adapters", "backbone")
 """What the text guidance runs on: the network with its adapters at α, or the backbone alone (see the module)."""
 
 
+def check_anchor_alpha(value: float, anchor: str) -> float:
+    """``value`` as a float when it is a finite number ≥ 0 that ``anchor`` can use (any anchor takes 0), else one
+    :class:`SimdiffError` line naming it."""
+    value = float(value)
+    if not (0.0 <= value < float("inf")):
+        raise SimdiffError(f"anchor alpha must be a finite number ≥ 0, got {value}")
+    if value and anchor != "backbone":
+        raise SimdiffError(f"anchor alpha {value} needs the backbone anchor (--anchor backbone), not {anchor!r}")
+    return value
+
+
 class GuidedDenoiser:
     """Wrap a denoiser with classifier-free guidance.
 
@@ -47,10 +61,13 @@ class GuidedDenoiser:
         reference_env: φ_ref = (g_z m/s², w_x N, w_y N).
         anchor: ``"adapters"`` or ``"backbone"`` (see the module); ``"backbone"`` needs ``cond.env`` and costs one
             2K forward over the K rows whose φ is not ``reference_env`` (φ and φ_ref with the adapters at α).
+        anchor_alpha: adapter strength of the backbone anchor's text guidance (0: the backbone alone); only with
+            ``anchor="backbone"``.
     """
 
     def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True, env_scale: float = 1.0,
-                 reference_env: Sequence[float] = REFERENCE_ENV, anchor: str = "adapters") -> None:
+                 reference_env: Sequence[float] = REFERENCE_ENV, anchor: str = "adapters",
+                 anchor_alpha: float = 0.0) -> None:
         self.denoiser = denoiser
         self.scale = float(scale)
         self.batched = batched
@@ -61,11 +78,12 @@ class GuidedDenoiser:
         if anchor not in ANCHORS:
             raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose {' or '.join(ANCHORS)}")
         self.anchor = anchor
+        self.anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
 
     def __call__(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
         """x: (B, T, F), timesteps: (B,) → guided x̂₀ (B, T, F)."""
         rows, ref = self._plan(cond)
-        text_cond = cond if self.anchor == "adapters" else replace(cond, alpha=0.0)
+        text_cond = cond if self.anchor == "adapters" else replace(cond, alpha=self.anchor_alpha)
         if self.scale == 1.0:
             cond_out = guided = self.denoiser(x, timesteps, text_cond)
         else:

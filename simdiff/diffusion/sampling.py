@@ -51,6 +51,7 @@ def sample(
     progress: Callable[[Iterable[Tensor]], Iterable[Tensor]] | None = None,
     env_guidance: float = 1.0,
     anchor: str = "adapters",
+    anchor_alpha: float = 0.0,
 ) -> Tensor:
     """Run the reverse process from pure noise; returns x₀ (B, num_frames, nfeats) normalised features.
 
@@ -65,13 +66,15 @@ def sample(
         progress: optional iterable wrapper (e.g. ``tqdm``).
         env_guidance: environment guidance s_e (1 = off; :class:`GuidedDenoiser`), continuous φ only.
         anchor: what the text guidance runs on, ``"adapters"`` or ``"backbone"`` (:class:`GuidedDenoiser`).
+        anchor_alpha: adapter strength of the backbone anchor's text guidance (0: the backbone alone).
     """
     device = cond.text.device
     b = cond.batch_size
     x = x_init.to(device) if x_init is not None else torch.randn(
         (b, num_frames, nfeats), generator=generator, device=generator.device if generator else device
     ).to(device)
-    model = GuidedDenoiser(denoiser, guidance, batched_cfg, env_scale=env_guidance, anchor=anchor)
+    model = GuidedDenoiser(denoiser, guidance, batched_cfg, env_scale=env_guidance, anchor=anchor,
+                           anchor_alpha=anchor_alpha)
     hooked = None if hook_timesteps is None else {int(t) for t in hook_timesteps}
     steps: Iterable[Tensor] = scheduler.timesteps
     if progress is not None:

@@ -13,7 +13,7 @@ from typing import Callable, Iterable, Sequence
 import torch
 from torch import Tensor, nn
 
-from simdiff.diffusion.guidance import ANCHORS
+from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha
 from simdiff.diffusion.sampling import X0Hook, make_scheduler, sample
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
@@ -113,6 +113,7 @@ class MotionGenerator:
         env_guidance: float = 1.0,
         anchor: str = "adapters",
         env_guidance_fallback: float | None = None,
+        anchor_alpha: float = 0.0,
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -139,6 +140,8 @@ class MotionGenerator:
             anchor: ``"adapters"`` (default) or ``"backbone"``: the text guidance runs on the backbone alone and only
                 the adapters' answer to φ against Earth without wind (times s_e) is added, so motions under Earth
                 without wind are the backbone's (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only.
+            anchor_alpha: with ``anchor="backbone"``, the adapter strength its text guidance runs at (0: the backbone
+                alone; e.g. 0.25: motions under Earth without wind are those of α 0.25, the answer to φ is α's).
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -168,6 +171,7 @@ class MotionGenerator:
         if anchor != "adapters" and not continuous:
             raise SimdiffError(f"anchor {anchor!r} needs a SimDiff model with a continuous Sim Encoder; "
                                "this model has none (leave it at 'adapters')")
+        anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
         # options checked first: a bad one fails before the text encoder runs
         text = text_embeddings.float().to(self.device) if text_embeddings is not None else self.encode_text(texts)
         frames = int(lens.max())
@@ -178,7 +182,7 @@ class MotionGenerator:
             return sample(self.network, make_scheduler(sampler, steps, eta), cond, frames,
                           nfeats=self.config.backbone.nfeats, guidance=guidance, batched_cfg=batched_cfg,
                           generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps, progress=progress,
-                          env_guidance=push, anchor=anchor)
+                          env_guidance=push, anchor=anchor, anchor_alpha=anchor_alpha)
 
         x = run(env_guidance)
         fell_back = None

@@ -49,6 +49,8 @@ class GenerationRequest:
         env_guidance_fallback: s_e ≥ 0 for samples that come out floating or gliding at ``env_guidance``
             (re-sampled with the same seed; None: off; :meth:`simdiff.model.generator.MotionGenerator.generate`).
         anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:data:`ANCHORS`).
+        anchor_alpha: with the ``backbone`` anchor, the adapter strength its text guidance runs at (0: the backbone
+            alone; :mod:`simdiff.diffusion.guidance`).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
     """
@@ -67,6 +69,7 @@ class GenerationRequest:
     env_guidance: float = 1.0
     env_guidance_fallback: float | None = None
     anchor: str = "adapters"
+    anchor_alpha: float = 0.0
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
 
@@ -217,6 +220,14 @@ def check_anchor(name: str, value: object) -> str:
     return str(value)
 
 
+def check_anchor_alpha(name: str, value: object, anchor: str) -> float:
+    """``value`` as a finite float ≥ 0, and 0 unless ``anchor`` is ``backbone`` (one-line errors naming ``name``)."""
+    number = check_finite(name, value, 0.0)
+    if number and anchor != "backbone":
+        raise SimdiffError(f"{name} {number:g} needs the backbone anchor (--anchor backbone), not {anchor!r}")
+    return number
+
+
 def with_model_defaults(request: GenerationRequest, stored: dict[str, float | int | str],
                         given: set[str]) -> GenerationRequest:
     """Apply a model's stored sampling settings (``sampling.json``) to the options the user did not give.
@@ -224,9 +235,10 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     Args:
         stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance``,
             ``env_guidance_fallback``,
-            ``anchor`` (see :func:`simdiff.model.default.sampling_defaults`).
+            ``anchor``, ``anchor_alpha`` (see :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
-            ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``).
+            ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``, ``anchor_alpha``). A stored
+            ``anchor_alpha`` belongs to the stored anchor: it is dropped when the user picks another anchor.
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -236,11 +248,18 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     else:
         steps = steps_for(sampler, stored.get("steps"))  # type: ignore[arg-type]
     anchor = request.anchor if "anchor" in given else check_anchor("anchor", stored.get("anchor", request.anchor))
+    if "anchor_alpha" in given:
+        anchor_alpha = check_anchor_alpha("--anchor-alpha", request.anchor_alpha, anchor)
+    elif anchor == stored.get("anchor", "adapters"):
+        anchor_alpha = check_anchor_alpha("anchor_alpha", stored.get("anchor_alpha", 0.0), anchor)
+    else:
+        anchor_alpha = 0.0
     fallback = request.env_guidance_fallback
     if "env_guidance_fallback" not in given and stored.get("env_guidance_fallback") is not None:
         fallback = check_finite("env_guidance_fallback", stored["env_guidance_fallback"], 0.0)
     return replace(
-        request, sampler=sampler, steps=steps, anchor=anchor, env_guidance_fallback=fallback,
+        request, sampler=sampler, steps=steps, anchor=anchor, anchor_alpha=anchor_alpha,
+        env_guidance_fallback=fallback,
         **{name: getattr(request, name) if name in given else stored_setting(stored, name, getattr(request, name))
            for name in STORED_NUMBERS},
     )
@@ -267,7 +286,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                   length_s: float | None = None, frames: int | None = None, seed: int = 0, num_samples: int = 1,
                   sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
                   foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
-                  env_guidance_fallback: float | None = None,
+                  env_guidance_fallback: float | None = None, anchor_alpha: float = 0.0,
                   compare: str | None = None, formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
@@ -293,6 +312,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         env_guidance_fallback=(None if env_guidance_fallback is None
                                else check_finite("--env-guidance-fallback", env_guidance_fallback, 0.0)),
         anchor=check_anchor("--anchor", anchor),
+        anchor_alpha=check_finite("--anchor-alpha", anchor_alpha, 0.0),
         formats=parse_formats(formats, no_video),
         force=bool(force),
     )

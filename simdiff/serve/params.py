@@ -54,6 +54,8 @@ class GenerateParams:
             or None for the model's ``sampling.json`` value (``adapters`` without one).
         env_guidance_fallback: s_e for a sample that floats or glides at ``env_guidance`` (re-sampled), or None for
             the model's ``sampling.json`` value (off without one).
+        anchor_alpha: the backbone anchor's adapter strength (:mod:`simdiff.diffusion.guidance`), or None for the
+            model's ``sampling.json`` value when the anchor is the stored one (0 otherwise).
     """
 
     text: str
@@ -70,6 +72,7 @@ class GenerateParams:
     env_guidance: float | None = None
     anchor: str | None = None
     env_guidance_fallback: float | None = None
+    anchor_alpha: float | None = None
 
     @property
     def frames(self) -> int:
@@ -118,7 +121,7 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
-            simulate, foot_lock, env_guidance, anchor}``;
+            simulate, foot_lock, env_guidance, anchor, env_guidance_fallback, anchor_alpha}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -173,6 +176,10 @@ def parse_generate(body: Any) -> GenerateParams:
     if fallback is not None:
         fallback = _number(body, "env_guidance_fallback", 1.0)
         _check_range("env_guidance_fallback", fallback, *ENV_GUIDANCE_RANGE)
+    anchor_alpha = body.get("anchor_alpha")
+    if anchor_alpha is not None:
+        anchor_alpha = _number(body, "anchor_alpha", 0.0)
+        _check_range("anchor_alpha", anchor_alpha, 0.0, ALPHA_RANGE[1])
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
                           guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance,
-                          anchor=anchor, env_guidance_fallback=fallback, **wind)
+                          anchor=anchor, env_guidance_fallback=fallback, anchor_alpha=anchor_alpha, **wind)

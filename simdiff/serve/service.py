@@ -149,7 +149,7 @@ class MotionService:
         as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import check_anchor, stored_setting
+        from simdiff.product.request import check_anchor, check_anchor_alpha, stored_setting
 
         try:
             stored = sampling_defaults(self.model_dir)
@@ -160,6 +160,10 @@ class MotionService:
             fallback = params.env_guidance_fallback
             if fallback is None and stored.get("env_guidance_fallback") is not None:
                 fallback = stored_setting(stored, "env_guidance_fallback", 1.0)
+            given_alpha = params.anchor_alpha
+            if given_alpha is None:  # the stored value belongs to the stored anchor
+                given_alpha = stored.get("anchor_alpha", 0.0) if anchor == stored.get("anchor", "adapters") else 0.0
+            anchor_alpha = check_anchor_alpha("anchor_alpha", given_alpha, anchor)
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
@@ -167,8 +171,9 @@ class MotionService:
             push = 1.0 if params.env_guidance is None else params.env_guidance
             anchor = params.anchor or "adapters"
             fallback = params.env_guidance_fallback
+            anchor_alpha = params.anchor_alpha or 0.0
         return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor,
-                       env_guidance_fallback=fallback)
+                       env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha))
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -244,7 +249,8 @@ class MotionService:
                                      guidance=params.guidance, seed=params.seed, progress=self._progress,
                                      foot_lock=params.foot_lock,
                                      **({"env_guidance": params.env_guidance, "anchor": params.anchor,
-                                         "env_guidance_fallback": params.env_guidance_fallback} if uses_env else {}))
+                                         "env_guidance_fallback": params.env_guidance_fallback,
+                                         "anchor_alpha": params.anchor_alpha or 0.0} if uses_env else {}))
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count

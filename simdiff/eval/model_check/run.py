@@ -150,7 +150,8 @@ class ModelCheck:
         c = self.config
         lock = {"foot_lock": c.foot_lock, "foot_cleanup": CLEANUP_VERSION} if c.foot_lock else {}
         return {"schema": SCHEMA, "model": _stamp(c.model), "seeds": c.seeds, "steps": c.steps, "guidance": c.guidance,
-                "alpha": c.alpha, "device": c.device, **lock, **({"anchor": c.anchor} if c.anchor != "adapters" else {})}
+                "alpha": c.alpha, "device": c.device, **lock, **({"anchor": c.anchor} if c.anchor != "adapters" else {}),
+                **({"anchor_alpha": c.anchor_alpha} if c.anchor_alpha else {})}
 
     def part(self, name: str, inputs: dict[str, Any], measure: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         """The stored result of section ``name`` when its fingerprint matches, else measured and stored."""
@@ -182,7 +183,8 @@ class ModelCheck:
             self._sets[key] = generate_set_flags(self.generator, batches, c.prompts.length, env=key[1], alpha=c.alpha,
                                                  steps=c.steps, guidance=c.guidance, progress=self.progress,
                                                  foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor,
-                                                 env_guidance_fallback=c.env_guidance_fallback)
+                                                 env_guidance_fallback=c.env_guidance_fallback,
+                                                 anchor_alpha=c.anchor_alpha)
         return self._sets[key][0]
 
     def fell_back(self, name: str, phis: Sequence[Sequence[float]]) -> dict[str, Any]:
@@ -214,7 +216,7 @@ class ModelCheck:
             env = self.env(EARTH)
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
                               steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock,
-                              env_guidance=c.env_guidance, anchor=c.anchor)
+                              env_guidance=c.env_guidance, anchor=c.anchor, anchor_alpha=c.anchor_alpha)
             if c.more_evaluators:
                 fn = _memoised(fn)
             result = score(c.evaluator, dataset, fn)
