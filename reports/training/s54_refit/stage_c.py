@@ -1,5 +1,6 @@
 """Rule 38's stage-C verdict: python stage_c.py NAME [BASE] (eval11/C_<name>/<phi>/check.json under /work/scratch/s39;
-BASE default J40m_se4). At g -1.6 and at w_x +10 N: R@3 >= base's - 0.03 and FID <= 1.25 x base's (evaluator 1)."""
+BASE default J40m_se4). At g -1.6 and at w_x +10 N: R@3 >= base's - 0.03 and FID <= 1.25 x base's (evaluator 1).
+Exit status 0 on a pass, 1 on a failure."""
 import json
 import sys
 
@@ -21,3 +22,4 @@ if __name__ == "__main__":
               f"bar {1.25 * fb:.2f})")
         fails += [f"R@3 at {phi}"] * (r < rb - 0.03) + [f"FID at {phi}"] * (f > 1.25 * fb)
     print("PASS" if not fails else "FAIL: " + ", ".join(fails))
+    sys.exit(1 if fails else 0)  # session 54: run47.sh read the exit status, which was 0 on a failure before this line
