@@ -228,6 +228,14 @@ def check_anchor_alpha(name: str, value: object, anchor: str) -> float:
     return number
 
 
+def stored_anchor_alpha(stored: dict[str, float | int | str], anchor: str) -> float:
+    """A model's stored ``anchor_alpha`` when ``anchor`` is its stored anchor (the value belongs to that anchor), else
+    0; checked as the option is (one-line errors naming it)."""
+    if anchor != stored.get("anchor", "adapters"):
+        return 0.0
+    return check_anchor_alpha("anchor_alpha", stored.get("anchor_alpha", 0.0), anchor)
+
+
 def with_model_defaults(request: GenerationRequest, stored: dict[str, float | int | str],
                         given: set[str]) -> GenerationRequest:
     """Apply a model's stored sampling settings (``sampling.json``) to the options the user did not give.
@@ -248,12 +256,8 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     else:
         steps = steps_for(sampler, stored.get("steps"))  # type: ignore[arg-type]
     anchor = request.anchor if "anchor" in given else check_anchor("anchor", stored.get("anchor", request.anchor))
-    if "anchor_alpha" in given:
-        anchor_alpha = check_anchor_alpha("--anchor-alpha", request.anchor_alpha, anchor)
-    elif anchor == stored.get("anchor", "adapters"):
-        anchor_alpha = check_anchor_alpha("anchor_alpha", stored.get("anchor_alpha", 0.0), anchor)
-    else:
-        anchor_alpha = 0.0
+    anchor_alpha = (check_anchor_alpha("--anchor-alpha", request.anchor_alpha, anchor) if "anchor_alpha" in given
+                    else stored_anchor_alpha(stored, anchor))
     fallback = request.env_guidance_fallback
     if "env_guidance_fallback" not in given and stored.get("env_guidance_fallback") is not None:
         fallback = check_finite("env_guidance_fallback", stored["env_guidance_fallback"], 0.0)

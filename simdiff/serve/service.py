@@ -149,7 +149,7 @@ class MotionService:
         as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import check_anchor, check_anchor_alpha, stored_setting
+        from simdiff.product.request import check_anchor, check_anchor_alpha, stored_anchor_alpha, stored_setting
 
         try:
             stored = sampling_defaults(self.model_dir)
@@ -160,10 +160,8 @@ class MotionService:
             fallback = params.env_guidance_fallback
             if fallback is None and stored.get("env_guidance_fallback") is not None:
                 fallback = stored_setting(stored, "env_guidance_fallback", 1.0)
-            given_alpha = params.anchor_alpha
-            if given_alpha is None:  # the stored value belongs to the stored anchor
-                given_alpha = stored.get("anchor_alpha", 0.0) if anchor == stored.get("anchor", "adapters") else 0.0
-            anchor_alpha = check_anchor_alpha("anchor_alpha", given_alpha, anchor)
+            anchor_alpha = (stored_anchor_alpha(stored, anchor) if params.anchor_alpha is None
+                            else check_anchor_alpha("anchor_alpha", params.anchor_alpha, anchor))
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
