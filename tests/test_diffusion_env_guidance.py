@@ -145,8 +145,50 @@ def test_anchor_alpha_is_checked_in_one_line() -> None:
     for bad in (-0.1, float("nan"), float("inf")):
         with pytest.raises(SimdiffError, match="anchor alpha must be a finite number ≥ 0"):
             GuidedDenoiser(simdiff_net(), 2.5, anchor="backbone", anchor_alpha=bad)
-    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone anchor"):
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone or reference anchor"):
         GuidedDenoiser(simdiff_net(), 2.5, anchor="adapters", anchor_alpha=0.25)
+
+
+# --- the reference anchor ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("batched", [True, False])
+@pytest.mark.parametrize("a", [0.25, 0.0])
+def test_reference_anchor_is_the_text_guidance_at_earth_plus_the_adapters_anchors_answer(batched: bool, a: float) -> None:
+    sd, c = simdiff_net(), cond()  # α 0.5 in the condition
+    x, t = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(3)), torch.tensor([900, 500, 20])
+    with torch.no_grad():
+        out = GuidedDenoiser(sd, 2.5, batched, env_scale=4.0, anchor="reference", anchor_alpha=a)(x, t, c)
+        base = GuidedDenoiser(sd, 2.5, batched)(x, t, earth(with_env(c, ENVS, alpha=a)))  # adapters anchor, Earth, α a
+        at_phi = GuidedDenoiser(sd, 2.5, batched, env_scale=4.0)(x, t, c)  # the adapters anchor at φ and α
+        at_ref = GuidedDenoiser(sd, 2.5, batched)(x, t, earth(c))  # ... at φ_ref
+    assert torch.allclose(out, base + at_phi - at_ref, atol=1e-4)
+    assert torch.equal(out[1], base[1])  # φ = φ_ref: exactly the adapters anchor at α = a
+    assert (out[0] - base[0]).abs().max() > 1e-3 and (out[2] - base[2]).abs().max() > 1e-3
+
+
+def test_reference_anchor_at_alpha_is_the_adapters_anchor() -> None:
+    sd, c = simdiff_net(), cond()
+    x, t = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(4)), torch.tensor([700, 300, 50])
+    with torch.no_grad():
+        out = GuidedDenoiser(sd, 2.5, env_scale=3.0, anchor="reference", anchor_alpha=0.5)(x, t, c)
+        adapters = GuidedDenoiser(sd, 2.5, env_scale=3.0)(x, t, c)
+    assert torch.allclose(out, adapters, atol=1e-4)
+
+
+def test_reference_anchor_costs_one_2b_and_one_4k_forward() -> None:
+    sd, sizes = simdiff_net(), []
+
+    def counting(x: torch.Tensor, t: torch.Tensor, c: Condition) -> torch.Tensor:
+        sizes.append(x.shape[0])
+        return sd(x, t, c)
+
+    x, t = torch.randn(3, 8, 263), torch.tensor([300, 300, 300])
+    with torch.no_grad():
+        GuidedDenoiser(counting, 2.5, env_scale=4.0, anchor="reference", anchor_alpha=0.25)(x, t, cond())
+        GuidedDenoiser(counting, 2.5, env_scale=4.0, anchor="reference")(x, t, earth(cond()))
+    assert sizes == [6, 8, 6]  # two rows off φ_ref; then an all-Earth batch: the text guidance only
+    with pytest.raises(SimdiffError, match="reference anchor needs a SimDiff model"):
+        GuidedDenoiser(sd, 2.5, anchor="reference")(x, t, Condition(text=cond().text))
 
 
 def test_the_default_anchor_is_unchanged() -> None:

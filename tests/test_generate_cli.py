@@ -275,7 +275,7 @@ def test_generate_backbone_anchor_from_the_option_or_sampling_json(tmp_path: Pat
     (model / "sampling.json").write_text('{"anchor": "sim"}')
     assert main([*argv, "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
-    assert "anchor must be adapters or backbone, got 'sim'" in err and err.count("\n") == 1
+    assert "anchor must be one of adapters, backbone, reference, got 'sim'" in err and err.count("\n") == 1
 
 
 def test_generate_anchor_alpha_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
@@ -299,7 +299,10 @@ def test_generate_anchor_alpha_from_the_option_or_sampling_json(tmp_path: Path, 
                                                                        "--anchor-alpha", "0"))  # stored value dropped
     assert main([*argv, "--anchor", "adapters", "--anchor-alpha", "0.25", "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
-    assert "--anchor-alpha 0.25 needs the backbone anchor" in err and err.count("\n") == 1
+    assert "--anchor-alpha 0.25 needs the backbone or reference anchor" in err and err.count("\n") == 1
+    reference = run("reference", "--anchor", "reference", "--anchor-alpha", "0.25")
+    assert np.array_equal(reference, run("a25", "--alpha", "0.25"))  # Earth without wind: the adapters at 0.25
+    assert json.loads((tmp_path / "reference" / "generation.json").read_text())["anchor"] == "reference"
     (model / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": -1}')
     assert main([*argv, "--out", str(tmp_path / "bad2")]) == 2
     err = capsys.readouterr().err

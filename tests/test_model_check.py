@@ -343,7 +343,7 @@ def test_config_refuses_bad_values(checked: dict) -> None:
         CheckConfig(**{**config.__dict__, "seeds": [1, 1]}).validate()
     with pytest.raises(SimdiffError, match="corpus"):
         CheckConfig(**{**config.__dict__, "corpus": str(checked["root"])}).validate()
-    with pytest.raises(SimdiffError, match="--anchor must be adapters or backbone, got 'sim'"):
+    with pytest.raises(SimdiffError, match="--anchor must be one of adapters, backbone, reference, got 'sim'"):
         CheckConfig(**{**config.__dict__, "anchor": "sim"}).validate()
 
 
@@ -398,7 +398,7 @@ def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: P
     assert not any(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))
     assert report["settings"]["anchor_alpha"] == 0.25
     assert "guidance anchor backbone at α 0.25" in (tmp_path / "out" / "check.md").read_text()
-    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone anchor"):
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone or reference anchor"):
         CheckConfig(**{**config.__dict__, "anchor": "adapters"}).validate()
 
 

@@ -398,4 +398,4 @@ def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):
     finally:
         (model_dir / "sampling.json").unlink()
     status, out, _ = call(server, "/api/generate", {**earth, "anchor": "sim"})
-    assert status == 400 and "anchor must be adapters or backbone, got 'sim'" in out["error"]
+    assert status == 400 and "anchor must be one of adapters, backbone, reference, got 'sim'" in out["error"]

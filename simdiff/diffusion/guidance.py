@@ -11,6 +11,12 @@
   ``anchor_alpha`` a > 0 runs that text guidance with the adapters at strength a instead (x₀⁰ → x₀ᵃ, the environment
   term still at the condition's α): at the reference φ it is exactly the adapters anchor at α = a (session 54: the
   adapters' answer to Earth costs FID and jumps, their answer to φ is what the environment needs).
+  ``"reference"`` runs the text guidance at the reference φ with the adapters at ``anchor_alpha`` a and adds the
+  adapters anchor's own answer to φ (its guided output at φ minus at φ_ref, both at the condition's α):
+  x̃₀ = G_a(c, φ_ref) + G_α(c, φ) − G_α(c, φ_ref), G being the adapters anchor's x̃₀ above. At the reference φ it is
+  exactly the adapters anchor at α = a; elsewhere the change of φ moves the motion exactly as far as the adapters
+  anchor at α would, text guidance included (session 55: the backbone anchor's push, outside the text guidance,
+  cost text fidelity under low gravity). Costs one 2B forward plus one 4K forward over the K rows off φ_ref.
 """
 
 from __future__ import annotations
@@ -32,8 +38,12 @@ Denoiser = Callable[[Tensor, Tensor, "Condition"], Tensor]
 REFERENCE_ENV: tuple[float, float, float] = (-9.81, 0.0, 0.0)
 """φ_ref of environment guidance: Earth's gravity (m/s², along z) and no wind (N)."""
 
-ANCHORS: tuple[str, ...] = ("adapters", "backbone")
-"""What the text guidance runs on: the network with its adapters at α, or the backbone alone (see the module)."""
+ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference")
+"""What the text guidance runs on: the network with its adapters at α, the backbone alone, or the network at the
+reference φ (see the module)."""
+
+ALPHA_ANCHORS: tuple[str, ...] = ("backbone", "reference")
+"""The anchors that take an ``anchor_alpha``."""
 
 
 def check_anchor_alpha(value: float, anchor: str) -> float:
@@ -42,8 +52,9 @@ def check_anchor_alpha(value: float, anchor: str) -> float:
     value = float(value)
     if not (0.0 <= value < float("inf")):
         raise SimdiffError(f"anchor alpha must be a finite number ≥ 0, got {value}")
-    if value and anchor != "backbone":
-        raise SimdiffError(f"anchor alpha {value} needs the backbone anchor (--anchor backbone), not {anchor!r}")
+    if value and anchor not in ALPHA_ANCHORS:
+        raise SimdiffError(f"anchor alpha {value} needs the backbone or reference anchor (--anchor backbone or "
+                           f"reference), not {anchor!r}")
     return value
 
 
@@ -59,10 +70,11 @@ class GuidedDenoiser:
             Sim Encoder); costs one more conditional forward over the rows whose φ is not ``reference_env``
             (a separate one: the other rows are computed bit for bit as without it).
         reference_env: φ_ref = (g_z m/s², w_x N, w_y N).
-        anchor: ``"adapters"`` or ``"backbone"`` (see the module); ``"backbone"`` needs ``cond.env`` and costs one
-            2K forward over the K rows whose φ is not ``reference_env`` (φ and φ_ref with the adapters at α).
-        anchor_alpha: adapter strength of the backbone anchor's text guidance (0: the backbone alone); only with
-            ``anchor="backbone"``.
+        anchor: ``"adapters"``, ``"backbone"`` or ``"reference"`` (see the module); the last two need ``cond.env``.
+            ``"backbone"`` costs one 2K forward over the K rows whose φ is not ``reference_env`` (φ and φ_ref with
+            the adapters at α), ``"reference"`` one 4K forward over them (both with and without the text).
+        anchor_alpha: adapter strength a of the backbone or reference anchor's text guidance (0: the backbone
+            alone); only with ``anchor="backbone"`` or ``"reference"``.
     """
 
     def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True, env_scale: float = 1.0,
@@ -76,24 +88,17 @@ class GuidedDenoiser:
         if len(self.reference_env) != 3:
             raise SimdiffError(f"reference_env must be 3 numbers (g_z, w_x, w_y), got {len(self.reference_env)}")
         if anchor not in ANCHORS:
-            raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose {' or '.join(ANCHORS)}")
+            raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose one of {', '.join(ANCHORS)}")
         self.anchor = anchor
         self.anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
 
     def __call__(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
         """x: (B, T, F), timesteps: (B,) → guided x̂₀ (B, T, F)."""
         rows, ref = self._plan(cond)
+        if self.anchor == "reference":
+            return self._reference_anchor(x, timesteps, cond, rows, ref)
         text_cond = cond if self.anchor == "adapters" else replace(cond, alpha=self.anchor_alpha)
-        if self.scale == 1.0:
-            cond_out = guided = self.denoiser(x, timesteps, text_cond)
-        else:
-            if self.batched:
-                out = self.denoiser(torch.cat([x, x]), torch.cat([timesteps, timesteps]), text_cond.with_guidance_pair())
-                cond_out, uncond_out = out.chunk(2)
-            else:
-                cond_out = self.denoiser(x, timesteps, text_cond)
-                uncond_out = self.denoiser(x, timesteps, text_cond.unconditional())
-            guided = uncond_out + self.scale * (cond_out - uncond_out)
+        cond_out, guided = self._text_guided(x, timesteps, text_cond)
         if rows is None or ref is None:  # nothing off the reference φ
             return guided
         # passes of their own, so that the rows above are computed exactly as without environment guidance
@@ -107,13 +112,42 @@ class GuidedDenoiser:
         guided[rows] += self.env_scale * (phi_out - ref_out)
         return guided
 
+    def _text_guided(self, x: Tensor, timesteps: Tensor, cond: Condition) -> tuple[Tensor, Tensor]:
+        """(x₀(c) (B, T, F), its classifier-free guided x̃₀ (B, T, F)) under ``cond``'s φ and α."""
+        if self.scale == 1.0:
+            out = self.denoiser(x, timesteps, cond)
+            return out, out
+        if self.batched:
+            out = self.denoiser(torch.cat([x, x]), torch.cat([timesteps, timesteps]), cond.with_guidance_pair())
+            cond_out, uncond_out = out.chunk(2)
+        else:
+            cond_out = self.denoiser(x, timesteps, cond)
+            uncond_out = self.denoiser(x, timesteps, cond.unconditional())
+        return cond_out, uncond_out + self.scale * (cond_out - uncond_out)
+
+    def _reference_anchor(self, x: Tensor, timesteps: Tensor, cond: Condition, rows: Tensor | None,
+                          ref: Condition | None) -> Tensor:
+        """G_a(c, φ_ref) for every row, plus G_α(c, φ) − G_α(c, φ_ref) on the rows off φ_ref (see the module)."""
+        assert cond.env is not None  # _plan checked it
+        phi = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
+        _, guided = self._text_guided(x, timesteps, replace(cond, alpha=self.anchor_alpha,
+                                                            env=phi.expand_as(cond.env).clone()))
+        if rows is None or ref is None:
+            return guided
+        guided = guided.clone()
+        xr, tr = x[rows], timesteps[rows]
+        cond_out, text_out = self._text_guided(torch.cat([xr, xr]), torch.cat([tr, tr]), cond.select(rows).stacked(ref))
+        (c_phi, c_ref), (g_phi, g_ref) = cond_out.chunk(2), text_out.chunk(2)
+        guided[rows] += (g_phi - g_ref) + (self.env_scale - 1.0) * (c_phi - c_ref)
+        return guided
+
     def _plan(self, cond: Condition) -> tuple[Tensor | None, Condition | None]:
         """((K,) indices of the rows environment guidance changes, their condition with φ set to the reference), or
         (None, None) when it changes none (a few small tensor operations per step, next to a network pass)."""
         if self.env_scale == 1.0 and self.anchor == "adapters":
             return None, None
         if cond.env is None:
-            what = "environment guidance" if self.anchor == "adapters" else "the backbone anchor"
+            what = "environment guidance" if self.anchor == "adapters" else f"the {self.anchor} anchor"
             raise SimdiffError(f"{what} needs a SimDiff model with a continuous Sim Encoder (φ as numbers)")
         phi = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
         rows = torch.nonzero((cond.env != phi).any(dim=-1)).flatten()

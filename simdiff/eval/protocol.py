@@ -238,7 +238,7 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
     (``success``: tracked to the end; ``frames_replaced``), in generation order. ``foot_lock``: the
     generator's foot lock strength (0: off; not with ``physdiff``); ``env_guidance``: environment guidance s_e
     (1: off; SimDiff continuous models); ``anchor``: what the text guidance runs on (:mod:`simdiff.diffusion.guidance`);
-    ``anchor_alpha``: the backbone anchor's adapter strength (0: the backbone alone).
+    ``anchor_alpha``: the backbone or reference anchor's adapter strength (0: the backbone alone).
     """
     finish_log: list[dict[str, Any]] = []
 

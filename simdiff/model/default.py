@@ -79,7 +79,7 @@ def sampling_defaults(model: str | os.PathLike[str] | None = None) -> dict[str, 
     The file is a JSON object with any of ``alpha`` (adapter strength), ``guidance``, ``steps``,
     ``sampler``, ``foot_lock`` (:mod:`simdiff.motion.foot_lock`'s strength), ``env_guidance``
     (:mod:`simdiff.diffusion.guidance`'s s_e), ``env_guidance_fallback`` (the s_e for samples that float or glide),
-    ``anchor`` (its text-guidance anchor) and ``anchor_alpha`` (the backbone anchor's adapter strength), e.g.
+    ``anchor`` (its text-guidance anchor) and ``anchor_alpha`` (the backbone or reference anchor's adapter strength), e.g.
     ``{"alpha": 0.8}``;
     values the user gives on the command line win.
 

@@ -140,8 +140,11 @@ class MotionGenerator:
             anchor: ``"adapters"`` (default) or ``"backbone"``: the text guidance runs on the backbone alone and only
                 the adapters' answer to φ against Earth without wind (times s_e) is added, so motions under Earth
                 without wind are the backbone's (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only.
-            anchor_alpha: with ``anchor="backbone"``, the adapter strength its text guidance runs at (0: the backbone
-                alone; e.g. 0.25: motions under Earth without wind are those of α 0.25, the answer to φ is α's).
+                ``"reference"``: the text guidance runs under Earth without wind with the adapters at
+                ``anchor_alpha`` and the adapters anchor's own answer to φ (text guidance and s_e included) is added.
+            anchor_alpha: with ``anchor="backbone"`` or ``"reference"``, the adapter strength its text guidance runs
+                at (0: the backbone alone; e.g. 0.25: motions under Earth without wind are those of α 0.25, the
+                answer to φ is α's).
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -167,7 +170,7 @@ class MotionGenerator:
             if not continuous:
                 raise SimdiffError("env guidance fallback needs a SimDiff model with a continuous Sim Encoder")
         if anchor not in ANCHORS:
-            raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose {' or '.join(ANCHORS)}")
+            raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose one of {', '.join(ANCHORS)}")
         if anchor != "adapters" and not continuous:
             raise SimdiffError(f"anchor {anchor!r} needs a SimDiff model with a continuous Sim Encoder; "
                                "this model has none (leave it at 'adapters')")

@@ -48,8 +48,8 @@ class GenerationRequest:
         env_guidance: environment guidance s_e ≥ 0 (1: off; :mod:`simdiff.diffusion.guidance`).
         env_guidance_fallback: s_e ≥ 0 for samples that come out floating or gliding at ``env_guidance``
             (re-sampled with the same seed; None: off; :meth:`simdiff.model.generator.MotionGenerator.generate`).
-        anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:data:`ANCHORS`).
-        anchor_alpha: with the ``backbone`` anchor, the adapter strength its text guidance runs at (0: the backbone
+        anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:data:`ANCHORS`).
+        anchor_alpha: with the ``backbone`` or ``reference`` anchor, the adapter strength its text guidance runs at (0: the backbone
             alone; :mod:`simdiff.diffusion.guidance`).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
@@ -209,22 +209,24 @@ def check_finite(name: str, value: float, minimum: float | None = None) -> float
 STORED_NUMBERS: tuple[str, ...] = ("guidance", "alpha", "foot_lock", "env_guidance")
 """The numeric ``sampling.json`` settings."""
 
-ANCHORS: tuple[str, ...] = ("adapters", "backbone")
+ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference")
 """``--anchor`` values: :data:`simdiff.diffusion.guidance.ANCHORS` (repeated here, where torch is not imported)."""
 
 
 def check_anchor(name: str, value: object) -> str:
     """``value`` if it is one of :data:`ANCHORS`, else a one-line error naming ``name``."""
     if value not in ANCHORS:
-        raise SimdiffError(f"{name} must be {' or '.join(ANCHORS)}, got {value!r}")
+        raise SimdiffError(f"{name} must be one of {', '.join(ANCHORS)}, got {value!r}")
     return str(value)
 
 
 def check_anchor_alpha(name: str, value: object, anchor: str) -> float:
-    """``value`` as a finite float ≥ 0, and 0 unless ``anchor`` is ``backbone`` (one-line errors naming ``name``)."""
+    """``value`` as a finite float ≥ 0, and 0 unless ``anchor`` is ``backbone`` or ``reference`` (one-line errors
+    naming ``name``)."""
     number = check_finite(name, value, 0.0)
-    if number and anchor != "backbone":
-        raise SimdiffError(f"{name} {number:g} needs the backbone anchor (--anchor backbone), not {anchor!r}")
+    if number and anchor not in ("backbone", "reference"):
+        raise SimdiffError(f"{name} {number:g} needs the backbone or reference anchor (--anchor backbone or "
+                           f"reference), not {anchor!r}")
     return number
 
 

@@ -4,6 +4,7 @@
 #   env ALSO: a second evaluator folder that scores the same test-split motions (--also-evaluator; session 48)
 #   env PYWRAP: a script that runs benchmarks/model_check.py with a patch (session 51: s51_floor/floored.py)
 #   env FB: --env-guidance-fallback (session 52)
+#   env AA: --anchor-alpha (session 55)
 #   A: selection seeds 100 101, val n 32, response on   B: val n 128 seeds 0 1, no response
 #   T: test n 256 seeds 0-4, response on                 Tq: the same without the response
 cd /work/main; . .venv/bin/activate
@@ -16,5 +17,5 @@ case $1 in
   *) echo "check.sh: unknown stage '$1' (A, B, T or Tq)" >&2; exit 2;;
 esac
 /usr/bin/time -f "stage$1 $2 %e s" python ${PYWRAP} benchmarks/model_check.py --model $3 --corpus $S/corpus3 --evaluator $S/eval \
-  $args --jump-samples 16 --speed-samples 8 --steps ${STEPS:-20} --guidance ${W:-2.5} --alpha ${ALPHA:-0.5} --foot-lock 1 --env-guidance ${4:-2} --anchor ${ANCHOR:-adapters} ${FB:+--env-guidance-fallback $FB} ${ALSO:+--also-evaluator $ALSO} --threads 2 \
+  $args --jump-samples 16 --speed-samples 8 --steps ${STEPS:-20} --guidance ${W:-2.5} --alpha ${ALPHA:-0.5} --foot-lock 1 --env-guidance ${4:-2} --anchor ${ANCHOR:-adapters} ${AA:+--anchor-alpha $AA} ${FB:+--env-guidance-fallback $FB} ${ALSO:+--also-evaluator $ALSO} --threads 2 \
   --out $S/eval11/${1:0:1}_$2 -q

@@ -89,10 +89,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           "sampled again with the same seed at S (default off, or the model's sampling.json)")
     smp.add_argument("--anchor", choices=ANCHORS,
                      help="what the text guidance runs on: the network with its adapters (adapters), or the backbone "
-                          "alone, the adapters adding only their answer to φ against Earth without wind (backbone); "
-                          "default adapters, or the model's sampling.json")
+                          "alone, the adapters adding only their answer to φ against Earth without wind (backbone), "
+                          "or the network under Earth without wind at --anchor-alpha, the adapters anchor's whole "
+                          "answer to φ added (reference); default adapters, or the model's sampling.json")
     smp.add_argument("--anchor-alpha", type=float, metavar="A",
-                     help="with --anchor backbone: run its text guidance with the adapters at strength A, so motions "
+                     help="with --anchor backbone or reference: run its text guidance with the adapters at strength A, so motions "
                           "under Earth without wind are those of --alpha A while the answer to φ is --alpha's "
                           "(default 0, or the model's sampling.json)")
     out = p.add_argument_group("output")

@@ -90,8 +90,8 @@ class CheckConfig:
         steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models; foot_lock: the
             generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`); env_guidance: environment
             guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth);
-            anchor: what the text guidance runs on, ``adapters`` or ``backbone`` (:mod:`simdiff.diffusion.guidance`);
-            anchor_alpha: the backbone anchor's adapter strength (0: the backbone alone);
+            anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:mod:`simdiff.diffusion.guidance`);
+            anchor_alpha: the backbone or reference anchor's adapter strength (0: the backbone alone);
             env_guidance_fallback: s_e for the prompt samples that float or glide at ``env_guidance`` (re-sampled;
             None: off). The test split is generated at Earth without wind, where any s_e gives the same motion.
         more_evaluators: further evaluator folders that score the same test-split motions (each motion generated
@@ -143,7 +143,7 @@ class CheckConfig:
         from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha
 
         if self.anchor not in ANCHORS:
-            raise SimdiffError(f"--anchor must be {' or '.join(ANCHORS)}, got {self.anchor!r}")
+            raise SimdiffError(f"--anchor must be one of {', '.join(ANCHORS)}, got {self.anchor!r}")
         self.anchor_alpha = check_anchor_alpha(self.anchor_alpha, self.anchor)
         if self.prompts.length > 196:
             raise SimdiffError(f"--length must be at most 196 frames, got {self.prompts.length}")
