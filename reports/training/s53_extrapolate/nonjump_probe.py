@@ -1,7 +1,8 @@
 """Spurious jumps: 6 prompts that ask for no jump x N samples (seed 2000+i, 120 frames, Earth, shipped sampling
 settings); counts samples that jump by the checker's rule (flight >= 0.2 s, pelvis >= 15 cm).
 Usage: python nonjump_probe.py MODEL...
-(session 54: env PROBE_ANCHOR, the guidance anchor, default adapters; PROBE_ALPHA, the adapter strength, default 0.5)"""
+(session 54: env PROBE_ANCHOR, the guidance anchor, default adapters; PROBE_ALPHA, the adapter strength, default 0.5;
+session 55: PROBE_ANCHOR_ALPHA, the anchor's adapter strength, default 0)"""
 import os
 import sys
 import time
@@ -24,7 +25,8 @@ def probe(models: list[str], prompts: list[str], n: int, seed0: int) -> None:
         for i, p in enumerate(prompts):
             out = gen.generate([p] * n, 120, seed=seed0 + i, steps=50, guidance=2.5, foot_lock=1.0,
                                alpha=float(os.environ.get("PROBE_ALPHA", "0.5")), env=[-9.81, 0.0, 0.0],
-                               anchor=os.environ.get("PROBE_ANCHOR", "adapters"))
+                               anchor=os.environ.get("PROBE_ANCHOR", "adapters"),
+                               anchor_alpha=float(os.environ.get("PROBE_ANCHOR_ALPHA", "0")))
             j = features_to_joints(out.features.double()).numpy()
             rows.append(sum(jump_stats(x)["jump"] for x in j))
         print(model, f"jumping {sum(rows)}/{n * len(prompts)}", rows, f"{time.time() - start:.0f}s", flush=True)
