@@ -127,6 +127,7 @@ def test_shipped_settings_are_the_measured_ones() -> None:
     assert stored.get("env_guidance_fallback") == measured.get("env_guidance_fallback")
     assert stored.get("anchor", "adapters") == measured.get("anchor", "adapters")
     assert stored.get("anchor_alpha", 0.0) == measured.get("anchor_alpha", 0.0)
+    assert stored.get("anchor_t_max") == measured.get("anchor_t_max")
     from simdiff.motion.foot_lock import CLEANUP_VERSION
 
     assert measured.get("foot_cleanup") == CLEANUP_VERSION  # measured with the foot cleanup users get

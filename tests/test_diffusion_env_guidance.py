@@ -191,6 +191,33 @@ def test_reference_anchor_costs_one_2b_and_one_4k_forward() -> None:
         GuidedDenoiser(sd, 2.5, anchor="reference")(x, t, Condition(text=cond().text))
 
 
+@pytest.mark.parametrize("anchor", ["reference", "backbone"])
+def test_anchor_t_max_runs_the_adapters_anchor_at_the_early_steps(anchor: str) -> None:
+    sd, c = simdiff_net(), cond()
+    x = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(5))
+    late = GuidedDenoiser(sd, 2.5, env_scale=4.0, anchor=anchor, anchor_alpha=0.25, anchor_t_max=500)
+    every = GuidedDenoiser(sd, 2.5, env_scale=4.0, anchor=anchor, anchor_alpha=0.25)
+    adapters = GuidedDenoiser(sd, 2.5, env_scale=4.0)
+    with torch.no_grad():
+        for step, expected in ((501, adapters), (900, adapters), (500, every), (20, every)):
+            t = torch.full((3,), step)
+            assert torch.equal(late(x, t, c), expected(x, t, c)), step
+        assert not torch.allclose(every(x, torch.full((3,), 900), c), adapters(x, torch.full((3,), 900), c), atol=1e-4)
+    with torch.no_grad():  # without environment guidance the early steps need no pass beyond the text guidance
+        sizes = []
+        GuidedDenoiser(lambda xx, tt, cc: sizes.append(xx.shape[0]) or sd(xx, tt, cc), 2.5, anchor=anchor,
+                       anchor_t_max=500)(x, torch.full((3,), 900), c)
+        assert sizes == [6]
+
+
+def test_anchor_t_max_is_checked_in_one_line() -> None:
+    for bad in (-1, 1000, 2.5, True):
+        with pytest.raises(SimdiffError, match="anchor t max must be a whole timestep in 0..999"):
+            GuidedDenoiser(simdiff_net(), 2.5, anchor="reference", anchor_t_max=bad)
+    with pytest.raises(SimdiffError, match="anchor t max 500 needs the backbone or reference anchor"):
+        GuidedDenoiser(simdiff_net(), 2.5, anchor_t_max=500)
+
+
 def test_the_default_anchor_is_unchanged() -> None:
     sd, c = simdiff_net(), cond()
     x, t = torch.randn(3, 8, 263), torch.tensor([300, 300, 300])

@@ -303,6 +303,19 @@ def test_generate_anchor_alpha_from_the_option_or_sampling_json(tmp_path: Path, 
     reference = run("reference", "--anchor", "reference", "--anchor-alpha", "0.25")
     assert np.array_equal(reference, run("a25", "--alpha", "0.25"))  # Earth without wind: the adapters at 0.25
     assert json.loads((tmp_path / "reference" / "generation.json").read_text())["anchor"] == "reference"
+    late = run("late", "--anchor", "reference", "--anchor-alpha", "0.25", "--anchor-t-max", "100")  # DDIM 2: t 500, 0
+    assert json.loads((tmp_path / "late" / "generation.json").read_text())["anchor_t_max"] == 100
+    assert not np.allclose(late, reference, atol=1e-4)  # the early steps ran the adapters anchor at α 0.5
+    (model / "sampling.json").write_text('{"anchor": "reference", "anchor_alpha": 0.25, "anchor_t_max": 100}')
+    assert np.array_equal(run("stored_late"), late)
+    assert json.loads((tmp_path / "given" / "generation.json").read_text())["anchor_t_max"] is None
+    (model / "sampling.json").unlink()
+    assert main([*argv, "--anchor-t-max", "500", "--out", str(tmp_path / "bad_t")]) == 2
+    err = capsys.readouterr().err
+    assert "--anchor-t-max 500 needs the backbone or reference anchor" in err and err.count("\n") == 1
+    assert main([*argv, "--anchor", "reference", "--anchor-t-max", "1000", "--out", str(tmp_path / "bad_t2")]) == 2
+    err = capsys.readouterr().err
+    assert "--anchor-t-max must be a whole timestep in 0..999, got 1000" in err and err.count("\n") == 1
     (model / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": -1}')
     assert main([*argv, "--out", str(tmp_path / "bad2")]) == 2
     err = capsys.readouterr().err

@@ -400,6 +400,11 @@ def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: P
     assert "guidance anchor backbone at α 0.25" in (tmp_path / "out" / "check.md").read_text()
     with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone or reference anchor"):
         CheckConfig(**{**config.__dict__, "anchor": "adapters"}).validate()
+    config.anchor_t_max = 500  # the early steps change: measured again
+    report = ModelCheck(config.validate(), text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert not report["test_split"].get("cached") and report["settings"]["anchor_t_max"] == 500
+    assert "guidance anchor backbone at α 0.25 at t ≤ 500" in (tmp_path / "out" / "check.md").read_text()
 
 
 def test_a_config_change_measures_every_section_again(checked: dict, tmp_path: Path) -> None:

@@ -89,6 +89,22 @@ def test_anchor_alpha_gives_alpha_a_at_earth_and_is_validated() -> None:
         gen.generate(["walk"], 12, env=envs[1], steps=2, anchor="backbone", anchor_alpha=-1.0)
 
 
+def test_anchor_t_max_switches_the_anchor_at_the_late_steps_and_is_validated() -> None:
+    gen = reacting_generator()
+    envs = [[-9.81, 0.0, 0.0], [-1.6, 0.0, 0.0]]
+    kw = dict(env=envs, alpha=0.5, steps=4, seed=1, env_guidance=2.0)
+    late = gen.generate(["walk", "jump"], 12, anchor="reference", anchor_alpha=0.25, anchor_t_max=999, **kw).features
+    every = gen.generate(["walk", "jump"], 12, anchor="reference", anchor_alpha=0.25, **kw).features
+    assert torch.equal(late, every)  # every DDIM step at t <= 999
+    never = gen.generate(["walk", "jump"], 12, anchor="reference", anchor_alpha=0.25, anchor_t_max=0, **kw).features
+    some = gen.generate(["walk", "jump"], 12, anchor="reference", anchor_alpha=0.25, anchor_t_max=500, **kw).features
+    assert not torch.allclose(never, every, atol=1e-4) and not torch.allclose(some, every, atol=1e-4)
+    with pytest.raises(SimdiffError, match="anchor t max 500 needs the backbone or reference anchor"):
+        gen.generate(["walk"], 12, env=envs[1], steps=2, anchor_t_max=500)
+    with pytest.raises(SimdiffError, match="anchor t max must be a whole timestep in 0..999, got 1000"):
+        gen.generate(["walk"], 12, env=envs[1], steps=2, anchor="reference", anchor_t_max=1000)
+
+
 def test_load_pretrained_missing_folder(tmp_path) -> None:
     with pytest.raises(SimdiffError, match="config.json"):
         load_pretrained(tmp_path / "nope")

@@ -382,6 +382,25 @@ def test_generate_anchor_alpha_from_sampling_json_or_the_request(server, model_d
         (model_dir / "sampling.json").unlink()
     status, out, _ = call(server, "/api/generate", {**earth, "anchor_alpha": -1})
     assert status == 400 and "anchor_alpha must be in" in out["error"]
+    status, out, _ = call(server, "/api/generate", {**earth, "anchor_alpha": 0.25})  # the request's error: 400
+    assert status == 400 and "anchor_alpha 0.25 needs the backbone or reference anchor" in out["error"], out
+
+
+def test_generate_anchor_t_max_from_sampling_json_or_the_request(server, model_dir):
+    moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5, "gravity": -1.6, "env_guidance": 2}
+    late = {**moon, "anchor": "reference", "anchor_alpha": 0.25}
+    status, given, _ = call(server, "/api/generate", {**late, "anchor_t_max": 500})
+    assert status == 200 and given["meta"]["params"]["anchor_t_max"] == 500
+    assert given["joints"] != call(server, "/api/generate", late)[1]["joints"]
+    (model_dir / "sampling.json").write_text('{"anchor": "reference", "anchor_alpha": 0.25, "anchor_t_max": 500}')
+    try:
+        status, stored, _ = call(server, "/api/generate", moon)
+        assert status == 200 and stored["joints"] == given["joints"]
+    finally:
+        (model_dir / "sampling.json").unlink()
+    for bad, message in ((1000, "anchor_t_max must be a whole timestep"), (500, "anchor_t_max 500 needs the backbone")):
+        status, out, _ = call(server, "/api/generate", {**moon, "anchor_t_max": bad})
+        assert status == 400 and message in out["error"], out
 
 
 def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):

@@ -17,6 +17,9 @@
   exactly the adapters anchor at α = a; elsewhere the change of φ moves the motion exactly as far as the adapters
   anchor at α would, text guidance included (session 55: the backbone anchor's push, outside the text guidance,
   cost text fidelity under low gravity). Costs one 2B forward plus one 4K forward over the K rows off φ_ref.
+* ``anchor_t_max`` T: the backbone or reference anchor runs only at the steps whose timestep is ≤ T, the adapters
+  anchor at the earlier ones (session 55: what the text asks for is settled by the early, noisy steps, the adapters'
+  answer to Earth, a matter of detail, by the late ones).
 """
 
 from __future__ import annotations
@@ -44,6 +47,19 @@ reference φ (see the module)."""
 
 ALPHA_ANCHORS: tuple[str, ...] = ("backbone", "reference")
 """The anchors that take an ``anchor_alpha``."""
+
+
+def check_anchor_t_max(value: int | None, anchor: str) -> int | None:
+    """``value`` as an int in [0, 999] that ``anchor`` can use (None: every step, any anchor), else one
+    :class:`SimdiffError` line naming it."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) or not 0 <= value <= 999:
+        raise SimdiffError(f"anchor t max must be a whole timestep in 0..999, got {value}")
+    if anchor not in ALPHA_ANCHORS:
+        raise SimdiffError(f"anchor t max {int(value)} needs the backbone or reference anchor (--anchor backbone or "
+                           f"reference), not {anchor!r}")
+    return int(value)
 
 
 def check_anchor_alpha(value: float, anchor: str) -> float:
@@ -75,11 +91,13 @@ class GuidedDenoiser:
             the adapters at α), ``"reference"`` one 4K forward over them (both with and without the text).
         anchor_alpha: adapter strength a of the backbone or reference anchor's text guidance (0: the backbone
             alone); only with ``anchor="backbone"`` or ``"reference"``.
+        anchor_t_max: the backbone or reference anchor only at timesteps ≤ this (0..999), the adapters anchor
+            above it (None: every step).
     """
 
     def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True, env_scale: float = 1.0,
                  reference_env: Sequence[float] = REFERENCE_ENV, anchor: str = "adapters",
-                 anchor_alpha: float = 0.0) -> None:
+                 anchor_alpha: float = 0.0, anchor_t_max: int | None = None) -> None:
         self.denoiser = denoiser
         self.scale = float(scale)
         self.batched = batched
@@ -91,19 +109,23 @@ class GuidedDenoiser:
             raise SimdiffError(f"unknown guidance anchor {anchor!r}; choose one of {', '.join(ANCHORS)}")
         self.anchor = anchor
         self.anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
+        self.anchor_t_max = check_anchor_t_max(anchor_t_max, anchor)
 
     def __call__(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
         """x: (B, T, F), timesteps: (B,) → guided x̂₀ (B, T, F)."""
-        rows, ref = self._plan(cond)
-        if self.anchor == "reference":
+        anchor = self.anchor
+        if self.anchor_t_max is not None and int(timesteps.max()) > self.anchor_t_max:
+            anchor = "adapters"  # an early step
+        rows, ref = self._plan(cond, anchor)
+        if anchor == "reference":
             return self._reference_anchor(x, timesteps, cond, rows, ref)
-        text_cond = cond if self.anchor == "adapters" else replace(cond, alpha=self.anchor_alpha)
+        text_cond = cond if anchor == "adapters" else replace(cond, alpha=self.anchor_alpha)
         cond_out, guided = self._text_guided(x, timesteps, text_cond)
         if rows is None or ref is None:  # nothing off the reference φ
             return guided
         # passes of their own, so that the rows above are computed exactly as without environment guidance
         guided = guided.clone()
-        if self.anchor == "adapters":
+        if anchor == "adapters":
             ref_out = self.denoiser(x[rows], timesteps[rows], ref)
             guided[rows] += (self.env_scale - 1.0) * (cond_out[rows] - ref_out)
             return guided
@@ -141,7 +163,7 @@ class GuidedDenoiser:
         guided[rows] += (g_phi - g_ref) + (self.env_scale - 1.0) * (c_phi - c_ref)
         return guided
 
-    def _plan(self, cond: Condition) -> tuple[Tensor | None, Condition | None]:
+    def _plan(self, cond: Condition, anchor: str) -> tuple[Tensor | None, Condition | None]:
         """((K,) indices of the rows environment guidance changes, their condition with φ set to the reference), or
         (None, None) when it changes none (a few small tensor operations per step, next to a network pass)."""
         if self.env_scale == 1.0 and self.anchor == "adapters":
@@ -149,6 +171,8 @@ class GuidedDenoiser:
         if cond.env is None:
             what = "environment guidance" if self.anchor == "adapters" else f"the {self.anchor} anchor"
             raise SimdiffError(f"{what} needs a SimDiff model with a continuous Sim Encoder (φ as numbers)")
+        if self.env_scale == 1.0 and anchor == "adapters":  # an early step of anchor_t_max
+            return None, None
         phi = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
         rows = torch.nonzero((cond.env != phi).any(dim=-1)).flatten()
         if not rows.numel():

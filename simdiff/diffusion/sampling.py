@@ -52,6 +52,7 @@ def sample(
     env_guidance: float = 1.0,
     anchor: str = "adapters",
     anchor_alpha: float = 0.0,
+    anchor_t_max: int | None = None,
 ) -> Tensor:
     """Run the reverse process from pure noise; returns x₀ (B, num_frames, nfeats) normalised features.
 
@@ -65,8 +66,10 @@ def sample(
         x0_hook: replaces x̂₀ at the timesteps in ``hook_timesteps`` (all when None).
         progress: optional iterable wrapper (e.g. ``tqdm``).
         env_guidance: environment guidance s_e (1 = off; :class:`GuidedDenoiser`), continuous φ only.
-        anchor: what the text guidance runs on, ``"adapters"`` or ``"backbone"`` (:class:`GuidedDenoiser`).
-        anchor_alpha: adapter strength of the backbone anchor's text guidance (0: the backbone alone).
+        anchor: what the text guidance runs on, ``"adapters"``, ``"backbone"`` or ``"reference"``
+            (:class:`GuidedDenoiser`).
+        anchor_alpha: adapter strength of the backbone or reference anchor's text guidance (0: the backbone alone).
+        anchor_t_max: that anchor only at timesteps ≤ this, the adapters anchor above (None: every step).
     """
     device = cond.text.device
     b = cond.batch_size
@@ -74,7 +77,7 @@ def sample(
         (b, num_frames, nfeats), generator=generator, device=generator.device if generator else device
     ).to(device)
     model = GuidedDenoiser(denoiser, guidance, batched_cfg, env_scale=env_guidance, anchor=anchor,
-                           anchor_alpha=anchor_alpha)
+                           anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max)
     hooked = None if hook_timesteps is None else {int(t) for t in hook_timesteps}
     steps: Iterable[Tensor] = scheduler.timesteps
     if progress is not None:

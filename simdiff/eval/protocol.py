@@ -228,7 +228,7 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
                  sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5,
                  physdiff: Any = None, projector: Any = None, simulate: bool = False,
                  finish_projector: Any = None, foot_lock: float = 0.0, env_guidance: float = 1.0,
-                 anchor: str = "adapters", anchor_alpha: float = 0.0) -> GenerateFn:
+                 anchor: str = "adapters", anchor_alpha: float = 0.0, anchor_t_max: int | None = None) -> GenerateFn:
     """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
 
     ``simulate``: the simulated finish: every final sample is re-tracked by ``finish_projector``
@@ -238,7 +238,8 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
     (``success``: tracked to the end; ``frames_replaced``), in generation order. ``foot_lock``: the
     generator's foot lock strength (0: off; not with ``physdiff``); ``env_guidance``: environment guidance s_e
     (1: off; SimDiff continuous models); ``anchor``: what the text guidance runs on (:mod:`simdiff.diffusion.guidance`);
-    ``anchor_alpha``: the backbone or reference anchor's adapter strength (0: the backbone alone).
+    ``anchor_alpha``: the backbone or reference anchor's adapter strength (0: the backbone alone); ``anchor_t_max``:
+    that anchor only at timesteps ≤ this (None: every step).
     """
     finish_log: list[dict[str, Any]] = []
 
@@ -252,6 +253,8 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
                 kwargs["anchor"] = anchor
             if anchor_alpha:
                 kwargs["anchor_alpha"] = anchor_alpha
+            if anchor_t_max is not None:
+                kwargs["anchor_t_max"] = anchor_t_max
         if physdiff is not None:
             from simdiff.baselines.physdiff import physdiff_generate
 

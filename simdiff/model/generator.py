@@ -13,7 +13,7 @@ from typing import Callable, Iterable, Sequence
 import torch
 from torch import Tensor, nn
 
-from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha
+from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha, check_anchor_t_max
 from simdiff.diffusion.sampling import X0Hook, make_scheduler, sample
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
@@ -114,6 +114,7 @@ class MotionGenerator:
         anchor: str = "adapters",
         env_guidance_fallback: float | None = None,
         anchor_alpha: float = 0.0,
+        anchor_t_max: int | None = None,
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -145,6 +146,8 @@ class MotionGenerator:
             anchor_alpha: with ``anchor="backbone"`` or ``"reference"``, the adapter strength its text guidance runs
                 at (0: the backbone alone; e.g. 0.25: motions under Earth without wind are those of α 0.25, the
                 answer to φ is α's).
+            anchor_t_max: with ``anchor="backbone"`` or ``"reference"``, that anchor only at the denoising steps
+                whose timestep is ≤ this (0..999), the adapters anchor at the earlier ones (None: every step).
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -175,6 +178,7 @@ class MotionGenerator:
             raise SimdiffError(f"anchor {anchor!r} needs a SimDiff model with a continuous Sim Encoder; "
                                "this model has none (leave it at 'adapters')")
         anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
+        anchor_t_max = check_anchor_t_max(anchor_t_max, anchor)
         # options checked first: a bad one fails before the text encoder runs
         text = text_embeddings.float().to(self.device) if text_embeddings is not None else self.encode_text(texts)
         frames = int(lens.max())
@@ -185,7 +189,7 @@ class MotionGenerator:
             return sample(self.network, make_scheduler(sampler, steps, eta), cond, frames,
                           nfeats=self.config.backbone.nfeats, guidance=guidance, batched_cfg=batched_cfg,
                           generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps, progress=progress,
-                          env_guidance=push, anchor=anchor, anchor_alpha=anchor_alpha)
+                          env_guidance=push, anchor=anchor, anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max)
 
         x = run(env_guidance)
         fell_back = None

@@ -128,6 +128,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
                        if request.env_guidance_fallback is not None and env is not None else {}),
                     **({"anchor": request.anchor} if request.anchor != "adapters" else {}),
                     **({"anchor_alpha": request.anchor_alpha} if request.anchor_alpha else {}),
+                    **({"anchor_t_max": request.anchor_t_max} if request.anchor_t_max is not None else {}),
                 )
                 features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
                 fell_back.append(None if out.fell_back is None else bool(out.fell_back[0]))
@@ -263,6 +264,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "env_guidance_fallback": request.env_guidance_fallback if simdiff_model else None,
         "anchor": request.anchor if simdiff_model else None,
         "anchor_alpha": request.anchor_alpha if simdiff_model else None,
+        "anchor_t_max": request.anchor_t_max if simdiff_model else None,
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",
         "samples": records,

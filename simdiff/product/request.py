@@ -51,6 +51,8 @@ class GenerationRequest:
         anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:data:`ANCHORS`).
         anchor_alpha: with the ``backbone`` or ``reference`` anchor, the adapter strength its text guidance runs at (0: the backbone
             alone; :mod:`simdiff.diffusion.guidance`).
+        anchor_t_max: with the ``backbone`` or ``reference`` anchor, the last timestep (0..999) it runs at from
+            below, the adapters anchor at the earlier steps (None: every step).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
     """
@@ -70,6 +72,7 @@ class GenerationRequest:
     env_guidance_fallback: float | None = None
     anchor: str = "adapters"
     anchor_alpha: float = 0.0
+    anchor_t_max: int | None = None
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
 
@@ -230,6 +233,28 @@ def check_anchor_alpha(name: str, value: object, anchor: str) -> float:
     return number
 
 
+def check_anchor_t_max(name: str, value: object, anchor: str | None = None) -> int | None:
+    """``value`` as a whole timestep in [0, 999] (None passes), usable with ``anchor`` unless that is None (the
+    ``backbone`` or ``reference`` anchor); one-line errors naming ``name``."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
+            or not 0 <= value <= 999:
+        raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value!r}")
+    if anchor is not None and anchor not in ("backbone", "reference"):
+        raise SimdiffError(f"{name} {int(value)} needs the backbone or reference anchor (--anchor backbone or "
+                           f"reference), not {anchor!r}")
+    return int(value)
+
+
+def stored_anchor_t_max(stored: dict[str, float | int | str], anchor: str) -> int | None:
+    """A model's stored ``anchor_t_max`` when ``anchor`` is its stored anchor (the value belongs to that anchor),
+    else None; checked as the option is."""
+    if anchor != stored.get("anchor", "adapters"):
+        return None
+    return check_anchor_t_max("anchor_t_max", stored.get("anchor_t_max"), anchor)
+
+
 def stored_anchor_alpha(stored: dict[str, float | int | str], anchor: str) -> float:
     """A model's stored ``anchor_alpha`` when ``anchor`` is its stored anchor (the value belongs to that anchor), else
     0; checked as the option is (one-line errors naming it)."""
@@ -245,10 +270,11 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     Args:
         stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance``,
             ``env_guidance_fallback``,
-            ``anchor``, ``anchor_alpha`` (see :func:`simdiff.model.default.sampling_defaults`).
+            ``anchor``, ``anchor_alpha``, ``anchor_t_max`` (see :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
-            ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``, ``anchor_alpha``). A stored
-            ``anchor_alpha`` belongs to the stored anchor: it is dropped when the user picks another anchor.
+            ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``, ``anchor_alpha``,
+            ``anchor_t_max``). A stored ``anchor_alpha`` or ``anchor_t_max`` belongs to the stored anchor: it is
+            dropped when the user picks another anchor.
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -260,11 +286,13 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     anchor = request.anchor if "anchor" in given else check_anchor("anchor", stored.get("anchor", request.anchor))
     anchor_alpha = (check_anchor_alpha("--anchor-alpha", request.anchor_alpha, anchor) if "anchor_alpha" in given
                     else stored_anchor_alpha(stored, anchor))
+    anchor_t_max = (check_anchor_t_max("--anchor-t-max", request.anchor_t_max, anchor) if "anchor_t_max" in given
+                    else stored_anchor_t_max(stored, anchor))
     fallback = request.env_guidance_fallback
     if "env_guidance_fallback" not in given and stored.get("env_guidance_fallback") is not None:
         fallback = check_finite("env_guidance_fallback", stored["env_guidance_fallback"], 0.0)
     return replace(
-        request, sampler=sampler, steps=steps, anchor=anchor, anchor_alpha=anchor_alpha,
+        request, sampler=sampler, steps=steps, anchor=anchor, anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max,
         env_guidance_fallback=fallback,
         **{name: getattr(request, name) if name in given else stored_setting(stored, name, getattr(request, name))
            for name in STORED_NUMBERS},
@@ -293,7 +321,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                   sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
                   foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
                   env_guidance_fallback: float | None = None, anchor_alpha: float = 0.0,
-                  compare: str | None = None, formats: str | None = None,
+                  anchor_t_max: int | None = None, compare: str | None = None, formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
     if seed < 0:
@@ -319,6 +347,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                                else check_finite("--env-guidance-fallback", env_guidance_fallback, 0.0)),
         anchor=check_anchor("--anchor", anchor),
         anchor_alpha=check_finite("--anchor-alpha", anchor_alpha, 0.0),
+        anchor_t_max=check_anchor_t_max("--anchor-t-max", anchor_t_max),
         formats=parse_formats(formats, no_video),
         force=bool(force),
     )

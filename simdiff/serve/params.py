@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass
 from typing import Any, Mapping
 
 from simdiff.errors import SimdiffError
-from simdiff.product.request import MAX_PROMPT_CHARS, check_anchor, check_text
+from simdiff.product.request import MAX_PROMPT_CHARS, check_anchor, check_anchor_t_max, check_text
 from simdiff.motion.skeleton import FPS, MAX_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND
 
@@ -56,6 +56,8 @@ class GenerateParams:
             the model's ``sampling.json`` value (off without one).
         anchor_alpha: the backbone or reference anchor's adapter strength (:mod:`simdiff.diffusion.guidance`), or None for the
             model's ``sampling.json`` value when the anchor is the stored one (0 otherwise).
+        anchor_t_max: that anchor only at timesteps ≤ this (0..999), or None for the model's ``sampling.json``
+            value when the anchor is the stored one (every step otherwise).
     """
 
     text: str
@@ -73,6 +75,7 @@ class GenerateParams:
     anchor: str | None = None
     env_guidance_fallback: float | None = None
     anchor_alpha: float | None = None
+    anchor_t_max: int | None = None
 
     @property
     def frames(self) -> int:
@@ -121,7 +124,7 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
-            simulate, foot_lock, env_guidance, anchor, env_guidance_fallback, anchor_alpha}``;
+            simulate, foot_lock, env_guidance, anchor, env_guidance_fallback, anchor_alpha, anchor_t_max}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -180,6 +183,8 @@ def parse_generate(body: Any) -> GenerateParams:
     if anchor_alpha is not None:
         anchor_alpha = _number(body, "anchor_alpha", 0.0)
         _check_range("anchor_alpha", anchor_alpha, 0.0, ALPHA_RANGE[1])
+    anchor_t_max = check_anchor_t_max("anchor_t_max", body.get("anchor_t_max"))
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
                           guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance,
-                          anchor=anchor, env_guidance_fallback=fallback, anchor_alpha=anchor_alpha, **wind)
+                          anchor=anchor, env_guidance_fallback=fallback, anchor_alpha=anchor_alpha,
+                          anchor_t_max=anchor_t_max, **wind)

@@ -149,7 +149,8 @@ class MotionService:
         as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import check_anchor, check_anchor_alpha, stored_anchor_alpha, stored_setting
+        from simdiff.product.request import (check_anchor, check_anchor_alpha, check_anchor_t_max, stored_anchor_alpha,
+                                             stored_anchor_t_max, stored_setting)
 
         try:
             stored = sampling_defaults(self.model_dir)
@@ -160,8 +161,8 @@ class MotionService:
             fallback = params.env_guidance_fallback
             if fallback is None and stored.get("env_guidance_fallback") is not None:
                 fallback = stored_setting(stored, "env_guidance_fallback", 1.0)
-            anchor_alpha = (stored_anchor_alpha(stored, anchor) if params.anchor_alpha is None
-                            else check_anchor_alpha("anchor_alpha", params.anchor_alpha, anchor))
+            anchor_alpha = stored_anchor_alpha(stored, anchor) if params.anchor_alpha is None else 0.0
+            t_max = stored_anchor_t_max(stored, anchor) if params.anchor_t_max is None else None
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
@@ -169,9 +170,14 @@ class MotionService:
             push = 1.0 if params.env_guidance is None else params.env_guidance
             anchor = params.anchor or "adapters"
             fallback = params.env_guidance_fallback
-            anchor_alpha = params.anchor_alpha or 0.0
+            anchor_alpha, t_max = 0.0, None
+        # the request's own values against the anchor: its error (400), not the model's
+        if params.anchor_alpha is not None:
+            anchor_alpha = check_anchor_alpha("anchor_alpha", params.anchor_alpha, anchor)
+        if params.anchor_t_max is not None:
+            t_max = check_anchor_t_max("anchor_t_max", params.anchor_t_max, anchor)
         return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor,
-                       env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha))
+                       env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha), anchor_t_max=t_max)
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -248,7 +254,8 @@ class MotionService:
                                      foot_lock=params.foot_lock,
                                      **({"env_guidance": params.env_guidance, "anchor": params.anchor,
                                          "env_guidance_fallback": params.env_guidance_fallback,
-                                         "anchor_alpha": params.anchor_alpha or 0.0} if uses_env else {}))
+                                         "anchor_alpha": params.anchor_alpha or 0.0,
+                                         "anchor_t_max": params.anchor_t_max} if uses_env else {}))
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count

@@ -92,6 +92,7 @@ class CheckConfig:
             guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth);
             anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:mod:`simdiff.diffusion.guidance`);
             anchor_alpha: the backbone or reference anchor's adapter strength (0: the backbone alone);
+            anchor_t_max: that anchor only at timesteps ≤ this, the adapters anchor above (None: every step);
             env_guidance_fallback: s_e for the prompt samples that float or glide at ``env_guidance`` (re-sampled;
             None: off). The test split is generated at Earth without wind, where any s_e gives the same motion.
         more_evaluators: further evaluator folders that score the same test-split motions (each motion generated
@@ -113,6 +114,7 @@ class CheckConfig:
     anchor: str = "adapters"
     env_guidance_fallback: float | None = None
     anchor_alpha: float = 0.0
+    anchor_t_max: int | None = None
     more_evaluators: list[str] = field(default_factory=list)
     device: str = "cpu"
     quick: bool = False
@@ -140,11 +142,12 @@ class CheckConfig:
             raise SimdiffError(f"--env-guidance must be a finite number ≥ 0, got {self.env_guidance}")
         if self.env_guidance_fallback is not None and not 0.0 <= self.env_guidance_fallback < float("inf"):
             raise SimdiffError(f"--env-guidance-fallback must be a finite number ≥ 0, got {self.env_guidance_fallback}")
-        from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha
+        from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha, check_anchor_t_max
 
         if self.anchor not in ANCHORS:
             raise SimdiffError(f"--anchor must be one of {', '.join(ANCHORS)}, got {self.anchor!r}")
         self.anchor_alpha = check_anchor_alpha(self.anchor_alpha, self.anchor)
+        self.anchor_t_max = check_anchor_t_max(self.anchor_t_max, self.anchor)
         if self.prompts.length > 196:
             raise SimdiffError(f"--length must be at most 196 frames, got {self.prompts.length}")
         model, corpus, evaluator = Path(self.model), Path(self.corpus), Path(self.evaluator)

@@ -43,7 +43,7 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
                        alpha: float, steps: int, guidance: float, progress: bool = False, foot_lock: float = 0.0,
                        env_guidance: float = 1.0, anchor: str = "adapters",
                        env_guidance_fallback: float | None = None,
-                       anchor_alpha: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                       anchor_alpha: float = 0.0, anchor_t_max: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Generate every batch; returns joints (N, length, 22, 3) float32 (metres, Y-up, 20 fps) and (N,) bool: the
     samples re-sampled at ``env_guidance_fallback`` (the generator's ``Generation.fell_back``; all False without one).
 
@@ -61,6 +61,8 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
         kwargs["anchor"] = anchor
     if anchor_alpha:
         kwargs["anchor_alpha"] = anchor_alpha
+    if anchor_t_max is not None:
+        kwargs["anchor_t_max"] = anchor_t_max
     if env_guidance_fallback is not None:
         kwargs["env_guidance_fallback"] = env_guidance_fallback
     out, flags = [], []
