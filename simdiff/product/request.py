@@ -49,8 +49,8 @@ class GenerationRequest:
         env_guidance_fallback: s_e ≥ 0 for samples that come out floating or gliding at ``env_guidance``
             (re-sampled with the same seed; None: off; :meth:`simdiff.model.generator.MotionGenerator.generate`).
         anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:data:`ANCHORS`).
-        anchor_alpha: with the ``backbone`` or ``reference`` anchor, the adapter strength its text guidance runs at (0: the backbone
-            alone; :mod:`simdiff.diffusion.guidance`).
+        anchor_alpha: with the ``backbone`` or ``reference`` anchor, the adapter strength its text guidance runs at
+            (0: the backbone alone; :mod:`simdiff.diffusion.guidance`).
         anchor_t_max: with the ``backbone`` or ``reference`` anchor, the last timestep (0..999) it runs at from
             below, the adapters anchor at the earlier steps (None: every step).
         formats: output kinds, a subset of :data:`FORMATS`.

@@ -50,12 +50,13 @@ class GenerateParams:
             ``sampling.json`` value (0 without one), as ``simdiff generate``.
         env_guidance: environment guidance s_e ≥ 0 (:mod:`simdiff.diffusion.guidance`), or None for the model's
             ``sampling.json`` value (1, off, without one).
-        anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:mod:`simdiff.diffusion.guidance`),
+        anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference``
+            (:mod:`simdiff.diffusion.guidance`),
             or None for the model's ``sampling.json`` value (``adapters`` without one).
         env_guidance_fallback: s_e for a sample that floats or glides at ``env_guidance`` (re-sampled), or None for
             the model's ``sampling.json`` value (off without one).
-        anchor_alpha: the backbone or reference anchor's adapter strength (:mod:`simdiff.diffusion.guidance`), or None for the
-            model's ``sampling.json`` value when the anchor is the stored one (0 otherwise).
+        anchor_alpha: the backbone or reference anchor's adapter strength (:mod:`simdiff.diffusion.guidance`), or None
+            for the model's ``sampling.json`` value when the anchor is the stored one (0 otherwise).
         anchor_t_max: that anchor only at timesteps ≤ this (0..999), or None for the model's ``sampling.json``
             value when the anchor is the stored one (every step otherwise).
     """

@@ -93,9 +93,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           "or the network under Earth without wind at --anchor-alpha, the adapters anchor's whole "
                           "answer to φ added (reference); default adapters, or the model's sampling.json")
     smp.add_argument("--anchor-alpha", type=float, metavar="A",
-                     help="with --anchor backbone or reference: run its text guidance with the adapters at strength A, so motions "
-                          "under Earth without wind are those of --alpha A while the answer to φ is --alpha's "
-                          "(default 0, or the model's sampling.json)")
+                     help="with --anchor backbone or reference: run its text guidance with the adapters at strength "
+                          "A, so motions under Earth without wind are those of --alpha A while the answer to φ is "
+                          "--alpha's (default 0, or the model's sampling.json)")
     smp.add_argument("--anchor-t-max", type=int, metavar="T",
                      help="with --anchor backbone or reference: use it only at the denoising steps whose timestep is "
                           "at most T (0-999), the adapters anchor at the earlier ones (default every step, or the "
@@ -173,7 +173,8 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
     read_recipe(folder)  # likewise extrapolation.json
     given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance",
-                               "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max") if getattr(args, name) is not None}
+                               "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max")
+             if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")
     for env in request.envs:

@@ -90,7 +90,8 @@ class CheckConfig:
         steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models; foot_lock: the
             generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`); env_guidance: environment
             guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth);
-            anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:mod:`simdiff.diffusion.guidance`);
+            anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference``
+            (:mod:`simdiff.diffusion.guidance`);
             anchor_alpha: the backbone or reference anchor's adapter strength (0: the backbone alone);
             anchor_t_max: that anchor only at timesteps ≤ this, the adapters anchor above (None: every step);
             env_guidance_fallback: s_e for the prompt samples that float or glide at ``env_guidance`` (re-sampled;
