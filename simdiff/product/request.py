@@ -215,6 +215,9 @@ STORED_NUMBERS: tuple[str, ...] = ("guidance", "alpha", "foot_lock", "env_guidan
 ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference")
 """``--anchor`` values: :data:`simdiff.diffusion.guidance.ANCHORS` (repeated here, where torch is not imported)."""
 
+ALPHA_ANCHORS: tuple[str, ...] = ("backbone", "reference")
+"""The anchors that take ``--anchor-alpha`` / ``--anchor-t-max`` (:data:`simdiff.diffusion.guidance.ALPHA_ANCHORS`)."""
+
 
 def check_anchor(name: str, value: object) -> str:
     """``value`` if it is one of :data:`ANCHORS`, else a one-line error naming ``name``."""
@@ -227,7 +230,7 @@ def check_anchor_alpha(name: str, value: object, anchor: str) -> float:
     """``value`` as a finite float ≥ 0, and 0 unless ``anchor`` is ``backbone`` or ``reference`` (one-line errors
     naming ``name``)."""
     number = check_finite(name, value, 0.0)
-    if number and anchor not in ("backbone", "reference"):
+    if number and anchor not in ALPHA_ANCHORS:
         raise SimdiffError(f"{name} {number:g} needs the backbone or reference anchor (--anchor backbone or "
                            f"reference), not {anchor!r}")
     return number
@@ -241,7 +244,7 @@ def check_anchor_t_max(name: str, value: object, anchor: str | None = None) -> i
     if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
             or not 0 <= value <= 999:
         raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value!r}")
-    if anchor is not None and anchor not in ("backbone", "reference"):
+    if anchor is not None and anchor not in ALPHA_ANCHORS:
         raise SimdiffError(f"{name} {int(value)} needs the backbone or reference anchor (--anchor backbone or "
                            f"reference), not {anchor!r}")
     return int(value)
