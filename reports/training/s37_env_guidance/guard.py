@@ -12,7 +12,8 @@ torch.set_num_threads(2)
 R.EARTH = phi
 E = os.environ.get("SIMDIFF_SCRATCH", "/work/scratch/s29")  # session 39: the corpus3/ and eval/ folder
 model = sys.argv[4] if len(sys.argv) > 4 else "simdiff/assets/default_model"  # session 38: another model folder
-c = CheckConfig(model=model, corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=out, seeds=[0],
+c = CheckConfig(model=model, corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=out,
+                seeds=[int(v) for v in os.environ.get("SEEDS", "0").split()],  # session 56: SEEDS="1 2"
                 steps=int(os.environ.get("STEPS", "20")), guidance=float(os.environ.get("W", "2.5")),  # session 46
                 alpha=float(os.environ.get("ALPHA", "0.5")), foot_lock=1.0, env_guidance=se,  # ALPHA: session 54
                 anchor=os.environ.get("ANCHOR", "adapters"),  # session 47
