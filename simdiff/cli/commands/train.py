@@ -76,6 +76,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--env-pairs-drift", type=float, metavar="WEIGHT",
                    help="weight of the twins' mean root-velocity (drift) term, with --env-pairs (0 = off); see "
                         "TrainConfig.env_pairs_drift")
+    a.add_argument("--targets", choices=["simulated", "source-anchored"],
+                   help="training targets: the simulator's replays (default) or the source clip plus the replay's "
+                        "change against its Earth twin; see simdiff.data.augment.anchored")
+    a.add_argument("--anchor-corpus", type=Path, metavar="PATH",
+                   help="with --targets source-anchored: the corpus the --data folders were augmented from "
+                        "(default: each folder's source_corpus.json)")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -143,6 +149,14 @@ def _run_config(args: argparse.Namespace):
         tc.env_pairs = args.env_pairs
     if getattr(args, "env_pairs_drift", None) is not None:
         tc.env_pairs_drift = args.env_pairs_drift
+    if getattr(args, "targets", None) is not None:
+        tc.targets = args.targets
+    from simdiff.data.augment.anchored import TARGETS
+
+    if tc.targets not in TARGETS:
+        raise SimdiffError(f"train.targets {tc.targets!r}: choose from {', '.join(TARGETS)}")
+    if tc.targets != "simulated" and args.mode != "adapters":
+        raise SimdiffError(f"targets {tc.targets!r} are for `simdiff train adapters`")
     if tc.steps < 1 or tc.batch_size < 1:
         raise SimdiffError("--steps and --batch-size must be positive")
     if args.loader_workers < 0:
@@ -181,7 +195,7 @@ def _run_config(args: argparse.Namespace):
     return config
 
 
-def _dataset(args: argparse.Namespace, seed: int):
+def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated"):
     from simdiff.errors import SimdiffError
     from simdiff.train.data import synthetic_dataset
 
@@ -196,7 +210,13 @@ def _dataset(args: argparse.Namespace, seed: int):
             raise SimdiffError(f"--data {folder}: not a directory")
         if args.mode == "adapters" and not (folder / "env.json").is_file():
             raise SimdiffError(f"{folder}: adapters train on a simulator-augmented corpus (env.json), see `simdiff data augment`")
-    return open_training_dataset(list(args.data), args.split, seed, source=getattr(args, "source", None))
+    dataset = open_training_dataset(list(args.data), args.split, seed, source=getattr(args, "source", None),
+                                    targets=targets, anchor_corpus=getattr(args, "anchor_corpus", None))
+    if targets != "simulated":
+        parts = getattr(dataset, "parts", [dataset])
+        anchored, simulated = sum(p.anchored for p in parts), sum(len(p.sim) for p in parts)
+        print(f"{targets} targets: {anchored} of {simulated} simulated items (the rest keep the replay)")
+    return dataset
 
 
 def _provenance(args: argparse.Namespace):
@@ -240,7 +260,7 @@ def run(args: argparse.Namespace) -> int:
             encoder = open_caption_table(args.text_table, config.model.text_encoder, device)
         else:
             encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
-        dataset = _dataset(args, config.train.seed)
+        dataset = _dataset(args, config.train.seed, config.train.targets)
         trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
                           init_model=getattr(args, "init", None),
                           init_adapters=getattr(args, "adapters_init", None), rank=dist.rank,

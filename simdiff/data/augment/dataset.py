@@ -12,11 +12,13 @@ Items are HumanML3D items (see :class:`simdiff.data.humanml3d.HumanML3D`) plus
 from __future__ import annotations
 
 import json
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from simdiff.data.augment.anchored import TARGETS, SourceAnchoredLoader, source_corpus
 from simdiff.data.humanml3d import HumanML3D
 from simdiff.errors import SimdiffError
 from simdiff.motion.normalize import Normalizer
@@ -52,11 +54,16 @@ class AugmentedHumanML3D:
         source_split: split of ``source`` to mix in.
         normalizer: default ``root``'s Mean/Std (copied from the source corpus).
         unit_length, seed: as :class:`HumanML3D`.
+        targets: ``"simulated"`` (the replays) or ``"source-anchored"`` (see :mod:`simdiff.data.augment.anchored`;
+            :attr:`anchored` counts the simulated items that get one).
+        anchor_corpus: the source corpus for source-anchored targets (default: ``root/source_corpus.json``'s path).
     """
 
     def __init__(self, root: str | Path, split: str = "train", source: str | Path | None = None,
                  source_split: str = "train", normalizer: Normalizer | None = None, unit_length: int = 4,
-                 seed: int = 0) -> None:
+                 seed: int = 0, targets: str = "simulated", anchor_corpus: str | Path | None = None) -> None:
+        if targets not in TARGETS:
+            raise SimdiffError(f"unknown targets {targets!r} (choose from {', '.join(TARGETS)})")
         self.env_table = read_env_table(root)
         self.sim = HumanML3D(root, split, normalizer=normalizer, unit_length=unit_length, seed=seed)
         self.normalizer = self.sim.normalizer
@@ -68,6 +75,15 @@ class AugmentedHumanML3D:
             self.source = HumanML3D(source, source_split, normalizer=self.normalizer, unit_length=unit_length,
                                     seed=seed + 1)
         self._twins = self._twin_groups()
+        self.targets, self.anchored = targets, 0
+        if targets == "source-anchored":
+            earth_twin = [-1 if self._is_earth(i) else (self._twins[i][0][0] if self._twins[i][0] else None)
+                          for i in range(len(self.sim.items))]
+            loader = SourceAnchoredLoader(partial(HumanML3D.load_motion, self.sim), self.sim.items,
+                                          [self.env_table[it.clip_id].get("source", it.clip_id) for it in self.sim.items],
+                                          earth_twin, source_corpus(root, anchor_corpus))
+            self.sim.load_motion = loader  # type: ignore[method-assign]
+            self.anchored = loader.anchored
 
     def _twin_groups(self) -> dict[int, tuple[list[int], list[int]]]:
         """Per simulated item: (Earth twins, other twins) — items of the same source clip with the same frames and captions."""
@@ -182,16 +198,21 @@ class ConcatItems:
 
 
 def open_training_dataset(root: str | Path | list[str | Path], split: str = "train", seed: int = 0,
-                          source: str | Path | None = None) -> HumanML3D | AugmentedHumanML3D | ConcatItems:
+                          source: str | Path | None = None, targets: str = "simulated",
+                          anchor_corpus: str | Path | None = None) -> HumanML3D | AugmentedHumanML3D | ConcatItems:
     """The dataset ``simdiff train`` should read from ``root``: augmented (with φ) when it has env.json.
 
-    ``root`` may be a list of folders (concatenated; ``source`` is mixed in once).
+    ``root`` may be a list of folders (concatenated; ``source`` is mixed in once). ``targets`` and
+    ``anchor_corpus``: as :class:`AugmentedHumanML3D` (each augmented folder's own source corpus by default).
     """
     if isinstance(root, (list, tuple)):
         if len(root) == 1:
-            return open_training_dataset(root[0], split, seed, source)
-        parts = [open_training_dataset(r, split, seed + 7 * i, source if i == 0 else None) for i, r in enumerate(root)]
+            return open_training_dataset(root[0], split, seed, source, targets, anchor_corpus)
+        parts = [open_training_dataset(r, split, seed + 7 * i, source if i == 0 else None, targets, anchor_corpus)
+                 for i, r in enumerate(root)]
         return ConcatItems(parts)
     if (Path(root) / ENV_FILE).is_file():
-        return AugmentedHumanML3D(root, split, source=source, seed=seed)
+        return AugmentedHumanML3D(root, split, source=source, seed=seed, targets=targets, anchor_corpus=anchor_corpus)
+    if targets != "simulated":
+        raise SimdiffError(f"{root}: {targets} targets need a simulator-augmented corpus (env.json)")
     return HumanML3D(root, split=split, seed=seed)
