@@ -90,6 +90,26 @@ def test_items_without_an_earth_twin_keep_the_replay(paired: tuple[Path, Path]) 
         np.testing.assert_array_equal(ds.sim.load_motion(item), plain.sim.load_motion(item))
 
 
+def test_pairs_leave_a_lone_earth_item_its_replay(paired: tuple[Path, Path]) -> None:
+    corpus, aug = paired
+    table = json.loads((aug / "env.json").read_text())
+    ids = (aug / "train.txt").read_text().split()
+    (aug / "earth_only.txt").write_text("\n".join(k for k in ids if table[k]["factor"] == "earth") + "\n")
+    plain = AugmentedHumanML3D(aug, "earth_only")
+    alone = AugmentedHumanML3D(aug, "earth_only", targets="source-anchored")
+    pairs = AugmentedHumanML3D(aug, "earth_only", targets="source-anchored-pairs")
+    assert alone.anchored == len(alone.sim.items) > 0 and pairs.anchored == 0
+    for item in pairs.sim.items:
+        np.testing.assert_array_equal(pairs.sim.load_motion(item), plain.sim.load_motion(item))
+        row = table[item.clip_id]
+        np.testing.assert_array_equal(alone.sim.load_motion(item), _raw(corpus, row["source"], item.start, item.stop))
+    # with their twins in the split, Earth items are anchored under both
+    full, full_pairs = AugmentedHumanML3D(aug, targets="source-anchored"), AugmentedHumanML3D(aug, targets="source-anchored-pairs")
+    assert full_pairs.anchored == full.anchored == len(full.sim.items)
+    for item in full.sim.items:
+        np.testing.assert_array_equal(full_pairs.sim.load_motion(item), full.sim.load_motion(item))
+
+
 def test_bad_targets_and_a_missing_source_corpus_are_one_line_errors(paired: tuple[Path, Path], tmp_path: Path) -> None:
     corpus, aug = paired
     with pytest.raises(SimdiffError, match="unknown targets 'replays'"):
@@ -129,4 +149,4 @@ def test_cli_trains_adapters_on_source_anchored_targets(paired: tuple[Path, Path
     config.write_text(json.dumps({"train": {"targets": "tracker"}}))
     assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad2")]) == 2
     err = capsys.readouterr().err
-    assert "train.targets 'tracker': choose from simulated, source-anchored" in err and err.count("\n") == 1
+    assert "train.targets 'tracker': choose from simulated, source-anchored, source-anchored-pairs" in err and err.count("\n") == 1

@@ -64,8 +64,9 @@ class TrainConfig:
         env_pairs_drift: weight μ of the twins' mean root-velocity term (needs ``env_pairs`` > 0; 0 = off):
             ``μ · (mean_t Δx̂₀_root − mean_t Δx₀_root)²`` (:func:`simdiff.diffusion.losses.twin_drift_mse`), the
             steady drift a wind gives a walker, which the per-frame pair loss weighs as a tiny part of its error.
-        targets: adapters mode: ``"simulated"`` (the simulator's replays) or ``"source-anchored"`` (the source clip
-            plus the replay's change against its Earth twin; :mod:`simdiff.data.augment.anchored`).
+        targets: adapters mode: ``"simulated"`` (the simulator's replays), ``"source-anchored"`` (the source clip
+            plus the replay's change against its Earth twin) or ``"source-anchored-pairs"`` (the same, but an Earth
+            item without twins keeps its replay); :mod:`simdiff.data.augment.anchored`.
     """
 
     mode: str = "backbone"

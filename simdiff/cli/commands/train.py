@@ -76,9 +76,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--env-pairs-drift", type=float, metavar="WEIGHT",
                    help="weight of the twins' mean root-velocity (drift) term, with --env-pairs (0 = off); see "
                         "TrainConfig.env_pairs_drift")
-    a.add_argument("--targets", choices=["simulated", "source-anchored"],
+    a.add_argument("--targets", choices=["simulated", "source-anchored", "source-anchored-pairs"],
                    help="training targets: the simulator's replays (default) or the source clip plus the replay's "
-                        "change against its Earth twin; see simdiff.data.augment.anchored")
+                        "change against its Earth twin (-pairs: Earth items without a twin keep the replay); see "
+                        "simdiff.data.augment.anchored")
     a.add_argument("--anchor-corpus", type=Path, metavar="PATH",
                    help="with --targets source-anchored: the corpus the --data folders were augmented from "
                         "(default: each folder's source_corpus.json)")

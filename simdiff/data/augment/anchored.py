@@ -27,7 +27,7 @@ from simdiff.errors import SimdiffError
 if TYPE_CHECKING:
     from simdiff.data.humanml3d import Item
 
-TARGETS: tuple[str, ...] = ("simulated", "source-anchored")
+TARGETS: tuple[str, ...] = ("simulated", "source-anchored", "source-anchored-pairs")
 """Training targets ``simdiff train adapters --targets`` accepts."""
 CONTACTS = slice(259, 263)
 """The four foot-contact channels of the 263 HumanML3D features (0 or 1)."""

@@ -54,8 +54,8 @@ class AugmentedHumanML3D:
         source_split: split of ``source`` to mix in.
         normalizer: default ``root``'s Mean/Std (copied from the source corpus).
         unit_length, seed: as :class:`HumanML3D`.
-        targets: ``"simulated"`` (the replays) or ``"source-anchored"`` (see :mod:`simdiff.data.augment.anchored`;
-            :attr:`anchored` counts the simulated items that get one).
+        targets: ``"simulated"`` (the replays), ``"source-anchored"`` or ``"source-anchored-pairs"`` (see
+            :mod:`simdiff.data.augment.anchored`; :attr:`anchored` counts the simulated items that get one).
         anchor_corpus: the source corpus for source-anchored targets (default: ``root/source_corpus.json``'s path).
     """
 
@@ -76,9 +76,16 @@ class AugmentedHumanML3D:
                                     seed=seed + 1)
         self._twins = self._twin_groups()
         self.targets, self.anchored = targets, 0
-        if targets == "source-anchored":
-            earth_twin = [-1 if self._is_earth(i) else (self._twins[i][0][0] if self._twins[i][0] else None)
-                          for i in range(len(self.sim.items))]
+        if targets != "simulated":
+            lone_earth = -1 if targets == "source-anchored" else None  # an Earth item without φ-twins
+
+            def earth_twin_of(i: int) -> int | None:
+                earth, other = self._twins[i]
+                if self._is_earth(i):
+                    return -1 if other else lone_earth
+                return earth[0] if earth else None
+
+            earth_twin = [earth_twin_of(i) for i in range(len(self.sim.items))]
             loader = SourceAnchoredLoader(partial(HumanML3D.load_motion, self.sim), self.sim.items,
                                           [self.env_table[it.clip_id].get("source", it.clip_id) for it in self.sim.items],
                                           earth_twin, source_corpus(root, anchor_corpus))
