@@ -145,6 +145,9 @@ def test_cli_trains_adapters_on_source_anchored_targets(paired: tuple[Path, Path
     n = len(AugmentedHumanML3D(aug).sim.items)
     assert f"source-anchored targets: {n} of {n} simulated items" in capsys.readouterr().out
     assert json.loads((tmp_path / "ad" / "train_config.json").read_text())["train"]["targets"] == "source-anchored"
+    notes = [p["note"] for p in json.loads((tmp_path / "ad" / "model" / "provenance.json").read_text())["trained_on"]
+             if p["what"] == "adapters"]
+    assert notes and all(n.endswith("trained on source-anchored targets") for n in notes)
     config = tmp_path / "bad.json"
     config.write_text(json.dumps({"train": {"targets": "tracker"}}))
     assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad2")]) == 2

@@ -286,7 +286,8 @@ def provenance_from_corpus(corpus_dir: str | Path, what: str = "backbone", split
 
 def training_provenance(what: str, data: Iterable[str | Path] = (), split: str = "train",
                         init: str | Path | None = None, source: str | Path | None = None,
-                        synthetic: int | None = None, adapters_init: str | Path | None = None) -> Provenance:
+                        synthetic: int | None = None, adapters_init: str | Path | None = None,
+                        data_note: str = "") -> Provenance:
     """Provenance of a ``simdiff train backbone|adapters`` run.
 
     Args:
@@ -302,6 +303,7 @@ def training_provenance(what: str, data: Iterable[str | Path] = (), split: str =
         adapters_init: ``--adapters-init``: a SimDiff folder whose adapters the run starts from; its
             ``provenance.json`` adapter entries come last (an ``unknown`` one when it has none): the data
             they were trained on counts for the licence.
+        data_note: a sentence added to the note of each ``data`` entry (e.g. the training targets used).
     """
     parts: list[TrainingData] = []
     if init is not None:
@@ -311,7 +313,10 @@ def training_provenance(what: str, data: Iterable[str | Path] = (), split: str =
     if synthetic is not None:
         parts.append(synthetic_data(what, synthetic))
     for folder in data:
-        parts += provenance_from_corpus(folder, what, split, source=source).trained_on
+        entries = provenance_from_corpus(folder, what, split, source=source).trained_on
+        for entry in entries if data_note else ():
+            entry.note = f"{entry.note}; {data_note}" if entry.note else data_note
+        parts += entries
     if source is not None:
         parts += provenance_from_corpus(source, what, split).trained_on
     if adapters_init is not None:
