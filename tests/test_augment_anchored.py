@@ -153,3 +153,5 @@ def test_cli_trains_adapters_on_source_anchored_targets(paired: tuple[Path, Path
     assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad2")]) == 2
     err = capsys.readouterr().err
     assert "train.targets 'tracker': choose from simulated, source-anchored, source-anchored-pairs" in err and err.count("\n") == 1
+    assert main(args + ["--anchor-corpus", str(tmp_path), "--out", str(tmp_path / "ad3")]) == 2
+    assert "--anchor-corpus" in capsys.readouterr().err and not (tmp_path / "ad3").exists()

@@ -158,6 +158,9 @@ def _run_config(args: argparse.Namespace):
         raise SimdiffError(f"train.targets {tc.targets!r}: choose from {', '.join(TARGETS)}")
     if tc.targets != "simulated" and args.mode != "adapters":
         raise SimdiffError(f"targets {tc.targets!r} are for `simdiff train adapters`")
+    if getattr(args, "anchor_corpus", None) is not None and tc.targets == "simulated":
+        raise SimdiffError(f"--anchor-corpus {args.anchor_corpus}: only with --targets source-anchored or "
+                           "source-anchored-pairs")
     if tc.steps < 1 or tc.batch_size < 1:
         raise SimdiffError("--steps and --batch-size must be positive")
     if args.loader_workers < 0:
