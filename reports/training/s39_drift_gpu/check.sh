@@ -5,12 +5,13 @@
 #   env PYWRAP: a script that runs benchmarks/model_check.py with a patch (session 51: s51_floor/floored.py)
 #   env FB: --env-guidance-fallback (session 52)
 #   env AA: --anchor-alpha (session 55)
+#   env ASEEDS: stage A's seeds (default "100 101"; session 56)
 #   A: selection seeds 100 101, val n 32, response on   B: val n 128 seeds 0 1, no response
 #   T: test n 256 seeds 0-4, response on                 Tq: the same without the response
 cd /work/main; . .venv/bin/activate
 S=/work/scratch/s39
 case $1 in
-  A) args="--split val --n 32 --seeds 100 101 --workers 2";;
+  A) args="--split val --n 32 --seeds ${ASEEDS:-100 101} --workers 2";;
   B) args="--split val --n 128 --seeds 0 1 --no-response";;
   T) args="--split test --n 256 --seeds 0 1 2 3 4 --workers 2";;
   Tq) args="--split test --n 256 --seeds 0 1 2 3 4 --no-response";;
