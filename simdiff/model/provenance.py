@@ -314,8 +314,9 @@ def training_provenance(what: str, data: Iterable[str | Path] = (), split: str =
         parts.append(synthetic_data(what, synthetic))
     for folder in data:
         entries = provenance_from_corpus(folder, what, split, source=source).trained_on
-        for entry in entries if data_note else ():
-            entry.note = f"{entry.note}; {data_note}" if entry.note else data_note
+        if data_note:
+            for entry in entries:
+                entry.note = f"{entry.note}; {data_note}" if entry.note else data_note
         parts += entries
     if source is not None:
         parts += provenance_from_corpus(source, what, split).trained_on

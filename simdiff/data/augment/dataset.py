@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from simdiff.data.augment.anchored import TARGETS, SourceAnchoredLoader, source_corpus
-from simdiff.data.humanml3d import HumanML3D
+from simdiff.data.humanml3d import HumanML3D, Item
 from simdiff.errors import SimdiffError
 from simdiff.motion.normalize import Normalizer
 from simdiff.sim.env import EARTH_GRAVITY
@@ -87,7 +87,7 @@ class AugmentedHumanML3D:
 
             earth_twin = [earth_twin_of(i) for i in range(len(self.sim.items))]
             loader = SourceAnchoredLoader(partial(HumanML3D.load_motion, self.sim), self.sim.items,
-                                          [self.env_table[it.clip_id].get("source", it.clip_id) for it in self.sim.items],
+                                          [self._source_id(it) for it in self.sim.items],
                                           earth_twin, source_corpus(root, anchor_corpus))
             self.sim.load_motion = loader  # type: ignore[method-assign]
             self.anchored = loader.anchored
@@ -96,8 +96,7 @@ class AugmentedHumanML3D:
         """Per simulated item: (Earth twins, other twins) — items of the same source clip with the same frames and captions."""
         groups: dict[tuple[Any, ...], list[int]] = {}
         for i, it in enumerate(self.sim.items):
-            row = self.env_table[it.clip_id]
-            key = (row.get("source", it.clip_id), it.start, it.stop, tuple(c.text for c in it.captions))
+            key = (self._source_id(it), it.start, it.stop, tuple(c.text for c in it.captions))
             groups.setdefault(key, []).append(i)
         twins: dict[int, tuple[list[int], list[int]]] = {}
         for members in groups.values():
@@ -106,6 +105,10 @@ class AugmentedHumanML3D:
                 earth = [j for j in others if self._is_earth(j)]
                 twins[i] = (earth, [j for j in others if j not in earth])
         return twins
+
+    def _source_id(self, item: Item) -> str:
+        """The source clip ``item`` was replayed from (env.json's ``source``; its own id when not recorded)."""
+        return self.env_table[item.clip_id].get("source", item.clip_id)
 
     def _is_earth(self, index: int) -> bool:
         env = self.env_table[self.sim.items[index].clip_id]["env"]
