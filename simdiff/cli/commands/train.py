@@ -199,7 +199,7 @@ def _run_config(args: argparse.Namespace):
     return config
 
 
-def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated"):
+def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated", verbose: bool = True):
     from simdiff.errors import SimdiffError
     from simdiff.train.data import synthetic_dataset
 
@@ -216,7 +216,7 @@ def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated"):
             raise SimdiffError(f"{folder}: adapters train on a simulator-augmented corpus (env.json), see `simdiff data augment`")
     dataset = open_training_dataset(list(args.data), args.split, seed, source=getattr(args, "source", None),
                                     targets=targets, anchor_corpus=getattr(args, "anchor_corpus", None))
-    if targets != "simulated":
+    if targets != "simulated" and verbose:  # one line per run, not per DDP rank
         parts = getattr(dataset, "parts", [dataset])
         anchored, simulated = sum(p.anchored for p in parts), sum(len(p.sim) for p in parts)
         print(f"{targets} targets: {anchored} of {simulated} simulated items (the rest keep the replay)")
@@ -265,7 +265,7 @@ def run(args: argparse.Namespace) -> int:
             encoder = open_caption_table(args.text_table, config.model.text_encoder, device)
         else:
             encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
-        dataset = _dataset(args, config.train.seed, config.train.targets)
+        dataset = _dataset(args, config.train.seed, config.train.targets, verbose=dist.is_main)
         trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
                           init_model=getattr(args, "init", None),
                           init_adapters=getattr(args, "adapters_init", None), rank=dist.rank,
