@@ -5,7 +5,8 @@
 #   env PYWRAP: a script that runs benchmarks/model_check.py with a patch (session 51: s51_floor/floored.py)
 #   env FB: --env-guidance-fallback (session 52)
 #   env AA: --anchor-alpha (session 55)
-#   env ASEEDS: stage A's seeds (default "100 101"; session 56)
+#   env ASEEDS: stage A's seeds (default "100 101"; session 56); they split the 16 samples per jump prompt, so more seeds
+#     do not raise n (96 jump pairs, 64 windy walks; session 57)
 #   A: selection seeds 100 101, val n 32, response on   B: val n 128 seeds 0 1, no response
 #   T: test n 256 seeds 0-4, response on                 Tq: the same without the response
 cd /work/main; . .venv/bin/activate
