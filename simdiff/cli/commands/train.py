@@ -81,8 +81,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "change against its Earth twin (-pairs: Earth items without a twin keep the replay); see "
                         "simdiff.data.augment.anchored")
     a.add_argument("--anchor-corpus", type=Path, metavar="PATH",
-                   help="with --targets source-anchored: the corpus the --data folders were augmented from "
-                        "(default: each folder's source_corpus.json)")
+                   help="with --targets source-anchored or source-anchored-pairs: the corpus the --data folders were "
+                        "augmented from (default: each folder's source_corpus.json)")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
