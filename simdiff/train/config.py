@@ -67,6 +67,9 @@ class TrainConfig:
         targets: adapters mode: ``"simulated"`` (the simulator's replays), ``"source-anchored"`` (the source clip
             plus the replay's change against its Earth twin) or ``"source-anchored-pairs"`` (the same, but an Earth
             item without twins keeps its replay); :mod:`simdiff.data.augment.anchored`.
+        twin_frames: adapters mode: ``"equal"`` (replays of one source clip are twins only with equal frames) or
+            ``"prefix"`` (trimmed to their common first frames, so replays that fly longer under low gravity are
+            paired too); :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`.
     """
 
     mode: str = "backbone"
@@ -85,6 +88,7 @@ class TrainConfig:
     env_pairs: float = 0.0
     env_pairs_drift: float = 0.0
     targets: str = "simulated"
+    twin_frames: str = "equal"
 
 
 @dataclass

@@ -83,6 +83,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--anchor-corpus", type=Path, metavar="PATH",
                    help="with --targets source-anchored or source-anchored-pairs: the corpus the --data folders were "
                         "augmented from (default: each folder's source_corpus.json)")
+    a.add_argument("--twin-frames", choices=["equal", "prefix"],
+                   help="which replays of one source clip are twins for --env-pairs: equal frames only (default) or "
+                        "all, trimmed to their common first frames (a low-gravity replay that flies longer is "
+                        "longer than its Earth twin); see TrainConfig.twin_frames")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -152,6 +156,8 @@ def _run_config(args: argparse.Namespace):
         tc.env_pairs_drift = args.env_pairs_drift
     if getattr(args, "targets", None) is not None:
         tc.targets = args.targets
+    if getattr(args, "twin_frames", None) is not None:
+        tc.twin_frames = args.twin_frames
     from simdiff.data.augment.anchored import TARGETS
 
     if tc.targets not in TARGETS:
@@ -161,6 +167,10 @@ def _run_config(args: argparse.Namespace):
     if getattr(args, "anchor_corpus", None) is not None and tc.targets == "simulated":
         raise SimdiffError(f"--anchor-corpus {args.anchor_corpus}: only with --targets source-anchored or "
                            "source-anchored-pairs")
+    if tc.twin_frames not in ("equal", "prefix"):
+        raise SimdiffError(f"train.twin_frames {tc.twin_frames!r}: choose from equal, prefix")
+    if tc.twin_frames != "equal" and args.mode != "adapters":
+        raise SimdiffError(f"twin frames {tc.twin_frames!r} are for `simdiff train adapters`")
     if tc.steps < 1 or tc.batch_size < 1:
         raise SimdiffError("--steps and --batch-size must be positive")
     if args.loader_workers < 0:
@@ -199,7 +209,8 @@ def _run_config(args: argparse.Namespace):
     return config
 
 
-def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated", verbose: bool = True):
+def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated", verbose: bool = True,
+             twin_frames: str = "equal"):
     from simdiff.errors import SimdiffError
     from simdiff.train.data import synthetic_dataset
 
@@ -215,9 +226,13 @@ def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated", ve
         if args.mode == "adapters" and not (folder / "env.json").is_file():
             raise SimdiffError(f"{folder}: adapters train on a simulator-augmented corpus (env.json), see `simdiff data augment`")
     dataset = open_training_dataset(list(args.data), args.split, seed, source=getattr(args, "source", None),
-                                    targets=targets, anchor_corpus=getattr(args, "anchor_corpus", None))
+                                    targets=targets, anchor_corpus=getattr(args, "anchor_corpus", None),
+                                    twin_frames=twin_frames)
+    parts = getattr(dataset, "parts", [dataset])
+    if twin_frames != "equal" and verbose:
+        print(f"twin frames {twin_frames}: {sum(getattr(p, 'trimmed', 0) for p in parts)} items trimmed to their "
+              "twins' common frames")
     if targets != "simulated" and verbose:  # one line per run, not per DDP rank
-        parts = getattr(dataset, "parts", [dataset])
         anchored, simulated = sum(p.anchored for p in parts), sum(len(p.sim) for p in parts)
         print(f"{targets} targets: {anchored} of {simulated} simulated items (the rest keep the replay)")
     return dataset
@@ -265,7 +280,8 @@ def run(args: argparse.Namespace) -> int:
             encoder = open_caption_table(args.text_table, config.model.text_encoder, device)
         else:
             encoder = load_text_encoder(config.model.text_encoder, device, args.clip_weights)
-        dataset = _dataset(args, config.train.seed, config.train.targets, verbose=dist.is_main)
+        dataset = _dataset(args, config.train.seed, config.train.targets, verbose=dist.is_main,
+                           twin_frames=config.train.twin_frames)
         trainer = Trainer(args.out, config, dataset, text_encoder=encoder, device=device,
                           init_model=getattr(args, "init", None),
                           init_adapters=getattr(args, "adapters_init", None), rank=dist.rank,

@@ -11,6 +11,7 @@ Items are HumanML3D items (see :class:`simdiff.data.humanml3d.HumanML3D`) plus
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from functools import partial
 from pathlib import Path
@@ -22,11 +23,14 @@ from simdiff.data.augment.anchored import TARGETS, SourceAnchoredLoader, source_
 from simdiff.data.humanml3d import HumanML3D, Item
 from simdiff.errors import SimdiffError
 from simdiff.motion.normalize import Normalizer
+from simdiff.motion.skeleton import MIN_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY
 
 ENV_FILE = "env.json"
 SOURCE_INDEX: int = 0
 """``env_index`` of source (non-simulated) clips."""
+TWIN_FRAMES: tuple[str, ...] = ("equal", "prefix")
+"""How replays of one source clip are made twins: ``equal`` frames only, or trimmed to their common ``prefix``."""
 
 
 def read_env_table(root: str | Path) -> dict[str, dict[str, Any]]:
@@ -57,19 +61,31 @@ class AugmentedHumanML3D:
         targets: ``"simulated"`` (the replays), ``"source-anchored"`` or ``"source-anchored-pairs"`` (see
             :mod:`simdiff.data.augment.anchored`; :attr:`anchored` counts the simulated items that get one).
         anchor_corpus: the source corpus for source-anchored targets (default: ``root/source_corpus.json``'s path).
+        twin_frames: ``"equal"``: items of one source clip, start and captions are twins only when their replays
+            have the same frames. ``"prefix"``: such items are all trimmed to their shortest replay's frames and
+            are twins. A low-gravity rollout is longer than its Earth twin (the flight clock waits while the body
+            flies longer: :mod:`simdiff.sim.rollout`), so under ``"equal"`` the replays that fly longer have no twin
+            and the paired loss sees mostly replays that did not change (session 58: 116 of 712 low-gravity items
+            of a jump augmentation had a twin, median apex change 0.000 m; the 596 others +0.48 m). The trim keeps
+            the frames both replays share from the start, where they track the same reference frames until the
+            first flight; a twin group whose shortest replay is under the corpus's minimum clip length is left as is.
     """
 
     def __init__(self, root: str | Path, split: str = "train", source: str | Path | None = None,
                  source_split: str = "train", normalizer: Normalizer | None = None, unit_length: int = 4,
-                 seed: int = 0, targets: str = "simulated", anchor_corpus: str | Path | None = None) -> None:
+                 seed: int = 0, targets: str = "simulated", anchor_corpus: str | Path | None = None,
+                 twin_frames: str = "equal") -> None:
         if targets not in TARGETS:
             raise SimdiffError(f"unknown targets {targets!r} (choose from {', '.join(TARGETS)})")
+        if twin_frames not in TWIN_FRAMES:
+            raise SimdiffError(f"unknown twin frames {twin_frames!r} (choose from {', '.join(TWIN_FRAMES)})")
         self.env_table = read_env_table(root)
         self.sim = HumanML3D(root, split, normalizer=normalizer, unit_length=unit_length, seed=seed)
         self.normalizer = self.sim.normalizer
         missing = [it.clip_id for it in self.sim.items if it.clip_id not in self.env_table]
         if missing:
             raise SimdiffError(f"{Path(root) / ENV_FILE}: no φ for clip {missing[0]!r}")
+        self.trimmed = self._trim_to_common_prefix() if twin_frames == "prefix" else 0
         self.source = None
         if source is not None:
             self.source = HumanML3D(source, source_split, normalizer=self.normalizer, unit_length=unit_length,
@@ -91,6 +107,22 @@ class AugmentedHumanML3D:
                                           earth_twin, source_corpus(root, anchor_corpus))
             self.sim.load_motion = loader  # type: ignore[method-assign]
             self.anchored = loader.anchored
+
+    def _trim_to_common_prefix(self) -> int:
+        """Trim the items of each (source clip, start, captions) group to the group's shortest; returns how many changed."""
+        groups: dict[tuple[Any, ...], list[int]] = {}
+        for i, it in enumerate(self.sim.items):
+            groups.setdefault((self._source_id(it), it.start, tuple(it.captions)), []).append(i)
+        changed = 0
+        for members in groups.values():
+            stop = min(self.sim.items[i].stop for i in members)
+            if len(members) < 2 or stop - self.sim.items[members[0]].start < MIN_FRAMES:
+                continue
+            for i in members:
+                if self.sim.items[i].stop != stop:
+                    self.sim.items[i] = dataclasses.replace(self.sim.items[i], stop=stop)
+                    changed += 1
+        return changed
 
     def _twin_groups(self) -> dict[int, tuple[list[int], list[int]]]:
         """Per simulated item: (Earth twins, other twins) — items of the same source clip with the same frames and captions."""
@@ -209,20 +241,26 @@ class ConcatItems:
 
 def open_training_dataset(root: str | Path | list[str | Path], split: str = "train", seed: int = 0,
                           source: str | Path | None = None, targets: str = "simulated",
-                          anchor_corpus: str | Path | None = None) -> HumanML3D | AugmentedHumanML3D | ConcatItems:
+                          anchor_corpus: str | Path | None = None,
+                          twin_frames: str = "equal") -> HumanML3D | AugmentedHumanML3D | ConcatItems:
     """The dataset ``simdiff train`` should read from ``root``: augmented (with φ) when it has env.json.
 
     ``root`` may be a list of folders (concatenated; ``source`` is mixed in once). ``targets`` and
-    ``anchor_corpus``: as :class:`AugmentedHumanML3D` (each augmented folder's own source corpus by default).
+    ``anchor_corpus`` and ``twin_frames``: as :class:`AugmentedHumanML3D` (each augmented folder's own source corpus
+    by default).
     """
     if isinstance(root, (list, tuple)):
         if len(root) == 1:
-            return open_training_dataset(root[0], split, seed, source, targets, anchor_corpus)
-        parts = [open_training_dataset(r, split, seed + 7 * i, source if i == 0 else None, targets, anchor_corpus)
+            return open_training_dataset(root[0], split, seed, source, targets, anchor_corpus, twin_frames)
+        parts = [open_training_dataset(r, split, seed + 7 * i, source if i == 0 else None, targets, anchor_corpus,
+                                       twin_frames)
                  for i, r in enumerate(root)]
         return ConcatItems(parts)
     if (Path(root) / ENV_FILE).is_file():
-        return AugmentedHumanML3D(root, split, source=source, seed=seed, targets=targets, anchor_corpus=anchor_corpus)
+        return AugmentedHumanML3D(root, split, source=source, seed=seed, targets=targets, anchor_corpus=anchor_corpus,
+                                  twin_frames=twin_frames)
+    if twin_frames != "equal":
+        raise SimdiffError(f"{root}: twin frames {twin_frames!r} need a simulator-augmented corpus (env.json)")
     if targets != "simulated":
         raise SimdiffError(f"{root}: {targets} targets need a simulator-augmented corpus (env.json)")
     return HumanML3D(root, split=split, seed=seed)
