@@ -23,7 +23,6 @@ from simdiff.data.augment.anchored import TARGETS, SourceAnchoredLoader, source_
 from simdiff.data.humanml3d import HumanML3D, Item
 from simdiff.errors import SimdiffError
 from simdiff.motion.normalize import Normalizer
-from simdiff.motion.skeleton import MIN_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY
 
 ENV_FILE = "env.json"
@@ -68,7 +67,7 @@ class AugmentedHumanML3D:
             and the paired loss sees mostly replays that did not change (session 58: 116 of 712 low-gravity items
             of a jump augmentation had a twin, median apex change 0.000 m; the 596 others +0.48 m). The trim keeps
             the frames both replays share from the start, where they track the same reference frames until the
-            first flight; a twin group whose shortest replay is under the corpus's minimum clip length is left as is.
+            first flight.
     """
 
     def __init__(self, root: str | Path, split: str = "train", source: str | Path | None = None,
@@ -115,9 +114,7 @@ class AugmentedHumanML3D:
             groups.setdefault((self._source_id(it), it.start, tuple(it.captions)), []).append(i)
         changed = 0
         for members in groups.values():
-            stop = min(self.sim.items[i].stop for i in members)
-            if len(members) < 2 or stop - self.sim.items[members[0]].start < MIN_FRAMES:
-                continue
+            stop = min(self.sim.items[i].stop for i in members)  # items are built with >= 40 frames: so is the trim
             for i in members:
                 if self.sim.items[i].stop != stop:
                     self.sim.items[i] = dataclasses.replace(self.sim.items[i], stop=stop)
