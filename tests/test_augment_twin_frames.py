@@ -117,6 +117,9 @@ def test_cli_passes_twin_frames_to_the_run(uneven: tuple[Path, Path], tmp_path: 
     trimmed = AugmentedHumanML3D(aug, twin_frames="prefix").trimmed
     assert f"twin frames prefix: {trimmed} items trimmed" in capsys.readouterr().out
     assert json.loads((tmp_path / "ad" / "train_config.json").read_text())["train"]["twin_frames"] == "prefix"
+    notes = [p["note"] for p in json.loads((tmp_path / "ad" / "model" / "provenance.json").read_text())["trained_on"]
+             if p["what"] == "adapters"]
+    assert notes and all(n.endswith("paired over their common frames (--twin-frames prefix)") for n in notes)
     config = tmp_path / "bad.json"
     config.write_text(json.dumps({"train": {"twin_frames": "middle"}}))
     assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad2")]) == 2

@@ -238,14 +238,17 @@ def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated", ve
     return dataset
 
 
-def _provenance(args: argparse.Namespace, targets: str = "simulated"):
+def _provenance(args: argparse.Namespace, targets: str = "simulated", twin_frames: str = "equal"):
     """What this run trains on (``model/provenance.json``); adapters add their backbone's record."""
+    notes = [] if targets == "simulated" else [f"trained on {targets} targets"]
+    if twin_frames != "equal":
+        notes.append(f"twins of unequal length paired over their common frames (--twin-frames {twin_frames})")
     from simdiff.model.provenance import Provenance, read_provenance, training_provenance, unknown_data
 
     init = getattr(args, "init", None)
     prov = training_provenance(args.mode, args.data or (), args.split, init=init, source=getattr(args, "source", None),
                                synthetic=args.synthetic, adapters_init=getattr(args, "adapters_init", None),
-                               data_note="" if targets == "simulated" else f"trained on {targets} targets")
+                               data_note="; ".join(notes))
     if args.mode == "adapters" and init is None:  # resuming: keep the backbone entries written before
         earlier = read_provenance(args.out / "model")
         backbone = [p for p in earlier.trained_on if p.what == "backbone"] if earlier is not None else []
@@ -286,7 +289,8 @@ def run(args: argparse.Namespace) -> int:
                           init_model=getattr(args, "init", None),
                           init_adapters=getattr(args, "adapters_init", None), rank=dist.rank,
                           world_size=dist.world_size,
-                          provenance=_provenance(args, config.train.targets), loader_workers=args.loader_workers)
+                          provenance=_provenance(args, config.train.targets, config.train.twin_frames),
+                          loader_workers=args.loader_workers)
         losses = trainer.train_for(args.max_minutes, progress=not args.no_progress)
         if dist.is_main:
             tail = losses[-10:]
