@@ -125,3 +125,10 @@ def test_cli_passes_twin_frames_to_the_run(uneven: tuple[Path, Path], tmp_path: 
     assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad2")]) == 2
     err = capsys.readouterr().err
     assert "train.twin_frames 'middle': choose from equal, prefix" in err and err.count("\n") == 1
+    config.write_text(json.dumps({"train": {"drift_pairs": "gusts"}}))
+    assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad3")]) == 2
+    err = capsys.readouterr().err
+    assert "train.drift_pairs 'gusts': choose from all, wind" in err and err.count("\n") == 1
+    assert main(args + ["--twin-frames", "prefix", "--drift-pairs", "wind", "--env-pairs-drift", "1",
+                        "--out", str(tmp_path / "ad4")]) == 0
+    assert json.loads((tmp_path / "ad4" / "train_config.json").read_text())["train"]["drift_pairs"] == "wind"

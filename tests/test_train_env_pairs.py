@@ -272,3 +272,29 @@ def test_drift_term_trains_and_changes_the_run(tmp_path: Path) -> None:
         losses[name] = trainer.train(progress=False)
     assert all(np.isfinite(losses["drift"]))
     assert losses["drift"][0] > losses["pairs"][0]  # the same first batch, one more non-negative term
+
+
+class GravityTwins(ShiftTwins):
+    """ShiftTwins whose φ differ in gravity only: (−9.81 + g_k, 0, 0) with the same shifted motions."""
+
+    def get(self, index: int, rng: np.random.Generator | None = None) -> dict[str, Any]:
+        item = super().get(index, rng)
+        item["env"] = np.array([-9.81 + abs(float(item["env"][1])) / 2.0, 0.0, 0.0], dtype=np.float32)
+        return item
+
+
+def test_drift_pairs_wind_leaves_gravity_twins_out_of_the_drift_term(tmp_path: Path) -> None:
+    bb = _backbone(tmp_path)
+    losses = {}
+    for ds_name, ds in (("gravity", GravityTwins()), ("wind", ShiftTwins())):
+        for name, mu, which in (("off", 0.0, "all"), ("all", 100.0, "all"), ("wind", 100.0, "wind")):
+            cfg = run_config(2, mode="adapters", sim=True, env_pairs=10.0, env_pairs_drift=mu, drift_pairs=which,
+                             batch_size=6, seed=4)
+            trainer = Trainer(tmp_path / f"{ds_name}_{name}", cfg, ds, text_encoder=HashText(), init_model=bb)
+            losses[ds_name, name] = trainer.train(progress=False)
+    assert losses["gravity", "all"][0] > losses["gravity", "off"][0]  # gravity twins drift apart: the term counts them
+    assert losses["gravity", "wind"] == losses["gravity", "off"]  # ... but not under drift_pairs "wind"
+    assert losses["wind", "wind"] == losses["wind", "all"]  # wind twins are in it either way
+    with pytest.raises(SimdiffError, match="drift_pairs must be 'all' or 'wind', got 'gusts'"):
+        Trainer(tmp_path / "bad", run_config(2, mode="adapters", sim=True, env_pairs=1.0, drift_pairs="gusts"),
+                ShiftTwins(), text_encoder=HashText(), init_model=bb)

@@ -67,6 +67,10 @@ class TrainConfig:
         targets: adapters mode: ``"simulated"`` (the simulator's replays), ``"source-anchored"`` (the source clip
             plus the replay's change against its Earth twin) or ``"source-anchored-pairs"`` (the same, but an Earth
             item without twins keeps its replay); :mod:`simdiff.data.augment.anchored`.
+        drift_pairs: which twins the drift term (``env_pairs_drift``) compares: ``"all"`` or ``"wind"`` (only twins
+            whose φ differ in wind). Paired over their common frames (``twin_frames="prefix"``), low-gravity twins
+            differ in mean root velocity 4–13× as much as wind twins (their longer flights lag behind), which
+            swamps the wind's drift (session 58).
         twin_frames: adapters mode: ``"equal"`` (replays of one source clip are twins only with equal frames) or
             ``"prefix"`` (trimmed to their common first frames, so replays that fly longer under low gravity are
             paired too); :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`.
@@ -89,6 +93,7 @@ class TrainConfig:
     env_pairs_drift: float = 0.0
     targets: str = "simulated"
     twin_frames: str = "equal"
+    drift_pairs: str = "all"
 
 
 @dataclass

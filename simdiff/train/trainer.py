@@ -99,6 +99,8 @@ class Trainer:
             raise SimdiffError(f"env_pairs_drift must be a finite weight >= 0, got {tc.env_pairs_drift}")
         if tc.env_pairs_drift > 0 and not tc.env_pairs > 0:
             raise SimdiffError(f"env_pairs_drift = {tc.env_pairs_drift} needs env_pairs > 0 (the drift term compares twins)")
+        if tc.drift_pairs not in ("all", "wind"):
+            raise SimdiffError(f"drift_pairs must be 'all' or 'wind', got {tc.drift_pairs!r}")
         if tc.env_pairs > 0 and tc.mode != "adapters":
             raise SimdiffError(f"env_pairs = {tc.env_pairs} needs adapters mode (the φ-difference loss trains the adapters)")
         with torch.random.fork_rng(devices=[]):
@@ -275,6 +277,9 @@ class Trainer:
             paired = batch["paired"].to(self.device)
             loss = loss + tc.env_pairs * self._pair_loss(pred, x0, mask, paired)
             if tc.env_pairs_drift > 0:
+                if tc.drift_pairs == "wind" and "env" in batch:  # only twins whose φ differ in wind
+                    env, h = batch["env"], x0.shape[0] // 2
+                    paired = paired & (env[:h, 1:] != env[h:, 1:]).any(dim=-1).to(self.device)
                 loss = loss + tc.env_pairs_drift * twin_drift_mse(pred, x0, mask, paired)
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()

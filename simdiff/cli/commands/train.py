@@ -87,6 +87,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="which replays of one source clip are twins for --env-pairs: equal frames only (default) or "
                         "all, trimmed to their common first frames (a low-gravity replay that flies longer is "
                         "longer than its Earth twin); see TrainConfig.twin_frames")
+    a.add_argument("--drift-pairs", choices=["all", "wind"],
+                   help="which twins the drift term (--env-pairs-drift) compares: all (default) or only those whose "
+                        "phi differ in wind; see TrainConfig.drift_pairs")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -158,6 +161,8 @@ def _run_config(args: argparse.Namespace):
         tc.targets = args.targets
     if getattr(args, "twin_frames", None) is not None:
         tc.twin_frames = args.twin_frames
+    if getattr(args, "drift_pairs", None) is not None:
+        tc.drift_pairs = args.drift_pairs
     from simdiff.data.augment.anchored import TARGETS
 
     if tc.targets not in TARGETS:
@@ -169,6 +174,8 @@ def _run_config(args: argparse.Namespace):
                            "source-anchored-pairs")
     if tc.twin_frames not in ("equal", "prefix"):
         raise SimdiffError(f"train.twin_frames {tc.twin_frames!r}: choose from equal, prefix")
+    if tc.drift_pairs not in ("all", "wind"):
+        raise SimdiffError(f"train.drift_pairs {tc.drift_pairs!r}: choose from all, wind")
     if tc.twin_frames != "equal" and args.mode != "adapters":
         raise SimdiffError(f"twin frames {tc.twin_frames!r} are for `simdiff train adapters`")
     if tc.steps < 1 or tc.batch_size < 1:
