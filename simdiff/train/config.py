@@ -26,6 +26,8 @@ class OptimConfig:
 
 
 LR_SCHEDULES: tuple[str, ...] = ("constant", "cosine")
+DRIFT_PAIRS: tuple[str, ...] = ("all", "wind")
+"""Which twins the drift term compares (``TrainConfig.drift_pairs``)."""
 """Names :attr:`OptimConfig.lr_schedule` accepts."""
 
 

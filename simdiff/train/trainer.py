@@ -29,7 +29,7 @@ from simdiff.model.condition import Condition
 from simdiff.model.provenance import Provenance, write_provenance
 from simdiff.model.simdiff_net import SimDiffNet
 from simdiff.text.cache import CachedTextEncoder
-from simdiff.train.config import RunConfig, lr_at
+from simdiff.train.config import DRIFT_PAIRS, RunConfig, lr_at
 from simdiff.train.data import MotionDataset, StepBatcher, StepBatches
 from simdiff.train.ema import EMA
 from simdiff.train.geometric import geometric_loss
@@ -99,7 +99,7 @@ class Trainer:
             raise SimdiffError(f"env_pairs_drift must be a finite weight >= 0, got {tc.env_pairs_drift}")
         if tc.env_pairs_drift > 0 and not tc.env_pairs > 0:
             raise SimdiffError(f"env_pairs_drift = {tc.env_pairs_drift} needs env_pairs > 0 (the drift term compares twins)")
-        if tc.drift_pairs not in ("all", "wind"):
+        if tc.drift_pairs not in DRIFT_PAIRS:
             raise SimdiffError(f"drift_pairs must be 'all' or 'wind', got {tc.drift_pairs!r}")
         if tc.env_pairs > 0 and tc.mode != "adapters":
             raise SimdiffError(f"env_pairs = {tc.env_pairs} needs adapters mode (the φ-difference loss trains the adapters)")

@@ -164,6 +164,8 @@ def _run_config(args: argparse.Namespace):
     if getattr(args, "drift_pairs", None) is not None:
         tc.drift_pairs = args.drift_pairs
     from simdiff.data.augment.anchored import TARGETS
+    from simdiff.data.augment.dataset import TWIN_FRAMES
+    from simdiff.train.config import DRIFT_PAIRS
 
     if tc.targets not in TARGETS:
         raise SimdiffError(f"train.targets {tc.targets!r}: choose from {', '.join(TARGETS)}")
@@ -172,10 +174,10 @@ def _run_config(args: argparse.Namespace):
     if getattr(args, "anchor_corpus", None) is not None and tc.targets == "simulated":
         raise SimdiffError(f"--anchor-corpus {args.anchor_corpus}: only with --targets source-anchored or "
                            "source-anchored-pairs")
-    if tc.twin_frames not in ("equal", "prefix"):
-        raise SimdiffError(f"train.twin_frames {tc.twin_frames!r}: choose from equal, prefix")
-    if tc.drift_pairs not in ("all", "wind"):
-        raise SimdiffError(f"train.drift_pairs {tc.drift_pairs!r}: choose from all, wind")
+    if tc.twin_frames not in TWIN_FRAMES:
+        raise SimdiffError(f"train.twin_frames {tc.twin_frames!r}: choose from {', '.join(TWIN_FRAMES)}")
+    if tc.drift_pairs not in DRIFT_PAIRS:
+        raise SimdiffError(f"train.drift_pairs {tc.drift_pairs!r}: choose from {', '.join(DRIFT_PAIRS)}")
     if tc.twin_frames != "equal" and args.mode != "adapters":
         raise SimdiffError(f"twin frames {tc.twin_frames!r} are for `simdiff train adapters`")
     if tc.steps < 1 or tc.batch_size < 1:
