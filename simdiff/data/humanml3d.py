@@ -171,8 +171,8 @@ def crop_length(length: int, unit_length: int, rng: np.random.Generator) -> int:
 class HumanML3D(Dataset):
     """HumanML3D text-motion pairs as MDM feeds them to training and evaluation.
 
-    Each item is ``dict(motion (196, 263) float32 normalised and zero-padded, length int,
-    caption str, tokens list[str], id str)``.
+    Each item is ``dict(motion (196, 263) float32 normalised and zero-padded, length int, offset int (the crop's
+    first frame within the item), caption str, tokens list[str], id str)``.
 
     Args:
         root: the HumanML3D directory.
@@ -210,6 +210,7 @@ class HumanML3D(Dataset):
         self.normalizer = normalizer if normalizer is not None else Normalizer.from_dir(self.root)
         self.unit_length = unit_length
         self.max_frames = max_frames
+        self.random_offset = True  # False: every crop starts at the item's first frame (twins stay aligned)
         self.seed = seed
         self.items = build_items(self.root, ids, min_frames)
         self._rng: np.random.Generator | None = None
@@ -244,7 +245,7 @@ class HumanML3D(Dataset):
         if self.unit_length:
             length = crop_length(length, self.unit_length, rng)
         length = min(length, self.max_frames)
-        offset = int(rng.integers(len(motion) - length + 1))
+        offset = int(rng.integers(len(motion) - length + 1)) if self.random_offset else 0
         out = np.zeros((self.max_frames, FEATURE_DIM), dtype=np.float32)
         out[:length] = self.normalizer.normalize(motion[offset : offset + length])
         return {
@@ -253,6 +254,7 @@ class HumanML3D(Dataset):
             "caption": caption.text,
             "tokens": list(caption.tokens),
             "id": item.name,
+            "offset": offset,
         }
 
     def __getitem__(self, index: int) -> dict[str, Any]:

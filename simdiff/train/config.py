@@ -73,9 +73,11 @@ class TrainConfig:
             whose φ differ in wind). Paired over their common frames (``twin_frames="prefix"``), low-gravity twins
             differ in mean root velocity 4–13× as much as wind twins (their longer flights lag behind), which
             swamps the wind's drift (session 58).
-        twin_frames: adapters mode: ``"equal"`` (replays of one source clip are twins only with equal frames) or
+        twin_frames: adapters mode: ``"equal"`` (replays of one source clip are twins only with equal frames),
             ``"prefix"`` (trimmed to their common first frames, so replays that fly longer under low gravity are
-            paired too); :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`.
+            paired too) or ``"overlap"`` (kept whole, cropped from their first frames and compared over the frames
+            they share, so a longer flight and its landing stay in the target);
+            :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`.
     """
 
     mode: str = "backbone"

@@ -138,6 +138,14 @@ def synthetic_dataset(num_clips: int = 8, frames: int = 60, max_frames: int = 19
     return TensorMotionDataset(motions, captions, envs if with_env else None, max_frames=max_frames)
 
 
+def _aligned(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Whether two twins' frames line up: equal lengths (one crop for both), or both cropped from their first frame
+    (twins of unequal length, ``twin_frames="overlap"``: compared over the frames they share)."""
+    if int(a["length"]) == int(b["length"]):
+        return True
+    return a.get("offset", -1) == 0 and b.get("offset", -1) == 0
+
+
 class StepBatches(torch.utils.data.Dataset):
     """The collated, cropped batches of steps ``start .. end - 1`` of a run, item ``i`` being step ``start + i``.
 
@@ -179,7 +187,7 @@ class StepBatches(torch.utils.data.Dataset):
             first.append(fetch(self.dataset, index, np.random.default_rng([self.seed, step, self.rank, j, 0])))
             second.append(fetch(self.dataset, index if twin is None else twin,
                                 np.random.default_rng([self.seed, step, self.rank, j, 0])))
-            paired.append(twin is not None and int(first[-1]["length"]) == int(second[-1]["length"]))
+            paired.append(twin is not None and _aligned(first[-1], second[-1]))
         batch = crop_batch(collate(first + second), self.crop, rng, pairs=len(anchors))
         batch["paired"] = torch.tensor(paired, dtype=torch.bool)
         return batch

@@ -63,7 +63,8 @@ class CropConfig:
 def crop_batch(batch: dict[str, Any], config: CropConfig, rng: np.random.Generator, pairs: int = 0) -> dict[str, Any]:
     """Apply ``config`` to a collated batch (motion (B, T, F), lengths, mask) in place; returns it.
 
-    ``pairs`` = h > 0: items ``i`` and ``i + h`` (i < h) are twins of equal length and get the same window.
+    ``pairs`` = h > 0: items ``i`` and ``i + h`` (i < h) are twins and get the same window start, drawn over the
+    frames they share (twins of unequal length start at their first frames: ``twin_frames="overlap"``).
     """
     if not config.active:
         return batch
@@ -75,16 +76,18 @@ def crop_batch(batch: dict[str, Any], config: CropConfig, rng: np.random.Generat
         offsets: dict[int, int] = {}
         full = lengths.tolist()
         for i, n in enumerate(full):
-            if n > cap:
-                twin_of = i - pairs if pairs and i >= pairs else -1
-                if twin_of >= 0 and twin_of in offsets and full[twin_of] == n:
-                    off = offsets[twin_of]
-                else:
-                    off = int(rng.integers(n - cap + 1))
-                offsets[i] = off
-                motion[i, :cap] = motion[i, off: off + cap].clone()
-                motion[i, cap:] = 0.0
-                lengths[i] = cap
+            twin_of = i - pairs if pairs and i >= pairs else -1
+            if twin_of >= 0 and twin_of in offsets:
+                off = offsets[twin_of]  # the window its twin got (0 when the shared frames fit in one)
+            else:
+                twin = i + pairs if pairs and i < pairs else -1
+                common = n if twin < 0 else min(n, full[twin])
+                off = offsets[i] = int(rng.integers(common - cap + 1)) if common > cap else 0
+            if n > cap or off:
+                window = motion[i, off: off + min(cap, n - off)].clone()
+                motion[i] = 0.0
+                motion[i, : len(window)] = window
+                lengths[i] = len(window)
         width = min(width, cap)
     if config.trim_padding:
         width = min(width, int(-(-int(lengths.max()) // 4) * 4))

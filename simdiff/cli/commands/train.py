@@ -83,10 +83,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--anchor-corpus", type=Path, metavar="PATH",
                    help="with --targets source-anchored or source-anchored-pairs: the corpus the --data folders were "
                         "augmented from (default: each folder's source_corpus.json)")
-    a.add_argument("--twin-frames", choices=["equal", "prefix"],
-                   help="which replays of one source clip are twins for --env-pairs: equal frames only (default) or "
-                        "all, trimmed to their common first frames (a low-gravity replay that flies longer is "
-                        "longer than its Earth twin); see TrainConfig.twin_frames")
+    a.add_argument("--twin-frames", choices=["equal", "prefix", "overlap"],
+                   help="which replays of one source clip are twins for --env-pairs: equal frames only (default), "
+                        "all trimmed to their common first frames (prefix), or all kept whole and compared over the "
+                        "frames they share (overlap); a low-gravity replay that flies longer is longer than its "
+                        "Earth twin; see TrainConfig.twin_frames")
     a.add_argument("--drift-pairs", choices=["all", "wind"],
                    help="which twins the drift term (--env-pairs-drift) compares: all (default) or only those whose "
                         "phi differ in wind; see TrainConfig.drift_pairs")
@@ -238,9 +239,12 @@ def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated", ve
                                     targets=targets, anchor_corpus=getattr(args, "anchor_corpus", None),
                                     twin_frames=twin_frames)
     parts = getattr(dataset, "parts", [dataset])
-    if twin_frames != "equal" and verbose:
-        print(f"twin frames {twin_frames}: {sum(getattr(p, 'trimmed', 0) for p in parts)} items trimmed to their "
+    if twin_frames == "prefix" and verbose:
+        print(f"twin frames prefix: {sum(getattr(p, 'trimmed', 0) for p in parts)} items trimmed to their "
               "twins' common frames")
+    if twin_frames == "overlap" and verbose:
+        print(f"twin frames overlap: {sum(getattr(p, 'unequal', 0) for p in parts)} items paired with a twin of "
+              "another length, over their common frames")
     if targets != "simulated" and verbose:  # one line per run, not per DDP rank
         anchored, simulated = sum(p.anchored for p in parts), sum(len(p.sim) for p in parts)
         print(f"{targets} targets: {anchored} of {simulated} simulated items (the rest keep the replay)")

@@ -28,8 +28,9 @@ from simdiff.sim.env import EARTH_GRAVITY
 ENV_FILE = "env.json"
 SOURCE_INDEX: int = 0
 """``env_index`` of source (non-simulated) clips."""
-TWIN_FRAMES: tuple[str, ...] = ("equal", "prefix")
-"""How replays of one source clip are made twins: ``equal`` frames only, or trimmed to their common ``prefix``."""
+TWIN_FRAMES: tuple[str, ...] = ("equal", "prefix", "overlap")
+"""How replays of one source clip are made twins: ``equal`` frames only, trimmed to their common ``prefix``, or
+kept whole and compared where they ``overlap``."""
 
 
 def read_env_table(root: str | Path) -> dict[str, dict[str, Any]]:
@@ -67,7 +68,12 @@ class AugmentedHumanML3D:
             and the paired loss sees mostly replays that did not change (session 58: 116 of 712 low-gravity items
             of a jump augmentation had a twin, median apex change 0.000 m; the 596 others +0.48 m). The trim keeps
             the frames both replays share from the start, where they track the same reference frames until the
-            first flight.
+            first flight. ``"overlap"``: such items are twins and keep their own frames; every crop starts at the
+            item's first frame, so twins are aligned and the paired loss compares the frames they share
+            (:func:`simdiff.diffusion.losses.twin_difference_mse` masks to them), while a longer low-gravity replay
+            keeps its whole flight and landing as a target (source-anchored:
+            :func:`simdiff.data.augment.anchored.anchor_overlap`). :attr:`unequal` counts the items with a twin of
+            another length.
     """
 
     def __init__(self, root: str | Path, split: str = "train", source: str | Path | None = None,
@@ -84,12 +90,17 @@ class AugmentedHumanML3D:
         missing = [it.clip_id for it in self.sim.items if it.clip_id not in self.env_table]
         if missing:
             raise SimdiffError(f"{Path(root) / ENV_FILE}: no φ for clip {missing[0]!r}")
+        self.twin_frames = twin_frames
         self.trimmed = self._trim_to_common_prefix() if twin_frames == "prefix" else 0
+        if twin_frames == "overlap":
+            self.sim.random_offset = False
         self.source = None
         if source is not None:
             self.source = HumanML3D(source, source_split, normalizer=self.normalizer, unit_length=unit_length,
                                     seed=seed + 1)
         self._twins = self._twin_groups()
+        self.unequal = sum(any(self.sim.items[j].length != self.sim.items[i].length for j in earth + other)
+                           for i, (earth, other) in self._twins.items())
         self.targets, self.anchored = targets, 0
         if targets != "simulated":
             lone_earth = -1 if targets == "source-anchored" else None  # an Earth item without φ-twins
@@ -103,7 +114,8 @@ class AugmentedHumanML3D:
             earth_twin = [earth_twin_of(i) for i in range(len(self.sim.items))]
             loader = SourceAnchoredLoader(partial(HumanML3D.load_motion, self.sim), self.sim.items,
                                           [self._source_id(it) for it in self.sim.items],
-                                          earth_twin, source_corpus(root, anchor_corpus))
+                                          earth_twin, source_corpus(root, anchor_corpus),
+                                          overlap=twin_frames == "overlap")
             self.sim.load_motion = loader  # type: ignore[method-assign]
             self.anchored = loader.anchored
 
@@ -122,10 +134,12 @@ class AugmentedHumanML3D:
         return changed
 
     def _twin_groups(self) -> dict[int, tuple[list[int], list[int]]]:
-        """Per simulated item: (Earth twins, other twins) — items of the same source clip with the same frames and captions."""
+        """Per simulated item: (Earth twins, other twins) — items of the same source clip with the same frames (any
+        last frame under ``twin_frames="overlap"``) and captions."""
         groups: dict[tuple[Any, ...], list[int]] = {}
         for i, it in enumerate(self.sim.items):
-            key = (self._source_id(it), it.start, it.stop, tuple(c.text for c in it.captions))
+            stop = None if self.twin_frames == "overlap" else it.stop
+            key = (self._source_id(it), it.start, stop, tuple(c.text for c in it.captions))
             groups.setdefault(key, []).append(i)
         twins: dict[int, tuple[list[int], list[int]]] = {}
         for members in groups.values():
