@@ -241,6 +241,10 @@ def test_cli_passes_twin_frames_to_the_run(uneven: tuple[Path, Path], tmp_path: 
     assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad3")]) == 2
     err = capsys.readouterr().err
     assert "train.drift_pairs 'gusts': choose from all, wind" in err and err.count("\n") == 1
+    config.write_text(json.dumps({"train": {"pair_twins": "gusts"}}))
+    assert main(args + ["--config", str(config), "--out", str(tmp_path / "ad3b")]) == 2
+    err = capsys.readouterr().err
+    assert "train.pair_twins 'gusts': choose from all, wind" in err and err.count("\n") == 1
     assert main(args + ["--twin-frames", "prefix", "--drift-pairs", "wind", "--env-pairs-drift", "1",
                         "--out", str(tmp_path / "ad4")]) == 0
     capsys.readouterr()
@@ -248,4 +252,6 @@ def test_cli_passes_twin_frames_to_the_run(uneven: tuple[Path, Path], tmp_path: 
     unequal = AugmentedHumanML3D(aug, twin_frames="overlap").unequal
     assert f"twin frames overlap: {unequal} items paired with a twin of another length" in capsys.readouterr().out
     assert json.loads((tmp_path / "ad5" / "train_config.json").read_text())["train"]["twin_frames"] == "overlap"
+    assert main(args + ["--pair-twins", "wind", "--out", str(tmp_path / "ad6")]) == 0
+    assert json.loads((tmp_path / "ad6" / "train_config.json").read_text())["train"]["pair_twins"] == "wind"
     assert json.loads((tmp_path / "ad4" / "train_config.json").read_text())["train"]["drift_pairs"] == "wind"

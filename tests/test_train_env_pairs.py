@@ -283,6 +283,23 @@ class GravityTwins(ShiftTwins):
         return item
 
 
+def test_pair_twins_wind_leaves_gravity_twins_out_of_the_paired_loss(tmp_path: Path) -> None:
+    bb = _backbone(tmp_path)
+    losses = {}
+    for ds_name, ds in (("gravity", GravityTwins()), ("wind", ShiftTwins())):
+        for name, lam, which in (("all", 10.0, "all"), ("wind", 10.0, "wind"), ("wind_big", 1000.0, "wind")):
+            cfg = run_config(2, mode="adapters", sim=True, env_pairs=lam, pair_twins=which, batch_size=6, seed=4)
+            trainer = Trainer(tmp_path / f"p_{ds_name}_{name}", cfg, ds, text_encoder=HashText(), init_model=bb)
+            losses[ds_name, name] = trainer.train(progress=False)
+    assert losses["gravity", "all"][0] > losses["gravity", "wind"][0]  # gravity twins' difference counts under "all"
+    assert losses["gravity", "wind"] == losses["gravity", "wind_big"]  # ... and not at all under "wind"
+    assert losses["wind", "wind"] == losses["wind", "all"]  # wind twins are in it either way
+    assert losses["wind", "wind_big"][0] > losses["wind", "wind"][0]
+    with pytest.raises(SimdiffError, match="pair_twins must be 'all' or 'wind', got 'gusts'"):
+        Trainer(tmp_path / "bad_p", run_config(2, mode="adapters", sim=True, env_pairs=1.0, pair_twins="gusts"),
+                ShiftTwins(), text_encoder=HashText(), init_model=bb)
+
+
 def test_drift_pairs_wind_leaves_gravity_twins_out_of_the_drift_term(tmp_path: Path) -> None:
     bb = _backbone(tmp_path)
     losses = {}

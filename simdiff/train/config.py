@@ -26,9 +26,9 @@ class OptimConfig:
 
 
 LR_SCHEDULES: tuple[str, ...] = ("constant", "cosine")
-DRIFT_PAIRS: tuple[str, ...] = ("all", "wind")
-"""Which twins the drift term compares (``TrainConfig.drift_pairs``)."""
 """Names :attr:`OptimConfig.lr_schedule` accepts."""
+DRIFT_PAIRS: tuple[str, ...] = ("all", "wind")
+"""Which twins the paired loss and the drift term compare (``TrainConfig.pair_twins``, ``TrainConfig.drift_pairs``)."""
 
 
 def lr_at(optim: OptimConfig, step: int, steps: int) -> float:
@@ -73,6 +73,10 @@ class TrainConfig:
             whose φ differ in wind). Paired over their common frames (``twin_frames="prefix"``), low-gravity twins
             differ in mean root velocity 4–13× as much as wind twins (their longer flights lag behind), which
             swamps the wind's drift (session 58).
+        pair_twins: which twins the per-frame paired loss (``env_pairs``) compares: ``"all"`` or ``"wind"`` (only
+            twins whose φ differ in wind; gravity's answer is then learnt from the plain denoising loss alone). A
+            longer low-gravity flight puts the twins out of step after its first landing; there the per-frame
+            difference cannot be told from the noise, and regressing it averages timings away (session 59).
         twin_frames: adapters mode: ``"equal"`` (replays of one source clip are twins only with equal frames),
             ``"prefix"`` (trimmed to their common first frames, so replays that fly longer under low gravity are
             paired too) or ``"overlap"`` (kept whole, cropped from their first frames and compared over the frames
@@ -98,6 +102,7 @@ class TrainConfig:
     targets: str = "simulated"
     twin_frames: str = "equal"
     drift_pairs: str = "all"
+    pair_twins: str = "all"
 
 
 @dataclass

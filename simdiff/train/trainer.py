@@ -101,6 +101,8 @@ class Trainer:
             raise SimdiffError(f"env_pairs_drift = {tc.env_pairs_drift} needs env_pairs > 0 (the drift term compares twins)")
         if tc.drift_pairs not in DRIFT_PAIRS:
             raise SimdiffError(f"drift_pairs must be 'all' or 'wind', got {tc.drift_pairs!r}")
+        if tc.pair_twins not in DRIFT_PAIRS:
+            raise SimdiffError(f"pair_twins must be 'all' or 'wind', got {tc.pair_twins!r}")
         if tc.env_pairs > 0 and tc.mode != "adapters":
             raise SimdiffError(f"env_pairs = {tc.env_pairs} needs adapters mode (the φ-difference loss trains the adapters)")
         with torch.random.fork_rng(devices=[]):
@@ -274,13 +276,14 @@ class Trainer:
         if tc.losses.active:
             loss = loss + geometric_loss(pred, x0, mask, self.mean, self.std, tc.losses)
         if "paired" in batch:
-            paired = batch["paired"].to(self.device)
-            loss = loss + tc.env_pairs * self._pair_loss(pred, x0, mask, paired)
+            paired = windy = batch["paired"].to(self.device)
+            if "env" in batch:  # twins whose φ differ in wind
+                env, h = batch["env"], x0.shape[0] // 2
+                windy = paired & (env[:h, 1:] != env[h:, 1:]).any(dim=-1).to(self.device)
+            loss = loss + tc.env_pairs * self._pair_loss(pred, x0, mask, windy if tc.pair_twins == "wind" else paired)
             if tc.env_pairs_drift > 0:
-                if tc.drift_pairs == "wind" and "env" in batch:  # only twins whose φ differ in wind
-                    env, h = batch["env"], x0.shape[0] // 2
-                    paired = paired & (env[:h, 1:] != env[h:, 1:]).any(dim=-1).to(self.device)
-                loss = loss + tc.env_pairs_drift * twin_drift_mse(pred, x0, mask, paired)
+                loss = loss + tc.env_pairs_drift * twin_drift_mse(pred, x0, mask,
+                                                                  windy if tc.drift_pairs == "wind" else paired)
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
         for group in self.optimizer.param_groups:

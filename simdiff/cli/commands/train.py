@@ -91,6 +91,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--drift-pairs", choices=["all", "wind"],
                    help="which twins the drift term (--env-pairs-drift) compares: all (default) or only those whose "
                         "phi differ in wind; see TrainConfig.drift_pairs")
+    a.add_argument("--pair-twins", choices=["all", "wind"],
+                   help="which twins the per-frame paired loss (--env-pairs) compares: all (default) or only those "
+                        "whose phi differ in wind; see TrainConfig.pair_twins")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -164,6 +167,8 @@ def _run_config(args: argparse.Namespace):
         tc.twin_frames = args.twin_frames
     if getattr(args, "drift_pairs", None) is not None:
         tc.drift_pairs = args.drift_pairs
+    if getattr(args, "pair_twins", None) is not None:
+        tc.pair_twins = args.pair_twins
     from simdiff.data.augment.anchored import TARGETS
     from simdiff.data.augment.dataset import TWIN_FRAMES
     from simdiff.train.config import DRIFT_PAIRS
@@ -179,6 +184,8 @@ def _run_config(args: argparse.Namespace):
         raise SimdiffError(f"train.twin_frames {tc.twin_frames!r}: choose from {', '.join(TWIN_FRAMES)}")
     if tc.drift_pairs not in DRIFT_PAIRS:
         raise SimdiffError(f"train.drift_pairs {tc.drift_pairs!r}: choose from {', '.join(DRIFT_PAIRS)}")
+    if tc.pair_twins not in DRIFT_PAIRS:
+        raise SimdiffError(f"train.pair_twins {tc.pair_twins!r}: choose from {', '.join(DRIFT_PAIRS)}")
     if tc.twin_frames != "equal" and args.mode != "adapters":
         raise SimdiffError(f"twin frames {tc.twin_frames!r} are for `simdiff train adapters`")
     if tc.steps < 1 or tc.batch_size < 1:
