@@ -254,4 +254,7 @@ def test_cli_passes_twin_frames_to_the_run(uneven: tuple[Path, Path], tmp_path: 
     assert json.loads((tmp_path / "ad5" / "train_config.json").read_text())["train"]["twin_frames"] == "overlap"
     assert main(args + ["--pair-twins", "wind", "--out", str(tmp_path / "ad6")]) == 0
     assert json.loads((tmp_path / "ad6" / "train_config.json").read_text())["train"]["pair_twins"] == "wind"
+    notes = [p["note"] for p in json.loads((tmp_path / "ad6" / "model" / "provenance.json").read_text())["trained_on"]
+             if p["what"] == "adapters"]
+    assert notes and all(n.endswith("per-frame paired loss on wind twins only (--pair-twins wind)") for n in notes)
     assert json.loads((tmp_path / "ad4" / "train_config.json").read_text())["train"]["drift_pairs"] == "wind"

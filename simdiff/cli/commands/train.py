@@ -258,11 +258,14 @@ def _dataset(args: argparse.Namespace, seed: int, targets: str = "simulated", ve
     return dataset
 
 
-def _provenance(args: argparse.Namespace, targets: str = "simulated", twin_frames: str = "equal"):
+def _provenance(args: argparse.Namespace, targets: str = "simulated", twin_frames: str = "equal",
+                pair_twins: str = "all"):
     """What this run trains on (``model/provenance.json``); adapters add their backbone's record."""
     notes = [] if targets == "simulated" else [f"trained on {targets} targets"]
     if twin_frames != "equal":
         notes.append(f"twins of unequal length paired over their common frames (--twin-frames {twin_frames})")
+    if pair_twins != "all":
+        notes.append(f"per-frame paired loss on {pair_twins} twins only (--pair-twins {pair_twins})")
     from simdiff.model.provenance import Provenance, read_provenance, training_provenance, unknown_data
 
     init = getattr(args, "init", None)
@@ -309,7 +312,8 @@ def run(args: argparse.Namespace) -> int:
                           init_model=getattr(args, "init", None),
                           init_adapters=getattr(args, "adapters_init", None), rank=dist.rank,
                           world_size=dist.world_size,
-                          provenance=_provenance(args, config.train.targets, config.train.twin_frames),
+                          provenance=_provenance(args, config.train.targets, config.train.twin_frames,
+                                                 config.train.pair_twins),
                           loader_workers=args.loader_workers)
         losses = trainer.train_for(args.max_minutes, progress=not args.no_progress)
         if dist.is_main:
