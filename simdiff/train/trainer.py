@@ -277,7 +277,7 @@ class Trainer:
             loss = loss + geometric_loss(pred, x0, mask, self.mean, self.std, tc.losses)
         if "paired" in batch:
             paired = windy = batch["paired"].to(self.device)
-            if "env" in batch:  # twins whose φ differ in wind
+            if "env" in batch and "wind" in (tc.pair_twins, tc.drift_pairs):  # twins whose φ differ in wind
                 env, h = batch["env"], x0.shape[0] // 2
                 windy = paired & (env[:h, 1:] != env[h:, 1:]).any(dim=-1).to(self.device)
             loss = loss + tc.env_pairs * self._pair_loss(pred, x0, mask, windy if tc.pair_twins == "wind" else paired)
