@@ -5,7 +5,7 @@ Wind: the two val walk prompts of the model check x N samples, each under Earth 
 wind grows against Earth (the check's rule, :func:`simdiff.eval.response.quantities`). Gravity: the six jump
 prompts x N samples under Earth and g -1.6; medians of the generated change of apex gain and of the longest flight
 (the simulator's side of the check's size ratios is not computed here). Shipped sampling settings of each model
-(sampling.json; fallback not applied), 120 frames, seeds S + prompt index."""
+(sampling.json; fallback not applied; --env-guidance overrides s_e), 120 frames, seeds S + prompt index."""
 from __future__ import annotations
 
 import argparse
@@ -31,8 +31,10 @@ def joints(gen: MotionGenerator, prompt: str, n: int, seed: int, env, s: dict) -
     return features_to_joints(out.features.double()).numpy()
 
 
-def probe(model: str, walks: int, jumps: int, seed: int) -> dict:
+def probe(model: str, walks: int, jumps: int, seed: int, env_guidance: float | None = None) -> dict:
     s = json.loads((Path(model) / "sampling.json").read_text())
+    if env_guidance is not None:
+        s["env_guidance"] = env_guidance
     gen, t0 = MotionGenerator.load(model), time.time()
     wind = {f"wx{w[1]:+.0f} wy{w[2]:+.0f}": [] for w in WINDS}
     for i, p in enumerate(SPEED_PROMPTS["walk"] if walks else ()):
@@ -65,11 +67,12 @@ if __name__ == "__main__":
     ap.add_argument("--walks", type=int, default=8)
     ap.add_argument("--jumps", type=int, default=0)
     ap.add_argument("--seed", type=int, default=7000)
+    ap.add_argument("--env-guidance", type=float, default=None, help="s_e instead of the model's sampling.json value")
     a = ap.parse_args()
     torch.set_num_threads(2)
     for m in a.models:
-        r = probe(m, a.walks, a.jumps, a.seed)
+        r = probe(m, a.walks, a.jumps, a.seed, a.env_guidance)
         total = sum(v["downwind"] for v in r["wind"].values()), sum(v["n"] for v in r["wind"].values())
         print(json.dumps(r), flush=True)
-        print(f"{m}: wind {total[0]}/{total[1]}", " ".join(f"{k}:{v['downwind']}/{v['n']} {v['median_m']:+.3f}"
+        print(f"{m} (s_e {a.env_guidance or 'shipped'}): wind {total[0]}/{total[1]}", " ".join(f"{k}:{v['downwind']}/{v['n']} {v['median_m']:+.3f}"
               for k, v in r["wind"].items()), r.get("gravity", ""), f"{r['seconds']}s", flush=True)
