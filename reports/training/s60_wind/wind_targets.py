@@ -7,6 +7,7 @@ from simdiff.motion.features import features_to_joints
 from simdiff.eval.response import quantities
 
 root, split = sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else "first_try"
+rng = np.random.default_rng(0)
 for targets, mode in [("simulated", "equal"), ("source-anchored", "equal"), ("source-anchored", "overlap")]:
     ds = AugmentedHumanML3D(root, split, targets=targets, twin_frames=mode)
     groups = {}
@@ -14,10 +15,10 @@ for targets, mode in [("simulated", "equal"), ("source-anchored", "equal"), ("so
         env = ds.env_table[it.clip_id]["env"]
         if abs(env[1]) + abs(env[2]) < 1e-9 or abs(env[0] + 9.81) > 1e-3:
             continue
-        earth, _ = ds._twins[i]
-        if not earth:
+        earth = ds.twin(i, rng)  # a non-Earth item's twin is its Earth twin, or None
+        if earth is None:
             continue
-        a, b = ds.sim.load_motion(it), ds.sim.load_motion(ds.sim.items[earth[0]])
+        a, b = ds.sim.load_motion(it), ds.sim.load_motion(ds.sim.items[earth])
         n = min(len(a), len(b), 120)
         d = quantities(features_to_joints(a[:n]), env)["drift_along_wind_m"] - \
             quantities(features_to_joints(b[:n]), env)["drift_along_wind_m"]
