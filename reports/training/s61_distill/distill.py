@@ -11,7 +11,9 @@ Every model must use the student's normaliser (checked). Batches are the adapter
 
 (the wind bracket only for items with wind; k ``--gravity-gain``, default 1; E ``--earth-teacher``, default G), so the
 student's Earth motion is E's, its answer to gravity G's, its answer to wind W's, and to both their sum. E and W must
-share the student's frozen backbone; G may have another (its answer is transplanted at the same x_t). Text dropout p 0.1 as in training and the adapter strength α (``--alphas``: drawn per item; default 1 as in
+share the student's frozen backbone; G may have another (its answer is transplanted at the same x_t). With
+``--flight-teacher F``, low-gravity items whose Earth motion (E's x̂₀ at that x_t) has a flight of ≥ ``--min-flight-s``
+take F's gravity answer instead of G's: ballistic phases answer gravity, ground contact barely does. Text dropout p 0.1 as in training and the adapter strength α (``--alphas``: drawn per item; default 1 as in
 training; sampling runs at 0.5), the same for student and teachers;
 every network in eval mode (no dropout). The student runs on φ and on Earth with the same x_t; loss: masked MSE of
 both x̂₀ against their targets (Earth: E(Earth)), plus ``--pairs`` λ × the MSE of the answer (x̂₀(φ) − x̂₀(Earth) against
@@ -31,6 +33,8 @@ from simdiff.data.augment import open_training_dataset
 from simdiff.diffusion.losses import masked_mse, twin_difference_mse, twin_drift_mse
 from simdiff.model.checkpoint import load_pretrained, read_config
 from simdiff.model.condition import Condition
+from simdiff.motion.features import features_to_joints
+from simdiff.motion.flight import flight_stats
 from simdiff.text.table import open_caption_table
 from simdiff.train.config import RunConfig, lr_at
 from simdiff.train.trainer import Trainer, _seeds
@@ -40,21 +44,34 @@ EARTH = -9.81
 
 class DistillTrainer(Trainer):
     def __init__(self, *args, gravity_teacher: Path, wind_teacher: Path, earth_teacher: Path | None = None,
+                 flight_teacher: Path | None = None, min_flight_s: float = 0.1,
                  gravity_gain: float = 1.0, pairs: float = 10.0,
                  drift: float = 20.0, alphas: tuple[float, ...] = (), **kw) -> None:
         super().__init__(*args, **kw)
         self.teachers = {}
         own = {k: v for k, v in self.network.state_dict().items() if k.startswith("backbone.")}
-        for name, folder in (("G", gravity_teacher), ("W", wind_teacher), ("E", earth_teacher or gravity_teacher)):
+        self.min_flight_s = min_flight_s
+        named = [("G", gravity_teacher), ("W", wind_teacher), ("E", earth_teacher or gravity_teacher)]
+        for name, folder in named + ([("F", flight_teacher)] if flight_teacher is not None else []):
             net, _, extra = load_pretrained(folder, "cpu")
             assert torch.equal(extra["normalizer.mean"], self.mean) and torch.equal(extra["normalizer.std"], self.std), \
                 f"{folder}: another normaliser"
             theirs = {k: v for k, v in net.state_dict().items() if k.startswith("backbone.")}
             same = theirs.keys() == own.keys() and all(torch.equal(own[k].cpu(), theirs[k]) for k in own)
             # the Earth and wind teachers share the student's backbone; the gravity teacher may bring its own
-            assert same or name == "G", f"{folder}: another backbone"
+            assert same or name in ("G", "F"), f"{folder}: another backbone"
             self.teachers[name] = net.to(self.device).eval().requires_grad_(False)
+        self.flying: list[tuple[int, int]] = []
         self.gain, self.pairs, self.drift, self.alphas = gravity_gain, pairs, drift, tuple(alphas)
+
+    def _flies(self, x: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        """(B,) bool: the motion x̂₀ (B, T, 263, normalised) has a flight of at least ``min_flight_s`` on its valid frames."""
+        raw = (x.detach().cpu().double() * self.std.double() + self.mean.double())
+        out = []
+        for row, m in zip(raw, mask.cpu()):
+            n = int(m.sum())
+            out.append(n >= 2 and flight_stats(features_to_joints(row[:n]).numpy())["flight_s"] >= self.min_flight_s)
+        return torch.tensor(out, device=x.device)
 
     def train_step(self, batch=None) -> float:
         tc = self.config.train
@@ -83,6 +100,17 @@ class DistillTrainer(Trainer):
                 dataclasses.replace(cond, env=earth)))
             t_earth = both[b:] if E is G else E(xt, t, dataclasses.replace(cond, env=earth))
             t_phi = t_earth + self.gain * (both[:b] - both[b:])
+            lowg = (env[:, 0] - EARTH).abs() > 1e-6
+            if "F" in self.teachers and bool(lowg.any()):  # items whose Earth motion flies: F's gravity answer
+                fly = lowg & self._flies(t_earth, mask)
+                if bool(fly.any()):
+                    rows = fly.nonzero().flatten()
+                    sub, k = cond.select(rows), len(rows)
+                    pair = self.teachers["F"](torch.cat([xt[rows], xt[rows]]), t[rows].repeat(2),
+                                              dataclasses.replace(sub, env=env_g[rows]).stacked(
+                                                  dataclasses.replace(sub, env=earth[rows])))
+                    t_phi[rows] = t_earth[rows] + self.gain * (pair[:k] - pair[k:])
+                self.flying.append((int(fly.sum()), int(lowg.sum())))
             if bool(windy.any()):
                 rows = windy.nonzero().flatten()
                 sub = cond.select(rows)
@@ -114,6 +142,9 @@ def main() -> None:
     p.add_argument("--student-init", type=Path, required=True)
     p.add_argument("--gravity-teacher", type=Path, required=True)
     p.add_argument("--wind-teacher", type=Path, required=True)
+    p.add_argument("--flight-teacher", type=Path, default=None,
+                   help="the gravity answer for items whose Earth motion (E's x̂₀) has a flight (default: G's for all)")
+    p.add_argument("--min-flight-s", type=float, default=0.1)
     p.add_argument("--earth-teacher", type=Path, default=None, help="the Earth answer (default: the gravity teacher)")
     p.add_argument("--backbone", type=Path, required=True)
     p.add_argument("--out", type=Path, required=True)
@@ -144,9 +175,13 @@ def main() -> None:
     trainer = DistillTrainer(a.out, config, dataset, text_encoder=encoder, device="cpu", init_model=a.backbone,
                              init_adapters=a.student_init, gravity_teacher=a.gravity_teacher,
                              wind_teacher=a.wind_teacher, earth_teacher=a.earth_teacher,
+                             flight_teacher=a.flight_teacher, min_flight_s=a.min_flight_s,
                              gravity_gain=a.gravity_gain,
                              pairs=a.pairs, drift=a.drift, alphas=a.alphas)
     losses = trainer.train(progress=False)
+    if trainer.flying:
+        fly, low = map(sum, zip(*trainer.flying))
+        print(f"low-gravity items whose Earth motion flies (F's answer): {fly} of {low}")
     tail = losses[-25:]
     print(f"distilled to step {trainer.step}; last-25 loss {sum(tail) / max(1, len(tail)):.5f}; model {a.out / 'model'}")
 
