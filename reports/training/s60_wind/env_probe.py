@@ -37,7 +37,7 @@ def joints(gen: MotionGenerator, prompt: str, n: int, seed: int, env, s: dict) -
     return features_to_joints(out.features.double()).numpy()
 
 
-def probe(model: str, walks: int, jumps: int, seed: int, env_guidance: float | None = None, moon: int = 0) -> dict:
+def probe(model: str, walks: int, jumps: int, seed: int, env_guidance: float | None = None, moon_n: int = 0) -> dict:
     s = json.loads((Path(model) / "sampling.json").read_text())
     if env_guidance is not None:
         s["env_guidance"] = env_guidance
@@ -59,9 +59,9 @@ def probe(model: str, walks: int, jumps: int, seed: int, env_guidance: float | N
             flight.append(fa["flight_s"] - fb["flight_s"])
     floats: dict[str, list[float]] = {"moon": [], "earth": []}
     ratio = []
-    for i, p in enumerate((*SPEED_PROMPTS["walk"], *SPEED_PROMPTS["run"]) if moon else ()):
-        earth = joints(gen, p, moon, seed + 200 + i, (-9.81, 0.0, 0.0), s)
-        low = joints(gen, p, moon, seed + 200 + i, (-1.6, 0.0, 0.0), s)
+    for i, p in enumerate((*SPEED_PROMPTS["walk"], *SPEED_PROMPTS["run"]) if moon_n else ()):
+        earth = joints(gen, p, moon_n, seed + 200 + i, (-9.81, 0.0, 0.0), s)
+        low = joints(gen, p, moon_n, seed + 200 + i, (-1.6, 0.0, 0.0), s)
         floats["earth"] += list(per_sample_physics_metrics(earth)["floating"])
         floats["moon"] += list(per_sample_physics_metrics(low)["floating"])
         ratio += [root_speed(a) / max(root_speed(b), 1e-6) for a, b in zip(low, earth)]

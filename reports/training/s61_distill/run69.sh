@@ -1,11 +1,11 @@
-# Rule 68 (session 61): the gate on D6's probe, then stages C', A, B, C+, T in order, each only after the one before
+# Rule 69 (session 61): the gate on D6's probe, then stages C', A, B, C+, T in order, each only after the one before
 # passed. D6 is trained and probed by: NAME=D6 INIT=/work/scratch/s61/D4_model FT=/work/scratch/s59/X15sg_model MINF=0.2 bash run_d4.sh
 set -u
 cd /work/main; . .venv/bin/activate
 S=/work/scratch/s39; O=/work/scratch/s61; R=reports/training/s61_distill; M=$O/D6_model
 R56=reports/training/s56_source_anchored; R57=reports/training/s57_pooled_a
 export SIMDIFF_SCRATCH=$S STEPS=50
-PROBE=${PROBE:-/work/scratch/s61_d5.log}
+PROBE=${PROBE:-/work/scratch/s61_d6.log}
 python - "$PROBE" <<'PY' | tee -a $R/rule69_stages.txt | grep -q "gate PASS" || { echo "rule 69: gate failed"; exit 0; }
 import json, sys
 r = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")][-1]
