@@ -1,39 +1,41 @@
 # Rule 68 (session 61): the gate on D5's probe, then stages C', A, B, C+, T in order, each only after the one before
 # passed. D5 is trained and probed by: NAME=D5 INIT=/work/scratch/s61/D4_model FT=/work/scratch/s59/X15sg_model bash run_d4.sh
+# Rule 69 runs the same with RULE=69 NAME=D6 AS=132 (run69.sh).
 set -u
 cd /work/main; . .venv/bin/activate
-S=/work/scratch/s39; O=/work/scratch/s61; R=reports/training/s61_distill; M=$O/D5_model
+RULE=${RULE:-68}; NAME=${NAME:-D5}; AS=${AS:-130}  # stage-A seeds AS and AS + 1
+S=/work/scratch/s39; O=/work/scratch/s61; R=reports/training/s61_distill; M=$O/${NAME}_model
 R56=reports/training/s56_source_anchored; R57=reports/training/s57_pooled_a
 export SIMDIFF_SCRATCH=$S STEPS=50
-PROBE=${PROBE:-/work/scratch/s61_d5.log}
-python - "$PROBE" <<'PY' | tee -a $R/rule68_stages.txt | grep -q "gate PASS" || { echo "rule 68: gate failed"; exit 0; }
+PROBE=${PROBE:-/work/scratch/s61_$(echo $NAME | tr D d).log}
+python - "$PROBE" $RULE <<'PY' | tee -a $R/rule${RULE}_stages.txt | grep -q "gate PASS" || { echo "rule $RULE: gate failed"; exit 0; }
 import json, sys
 r = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")][-1]
 wind = sum(v["downwind"] for v in r["wind"].values())
 apex, ratio = r["gravity"]["apex_change_median_m"], r["moon"]["speed_ratio_median"]
 ok = wind >= 60 and apex >= 0.32 and ratio >= 0.80
-print(f"rule 68 gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
+print(f"rule {sys.argv[2]} gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
 PY
-if [ ! -f $S/eval11/C12_D5_se4/-1.6,0,0/check.json ]; then
-  SEEDS="1 2" /usr/bin/time -f "stageC12 D5 %e s" python reports/training/s37_env_guidance/guard.py -1.6,0,0 4 \
-    $S/eval11/C12_D5_se4/-1.6,0,0 $M || exit 1
+if [ ! -f $S/eval11/C12_${NAME}_se4/-1.6,0,0/check.json ]; then
+  SEEDS="1 2" /usr/bin/time -f "stageC12 $NAME %e s" python reports/training/s37_env_guidance/guard.py -1.6,0,0 4 \
+    $S/eval11/C12_${NAME}_se4/-1.6,0,0 $M || exit 1
 fi
-python $R56/c51.py C12 D5_se4 | tee -a $R/rule68_stages.txt | grep -q PASS || { echo "rule 68: C' failed"; exit 0; }
-JS=32 ASEEDS="130 131" FB=3 bash reports/training/s39_drift_gpu/check.sh A D5_se4_fb3_js32_s130 $M 4
-python $R57/stage_a55.py $S/eval11/A_D5_se4_fb3_js32_s130 | tee -a $R/rule68_stages.txt | grep -q PASS \
-  || { echo "rule 68: A failed"; exit 0; }
-ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh B D5 $M 4
-W=$(cd reports/training/s53_extrapolate && python walk_probe.py $M | tee -a $O/walk68.txt | sed -n 's/.*jumping \([0-9]*\)\/.*/\1/p')
-python $R57/b56.py D5 $W | tee -a $R/rule68_stages.txt | grep -q PASS || { echo "rule 68: B failed"; exit 0; }
-/usr/bin/time -f "stageC D5 +10N %e s" python reports/training/s37_env_guidance/guard.py -9.81,10,0 4 \
-  $S/eval11/C_D5_se4/-9.81,10,0 $M || exit 1
-python $R56/c51.py CPLUS D5_se4 | tee -a $R/rule68_stages.txt | grep -q PASS || { echo "rule 68: C+ failed"; exit 0; }
+python $R56/c51.py C12 ${NAME}_se4 | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
+JS=32 ASEEDS="$AS $((AS + 1))" FB=3 bash reports/training/s39_drift_gpu/check.sh A ${NAME}_se4_fb3_js32_s$AS $M 4
+python $R57/stage_a55.py $S/eval11/A_${NAME}_se4_fb3_js32_s$AS | tee -a $R/rule${RULE}_stages.txt | grep -q PASS \
+  || { echo "rule $RULE: A failed"; exit 0; }
+ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh B $NAME $M 4
+W=$(cd reports/training/s53_extrapolate && python walk_probe.py $M | tee -a $O/walk$RULE.txt | sed -n 's/.*jumping \([0-9]*\)\/.*/\1/p')
+python $R57/b56.py $NAME $W | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: B failed"; exit 0; }
+/usr/bin/time -f "stageC $NAME +10N %e s" python reports/training/s37_env_guidance/guard.py -9.81,10,0 4 \
+  $S/eval11/C_${NAME}_se4/-9.81,10,0 $M || exit 1
+python $R56/c51.py CPLUS ${NAME}_se4 | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C+ failed"; exit 0; }
 mkdir -p $S/eval11/T_3_J40m_se4_fb3_c53  # t51.py's reference: the shipped model's test report
 cp reports/training/s53_extrapolate/test/J40m_se4_fb3/check.json $S/eval11/T_3_J40m_se4_fb3_c53/
-FB=3 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh T D5_se4_fb3 $M 4
-python $R56/t51.py T_D5_se4_fb3 | tee -a $R/rule68_stages.txt | grep -q "^SHIP" || { echo "rule 68: T failed"; exit 0; }
-python - <<'PY' | tee -a $R/rule68_stages.txt
-import json
-j = round(json.load(open("/work/scratch/s39/eval11/T_D5_se4_fb3/check.json"))["figures"]["jump_fraction"] * 96)
-print(f"rule 68: T jumps {j} of 96 (bar 39):", "SHIP" if j >= 39 else "DO NOT SHIP")
+FB=3 ALSO="$S/eval2 --also-evaluator $S/eval3" bash reports/training/s39_drift_gpu/check.sh T ${NAME}_se4_fb3 $M 4
+python $R56/t51.py T_${NAME}_se4_fb3 | tee -a $R/rule${RULE}_stages.txt | grep -q "^SHIP" || { echo "rule $RULE: T failed"; exit 0; }
+python - $RULE $NAME <<'PY' | tee -a $R/rule${RULE}_stages.txt
+import json, sys
+j = round(json.load(open(f"/work/scratch/s39/eval11/T_{sys.argv[2]}_se4_fb3/check.json"))["figures"]["jump_fraction"] * 96)
+print(f"rule {sys.argv[1]}: T jumps {j} of 96 (bar 39):", "SHIP" if j >= 39 else "DO NOT SHIP")
 PY
