@@ -32,7 +32,6 @@ import torch
 from simdiff.data.augment import open_training_dataset
 from simdiff.diffusion.losses import masked_mse, twin_difference_mse, twin_drift_mse
 from simdiff.model.checkpoint import load_pretrained, read_config
-from simdiff.model.condition import Condition
 from simdiff.motion.features import features_to_joints
 from simdiff.motion.flight import flight_stats
 from simdiff.text.table import open_caption_table
@@ -54,12 +53,13 @@ class DistillTrainer(Trainer):
         named = [("G", gravity_teacher), ("W", wind_teacher), ("E", earth_teacher or gravity_teacher)]
         for name, folder in named + ([("F", flight_teacher)] if flight_teacher is not None else []):
             net, _, extra = load_pretrained(folder, "cpu")
-            assert torch.equal(extra["normalizer.mean"], self.mean) and torch.equal(extra["normalizer.std"], self.std), \
-                f"{folder}: another normaliser"
+            if not (torch.equal(extra["normalizer.mean"], self.mean) and torch.equal(extra["normalizer.std"], self.std)):
+                raise SystemExit(f"{folder}: another normaliser than the student's")
             theirs = {k: v for k, v in net.state_dict().items() if k.startswith("backbone.")}
             same = theirs.keys() == own.keys() and all(torch.equal(own[k].cpu(), theirs[k]) for k in own)
             # the Earth and wind teachers share the student's backbone; the gravity teacher may bring its own
-            assert same or name in ("G", "F"), f"{folder}: another backbone"
+            if not (same or name in ("G", "F")):
+                raise SystemExit(f"{folder}: another backbone than the student's (only the gravity and flight teachers may)")
             self.teachers[name] = net.to(self.device).eval().requires_grad_(False)
         self.flying: list[tuple[int, int]] = []
         self.gain, self.pairs, self.drift, self.alphas = gravity_gain, pairs, drift, tuple(alphas)
