@@ -21,10 +21,10 @@ import numpy as np
 import torch
 
 from simdiff.eval.model_check.config import JUMP_PROMPTS, SPEED_PROMPTS
+from simdiff.eval.model_check.detect import root_speed
 from simdiff.eval.response import quantities
 from simdiff.model.generator import MotionGenerator
 from simdiff.motion.features import features_to_joints
-from simdiff.eval.model_check.detect import root_speed
 from simdiff.motion.flight import flight_stats
 from simdiff.motion.metrics import per_sample_physics_metrics
 

@@ -66,12 +66,10 @@ class DistillTrainer(Trainer):
 
     def _flies(self, x: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
         """(B,) bool: the motion x̂₀ (B, T, 263, normalised) has a flight of at least ``min_flight_s`` on its valid frames."""
-        raw = (x.detach().cpu().double() * self.std.double() + self.mean.double())
-        out = []
-        for row, m in zip(raw, mask.cpu()):
-            n = int(m.sum())
-            out.append(n >= 2 and flight_stats(features_to_joints(row[:n]).numpy())["flight_s"] >= self.min_flight_s)
-        return torch.tensor(out, device=x.device)
+        joints = features_to_joints(x.detach().cpu().double() * self.std.double() + self.mean.double()).numpy()
+        lengths = mask.sum(dim=1).tolist()  # frames integrate forward, so padding does not touch the valid ones
+        return torch.tensor([n >= 2 and flight_stats(j[:n])["flight_s"] >= self.min_flight_s
+                             for j, n in zip(joints, lengths)], device=x.device)
 
     def train_step(self, batch=None) -> float:
         tc = self.config.train
@@ -102,7 +100,8 @@ class DistillTrainer(Trainer):
             t_phi = t_earth + self.gain * (both[:b] - both[b:])
             lowg = (env[:, 0] - EARTH).abs() > 1e-6
             if "F" in self.teachers and bool(lowg.any()):  # items whose Earth motion flies: F's gravity answer
-                fly = lowg & self._flies(t_earth, mask)
+                fly = lowg.clone()
+                fly[lowg] = self._flies(t_earth[lowg], mask[lowg])  # only the low-gravity rows are tested
                 if bool(fly.any()):
                     rows = fly.nonzero().flatten()
                     sub, k = cond.select(rows), len(rows)

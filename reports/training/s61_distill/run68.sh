@@ -16,11 +16,7 @@ apex, ratio = r["gravity"]["apex_change_median_m"], r["moon"]["speed_ratio_media
 ok = wind >= 60 and apex >= 0.32 and ratio >= 0.80
 print(f"rule {sys.argv[2]} gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
 PY
-if [ ! -f $S/eval11/C12_${NAME}_se4/-1.6,0,0/check.json ]; then
-  SEEDS="1 2" /usr/bin/time -f "stageC12 $NAME %e s" python reports/training/s37_env_guidance/guard.py -1.6,0,0 4 \
-    $S/eval11/C12_${NAME}_se4/-1.6,0,0 $M || exit 1
-fi
-python $R56/c51.py C12 ${NAME}_se4 | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
+bash $R/cprime.sh $NAME $M | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
 JS=32 ASEEDS="$AS $((AS + 1))" FB=3 bash reports/training/s39_drift_gpu/check.sh A ${NAME}_se4_fb3_js32_s$AS $M 4
 python $R57/stage_a55.py $S/eval11/A_${NAME}_se4_fb3_js32_s$AS | tee -a $R/rule${RULE}_stages.txt | grep -q PASS \
   || { echo "rule $RULE: A failed"; exit 0; }
