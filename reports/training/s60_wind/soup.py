@@ -1,6 +1,6 @@
 """Weight-space interpolation of two models with the same architecture and backbone:
 python soup.py A B T OUT  ->  OUT = (1 - T) * A + T * B (every tensor; backbone tensors must be equal), config.json,
-sampling.json and provenance.json copied from B."""
+sampling.json and provenance.json copied from B (those B has)."""
 import shutil
 import sys
 from pathlib import Path
@@ -24,7 +24,8 @@ shutil.rmtree(tmp, ignore_errors=True)
 tmp.mkdir(parents=True)
 save_file(mixed, str(tmp / "model.safetensors"))
 for name in ("config.json", "sampling.json", "provenance.json"):
-    shutil.copyfile(b / name, tmp / name)
+    if (b / name).exists():
+        shutil.copyfile(b / name, tmp / name)
 shutil.rmtree(out, ignore_errors=True)
 tmp.rename(out)
 print(f"{out}: {len(differ)} of {len(wa)} tensors mixed at t {t}; e.g. {differ[:3]}")

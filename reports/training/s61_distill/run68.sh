@@ -1,10 +1,10 @@
 # Rule 68 (session 61): the gate on D5's probe, then stages C', A, B, C+, T in order, each only after the one before
 # passed. D5 is trained and probed by: NAME=D5 INIT=/work/scratch/s61/D4_model FT=/work/scratch/s59/X15sg_model bash run_d4.sh
-# Rule 69 runs the same with RULE=69 NAME=D6 AS=132 (run69.sh).
+# Rule 69 runs the same with RULE=69 NAME=D6 AS=132 (run69.sh); rule 70 (session 62) with O, R and PROBE set (run70.sh).
 set -u
 cd /work/main; . .venv/bin/activate
 RULE=${RULE:-68}; NAME=${NAME:-D5}; AS=${AS:-130}  # stage-A seeds AS and AS + 1
-S=/work/scratch/s39; O=/work/scratch/s61; R=reports/training/s61_distill; M=$O/${NAME}_model
+S=/work/scratch/s39; O=${O:-/work/scratch/s61}; R=${R:-reports/training/s61_distill}; M=$O/${NAME}_model
 R56=reports/training/s56_source_anchored; R57=reports/training/s57_pooled_a
 export SIMDIFF_SCRATCH=$S STEPS=50
 PROBE=${PROBE:-/work/scratch/s61_$(echo $NAME | tr D d).log}
@@ -16,7 +16,7 @@ apex, ratio = r["gravity"]["apex_change_median_m"], r["moon"]["speed_ratio_media
 ok = wind >= 60 and apex >= 0.32 and ratio >= 0.80
 print(f"rule {sys.argv[2]} gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
 PY
-bash $R/cprime.sh $NAME $M | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
+bash reports/training/s61_distill/cprime.sh $NAME $M | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
 JS=32 ASEEDS="$AS $((AS + 1))" FB=3 bash reports/training/s39_drift_gpu/check.sh A ${NAME}_se4_fb3_js32_s$AS $M 4
 python $R57/stage_a55.py $S/eval11/A_${NAME}_se4_fb3_js32_s$AS | tee -a $R/rule${RULE}_stages.txt | grep -q PASS \
   || { echo "rule $RULE: A failed"; exit 0; }
