@@ -19,10 +19,12 @@ from safetensors.torch import load_file, save_file
 bb, out = Path(sys.argv[1]), Path(sys.argv[2])
 ship = Path("simdiff/assets/default_model")
 w, new = load_file(ship / "model.safetensors"), load_file(bb / "model.safetensors")
-keys = [k for k in w if k.startswith("backbone.")]
-assert all(k in new and new[k].shape == w[k].shape for k in keys), "backbone tensors differ in name or shape"
+keys = [k for k in w if k.startswith("backbone.")]  # the backbone export names them without the prefix
+assert all(k[9:] in new and new[k[9:]].shape == w[k].shape for k in keys), "backbone tensors differ in name or shape"
+extra = sorted(set(new) - {k[9:] for k in keys})
+assert all(k in w and (new[k] == w[k]).all() for k in extra), f"not the shipped normaliser: {extra}"
 for k in keys:
-    w[k] = new[k].to(w[k].dtype)
+    w[k] = new[k[9:]].to(w[k].dtype)
 shutil.rmtree(out, ignore_errors=True); out.mkdir(parents=True)
 save_file(w, str(out / "model.safetensors"))
 for name in ("config.json", "sampling.json"):
