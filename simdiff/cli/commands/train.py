@@ -1,4 +1,4 @@
-"""``simdiff train backbone|adapters|export-backbone|extrapolate``: train the MDM backbone, or SimDiff's adapters on
+"""``simdiff train backbone|adapters|export-backbone|extrapolate|deepen``: train the MDM backbone, or SimDiff's adapters on
 a frozen one; export a SimDiff model's backbone on its own; extrapolate a backbone fine-tune.
 
 Multi-process: ``torchrun --nproc_per_node N -m simdiff train backbone ...`` (gloo on CPU,
@@ -111,12 +111,32 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     x.add_argument("--lam", type=float, required=True, metavar="LAMBDA", help="extrapolation factor (e.g. 2)")
     x.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
     x.set_defaults(func=run_extrapolate)
+    dp = group.add_parser("deepen", help="insert identity layers into a model's backbone (same output, more depth)",
+                          description="Write MODEL with one new transformer layer after each listed backbone layer. "
+                                      "The new layers start as the identity (zero attention out-projection and "
+                                      "second feed-forward linear; the preceding layer's norm2 affine moves onto "
+                                      "them), so the deeper model gives the same x0 until it is trained further "
+                                      "(`train backbone --init`). Adapters keep their inputs; new adapter slots are "
+                                      "zero. deepening.json records the recipe.")
+    dp.add_argument("--model", type=Path, required=True, help="model folder (SimDiff or backbone-only)")
+    dp.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
+    dp.add_argument("--after", type=int, nargs="+", metavar="LAYER",
+                    help="old layer indices each followed by a new layer (default: every layer, doubling the depth)")
+    dp.add_argument("--seed", type=int, default=0, help="seed of the new layers' input-side weights (default 0)")
+    dp.set_defaults(func=run_deepen)
 
 
 def run_export(args: argparse.Namespace) -> int:
     from simdiff.model.checkpoint import export_backbone
 
     print(f"wrote {export_backbone(args.model, args.out)}")
+    return 0
+
+
+def run_deepen(args: argparse.Namespace) -> int:
+    from simdiff.model.deepen import deepen_model
+
+    print(f"wrote {deepen_model(args.model, args.out, args.after, args.seed)}")
     return 0
 
 
