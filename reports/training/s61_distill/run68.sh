@@ -1,6 +1,7 @@
 # Rule 68 (session 61): the gate on D5's probe, then stages C', A, B, C+, T in order, each only after the one before
 # passed. D5 is trained and probed by: NAME=D5 INIT=/work/scratch/s61/D4_model FT=/work/scratch/s59/X15sg_model bash run_d4.sh
-# Rule 69 runs the same with RULE=69 NAME=D6 AS=132 (run69.sh); rule 70 (session 62) with O, R and PROBE set (run70.sh).
+# Rule 69 runs the same with RULE=69 NAME=D6 AS=132 (run69.sh); rule 70 (session 62) with O, R and PROBE set (run70.sh);
+# rule 71 (session 63) also with CPRIME, its stage-C' command (run71.sh).
 set -u
 cd /work/main; . .venv/bin/activate
 RULE=${RULE:-68}; NAME=${NAME:-D5}; AS=${AS:-130}  # stage-A seeds AS and AS + 1
@@ -16,7 +17,7 @@ apex, ratio = r["gravity"]["apex_change_median_m"], r["moon"]["speed_ratio_media
 ok = wind >= 60 and apex >= 0.32 and ratio >= 0.80
 print(f"rule {sys.argv[2]} gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
 PY
-bash reports/training/s61_distill/cprime.sh $NAME $M | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
+${CPRIME:-bash reports/training/s61_distill/cprime.sh} $NAME $M | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
 JS=32 ASEEDS="$AS $((AS + 1))" FB=3 bash reports/training/s39_drift_gpu/check.sh A ${NAME}_se4_fb3_js32_s$AS $M 4
 python $R57/stage_a55.py $S/eval11/A_${NAME}_se4_fb3_js32_s$AS | tee -a $R/rule${RULE}_stages.txt | grep -q PASS \
   || { echo "rule $RULE: A failed"; exit 0; }
