@@ -222,13 +222,8 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
         assert MotionGenerator.load(run / "model", load_text=False).is_simdiff
 
 
-def test_gpu_continue_script_rehearsal_warm_starts_backbone_then_adapters(corpus, tmp_path) -> None:
-    """scripts/gpu_continue.sh on CPU: the backbone warm-starts from a SimDiff folder's backbone on the train split's
-    pack, then the adapters train on that new backbone starting from the folder's own adapters; two tars come back."""
-    import tarfile
-
-    from safetensors.torch import load_file
-
+def _train_and_aug_packs(corpus: Path, tmp_path: Path) -> Path:
+    """``tmp_path/packs``: the corpus's train-split pack, a paired augmented pack of it and their caption table."""
     aug = tmp_path / "aug"
     augment(corpus, aug, AugmentConfig(mode="paired", conditions=2, shard_size=4), projector=EchoProjector(),
             progress=False)
@@ -236,6 +231,17 @@ def test_gpu_continue_script_rehearsal_warm_starts_backbone_then_adapters(corpus
     pack(corpus, packs / "corpus", splits=["train"])
     pack(aug, packs / "aug")
     write_caption_table(corpus_captions(corpus), FakeMiniLM(), packs / "captions.safetensors")
+    return packs
+
+
+def test_gpu_continue_script_rehearsal_warm_starts_backbone_then_adapters(corpus, tmp_path) -> None:
+    """scripts/gpu_continue.sh on CPU: the backbone warm-starts from a SimDiff folder's backbone on the train split's
+    pack, then the adapters train on that new backbone starting from the folder's own adapters; two tars come back."""
+    import tarfile
+
+    from safetensors.torch import load_file
+
+    packs = _train_and_aug_packs(corpus, tmp_path)
     tiny = backbone_preset("tiny")
     model_config = ModelConfig(backbone=tiny, sim=SimConfig())
     torch.manual_seed(3)
@@ -294,13 +300,7 @@ def test_gpu_deepen_script_rehearsal_deepens_then_trains_backbone_and_adapters(c
     train split's pack, its moved adapters two steps on an augmented pack; both models come back as tar parts."""
     import tarfile
 
-    aug = tmp_path / "aug"
-    augment(corpus, aug, AugmentConfig(mode="paired", conditions=2, shard_size=4), projector=EchoProjector(),
-            progress=False)
-    packs = tmp_path / "packs"
-    pack(corpus, packs / "corpus", splits=["train"])
-    pack(aug, packs / "aug")
-    write_caption_table(corpus_captions(corpus), FakeMiniLM(), packs / "captions.safetensors")
+    packs = _train_and_aug_packs(corpus, tmp_path)
     tiny = backbone_preset("tiny")
     model_config = ModelConfig(backbone=tiny, sim=SimConfig())
     torch.manual_seed(4)

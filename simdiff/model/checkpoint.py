@@ -75,6 +75,21 @@ def save_pretrained(folder: str | os.PathLike[str], network: nn.Module, config: 
     atomic_write_json(dataclasses.asdict(config), folder / CONFIG_NAME)
 
 
+def save_derived(dst: str | os.PathLike[str], network: nn.Module, config: ModelConfig, extra: Mapping[str, Tensor],
+                 src: str | os.PathLike[str], copied: tuple[str, ...]) -> Path:
+    """Write a model made from folder ``src`` (weights and config via :func:`save_pretrained`) into ``dst``, with
+    ``src``'s files named in ``copied`` (e.g. ``sampling.json``) carried over byte for byte when present."""
+    from simdiff.fsio import write_bytes
+
+    dst, src = Path(dst), Path(src)
+    dst.mkdir(parents=True, exist_ok=True)
+    save_pretrained(dst, network, config, extra)
+    for name in copied:
+        if (src / name).is_file():
+            write_bytes(dst / name, (src / name).read_bytes())
+    return dst
+
+
 def read_config(folder: str | os.PathLike[str]) -> ModelConfig:
     """Read ``folder/config.json`` into a :class:`ModelConfig`."""
     path = Path(folder) / CONFIG_NAME

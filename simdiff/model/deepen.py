@@ -25,9 +25,9 @@ import torch
 from torch import Tensor
 
 from simdiff.errors import SimdiffError
-from simdiff.fsio import write_bytes, write_json
+from simdiff.fsio import write_json
 from simdiff.model.backbone import EncoderLayer
-from simdiff.model.checkpoint import WEIGHTS_NAME, build_network, load_pretrained, save_pretrained
+from simdiff.model.checkpoint import WEIGHTS_NAME, build_network, load_pretrained, save_derived
 from simdiff.model.simdiff_net import SimDiffNet
 
 RECIPE_NAME = "deepening.json"
@@ -112,11 +112,7 @@ def deepen_model(model: str | os.PathLike[str], out: str | os.PathLike[str], aft
     generator = torch.Generator().manual_seed(int(seed))
     state = deepen_state(network.state_dict(), "backbone." if simdiff else "", bb, after, generator, fresh)
     new_net.load_state_dict(state)
-    dst.mkdir(parents=True, exist_ok=True)
-    save_pretrained(dst, new_net, new_config, extra)
-    for name in COPIED:
-        if (src / name).is_file():
-            write_bytes(dst / name, (src / name).read_bytes())
+    save_derived(dst, new_net, new_config, extra, src, COPIED)
     write_json(dst / RECIPE_NAME, {
         "rule": "one identity layer (zero attention out-projection and second feed-forward linear) after each "
                 "listed layer; the preceding layer's norm2 affine moved onto it; fresh adapters zero",

@@ -20,8 +20,8 @@ import torch
 from torch import nn
 
 from simdiff.errors import SimdiffError
-from simdiff.fsio import write_bytes, write_json
-from simdiff.model.checkpoint import WEIGHTS_NAME, load_pretrained, save_pretrained
+from simdiff.fsio import write_json
+from simdiff.model.checkpoint import WEIGHTS_NAME, load_pretrained, save_derived
 from simdiff.model.simdiff_net import SimDiffNet
 
 RECIPE_NAME = "extrapolation.json"
@@ -63,11 +63,7 @@ def extrapolate_backbone(model: str | os.PathLike[str], parent: str | os.PathLik
     with torch.no_grad():
         moved = {k: (v + lam * (v - start[k])).to(v.dtype) if v.is_floating_point() else v for k, v in state.items()}
     backbone.load_state_dict(moved)
-    dst.mkdir(parents=True, exist_ok=True)
-    save_pretrained(dst, network, config, extra)
-    for name in COPIED:
-        if (src / name).is_file():
-            write_bytes(dst / name, (src / name).read_bytes())
+    save_derived(dst, network, config, extra, src, COPIED)
     _write_provenance(src, par, dst)
     digest = {name: hashlib.sha256((folder / WEIGHTS_NAME).read_bytes()).hexdigest()
               for name, folder in (("model", src), ("parent", par))}
