@@ -87,3 +87,19 @@ def test_deepen_errors_are_one_line(tmp_path, capsys, argv_tail, message) -> Non
     assert main(["train", "deepen", "--model", str(src), "--out", str(out), *tail]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and "\n" not in err
+
+
+def test_deepen_is_deterministic_under_its_seed(tmp_path) -> None:
+    from simdiff.model.deepen import deepen_model
+
+    src = tmp_path / "src"
+    _trained_like(src, sim=True)
+    torch.manual_seed(123)  # the global RNG's state must not matter
+    for name, seed in (("a", 5), ("b", 5), ("c", 6)):
+        deepen_model(src, tmp_path / name, seed=seed)
+        torch.rand(7)
+    from safetensors.torch import load_file
+
+    w = {n: load_file(str(tmp_path / n / "model.safetensors")) for n in "abc"}  # (the header's order is the library's)
+    assert all(torch.equal(v, w["b"][k]) for k, v in w["a"].items())
+    assert not all(torch.equal(v, w["c"][k]) for k, v in w["a"].items())

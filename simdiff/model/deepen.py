@@ -27,19 +27,22 @@ from torch import Tensor
 from simdiff.errors import SimdiffError
 from simdiff.fsio import write_json
 from simdiff.model.backbone import EncoderLayer
+from simdiff.model.config import BackboneConfig
 from simdiff.model.checkpoint import WEIGHTS_NAME, build_network, load_pretrained, save_derived
-from simdiff.model.simdiff_net import SimDiffNet
+from simdiff.model.adapter import MotionAdapter
+from simdiff.model.simdiff_net import SimDiffNet, adapter_bottleneck
 
 RECIPE_NAME = "deepening.json"
 COPIED = ("sampling.json", "provenance.json")
 _LAYER = "seqTransEncoder.layers."
 
 
-def _identity_layer(old: dict[str, Tensor], config, generator: torch.Generator) -> dict[str, Tensor]:
+def _identity_layer(old: dict[str, Tensor], config: BackboneConfig, generator: torch.Generator) -> dict[str, Tensor]:
     """A fresh layer's weights (PyTorch's default init under ``generator``) with zero output paths; ``norm2`` = old's."""
     c = config
-    torch.manual_seed(int(torch.randint(0, 2**31 - 1, (1,), generator=generator)))
-    layer = EncoderLayer(c.latent_dim, c.num_heads, c.ff_size, c.dropout, c.activation)
+    with torch.random.fork_rng(devices=[]):  # the global RNG is left as it was
+        torch.manual_seed(int(torch.randint(0, 2**31 - 1, (1,), generator=generator)))
+        layer = EncoderLayer(c.latent_dim, c.num_heads, c.ff_size, c.dropout, c.activation)
     state = {k: v.detach().clone() for k, v in layer.state_dict().items()}
     for key in ("self_attn.out_proj.weight", "self_attn.out_proj.bias", "linear2.weight", "linear2.bias"):
         state[key].zero_()
@@ -50,7 +53,7 @@ def _identity_layer(old: dict[str, Tensor], config, generator: torch.Generator) 
     return state
 
 
-def deepen_state(state: dict[str, Tensor], prefix: str, config, after: Sequence[int], generator: torch.Generator,
+def deepen_state(state: dict[str, Tensor], prefix: str, config: BackboneConfig, after: Sequence[int], generator: torch.Generator,
                  fresh_adapter: dict[str, Tensor] | None = None) -> dict[str, Tensor]:
     """The state dict of the deepened network (backbone keys under ``prefix``; adapters under ``adapters.``).
 
@@ -104,12 +107,13 @@ def deepen_model(model: str | os.PathLike[str], out: str | os.PathLike[str], aft
     simdiff = isinstance(network, SimDiffNet)
     new_config = dataclasses.replace(config, backbone=dataclasses.replace(bb, num_layers=bb.num_layers + len(after)))
     new_net = build_network(new_config)
-    fresh = None
-    if simdiff:
-        fresh = {k: v.detach().clone() for k, v in new_net.adapters[0].state_dict().items()}
-        fresh["up.weight"].zero_()
-        fresh["up.bias"].zero_()
     generator = torch.Generator().manual_seed(int(seed))
+    fresh = None
+    if simdiff:  # one zero adapter (its input side drawn under the seed) fills every new slot
+        with torch.random.fork_rng(devices=[]):
+            torch.manual_seed(int(torch.randint(0, 2**31 - 1, (1,), generator=generator)))
+            adapter = MotionAdapter(bb.latent_dim, adapter_bottleneck(config.sim, bb.latent_dim))
+        fresh = {k: v.detach().clone() for k, v in adapter.state_dict().items()}
     state = deepen_state(network.state_dict(), "backbone." if simdiff else "", bb, after, generator, fresh)
     new_net.load_state_dict(state)
     save_derived(dst, new_net, new_config, extra, src, COPIED)
