@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Adapters-only GPU run (issue 14): unpack an augmented pack and train several SimDiff adapter variants side by
 # side on one GPU (the small backbone leaves it mostly idle; the batch loaders share the cores) until a wall-clock
-# cap, then tar each run's exported model and logs into $OUT (one file per run, <= 16 MiB each; the device
-# returns at most 8 files, so at most 7 runs).
+# cap, then tar each run's exported model and logs into $OUT (one file per run; a tar over PART_KIB, 15 MiB, is cut
+# into NAME.tar.part_aa, _ab, … since the device returns files of <= 16 MiB, at most 8 of them).
 #
 # Carried (prepare on CPU):
 #   $AUG_PACK    augmented pack(s), e.g. `simdiff train pack AUGMENTED --out .gpu/aug --splits all`; several
@@ -17,6 +17,7 @@
 #   the twins' mean root-velocity term, default 0).
 # Overrides: CONFIG (configs/adapters_paired_gpu.json) SPLIT (all) MINUTES (7) LOADER_WORKERS (cores / runs)
 #   DEVICE (cuda) PYTHON (python) ADAPTERS_INIT (a SimDiff folder to warm-start the adapters from) SEED
+#   PART_KIB (15360: larger tars are cut into parts of this size, e.g. an 8-layer model's 27 MB)
 set -uo pipefail
 : "${OUT:?set OUT to the output folder}"
 : "${AUG_PACK:?set AUG_PACK to an augmented pack folder}"
@@ -65,8 +66,16 @@ kill "$watcher" 2>/dev/null
 for r in $RUNS; do
   n=${r%%:*}
   tail -n 3 "$WORK/logs/$n.log" | tee -a "$OUT/run.log"
-  tar -C "$WORK/$n" -cf "$OUT/$n.tar" model train_log.jsonl train_config.json -C "$WORK/logs" "$n.log" \
-    2>>"$OUT/run.log" || log "$n: nothing to tar"
+  if tar -C "$WORK/$n" -cf "$WORK/$n.tar" model train_log.jsonl train_config.json -C "$WORK/logs" "$n.log" \
+      2>>"$OUT/run.log"; then
+    if [ "$(stat -c %s "$WORK/$n.tar")" -le "$(( ${PART_KIB:-15360} * 1024 ))" ]; then
+      mv "$WORK/$n.tar" "$OUT/$n.tar"
+    else  # the device returns files of <= 16 MiB: cut, `cat NAME.tar.part_* > NAME.tar` joins them
+      split -b "${PART_KIB:-15360}k" "$WORK/$n.tar" "$OUT/$n.tar.part_" && rm -f "$WORK/$n.tar"
+    fi
+  else
+    log "$n: nothing to tar"
+  fi
 done
 log "done status=$status"
 exit "$status"

@@ -202,13 +202,18 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
            "AUG_PACK": f"{tmp_path / 'packs' / 'aug'} {tmp_path / 'packs' / 'aug2'}",
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
            "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5:2", "LOADER_WORKERS": "0",
-           "MINUTES": "3", "WORK": str(tmp_path / "work")})
+           "MINUTES": "3", "WORK": str(tmp_path / "work"), "PART_KIB": "400"})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
                           text=True, timeout=240)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
-    assert sorted(p.name for p in out.iterdir()) == ["pair5.tar", "plain.tar", "run.log"]
+    names = sorted(p.name for p in out.iterdir())
+    assert "run.log" in names and all(n == "run.log" or n.startswith(("plain.tar", "pair5.tar")) for n in names)
+    assert all((out / n).stat().st_size <= 400 * 1024 for n in names if n != "run.log")
+    assert any(".part_" in n for n in names)  # a tar of ~0.7 MB is cut
     for name, lam, mu in (("plain", 0.0, 0.0), ("pair5", 5.0, 2.0)):
-        with tarfile.open(out / f"{name}.tar") as tar:
+        parts = sorted(out.glob(f"{name}.tar.part_*")) or [out / f"{name}.tar"]
+        (tmp_path / f"{name}.joined.tar").write_bytes(b"".join(p.read_bytes() for p in parts))
+        with tarfile.open(tmp_path / f"{name}.joined.tar") as tar:
             tar.extractall(tmp_path / "back" / name, filter="data")
         run = tmp_path / "back" / name
         assert json.loads((run / "train_log.jsonl").read_text().splitlines()[-1])["step"] == 2
