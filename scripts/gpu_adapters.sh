@@ -15,7 +15,8 @@
 #     RUNS="plain:0 pair10:10" bash scripts/gpu_adapters.sh
 # RUNS: space-separated NAME:LAMBDA[:MU] (λ of --env-pairs, 0 = the paper's plain loss; MU of --env-pairs-drift,
 #   the twins' mean root-velocity term, default 0).
-# Overrides: CONFIG (configs/adapters_paired_gpu.json) SPLIT (all) MINUTES (7) LOADER_WORKERS (cores / runs)
+# Overrides: CONFIG (configs/adapters_paired_gpu.json) SPLIT (all; `adapt`: each pack's split files joined, for
+#   packs made with --splits NAME) MINUTES (7) LOADER_WORKERS (cores / runs)
 #   DEVICE (cuda) PYTHON (python) ADAPTERS_INIT (a SimDiff folder to warm-start the adapters from) SEED
 #   PART_KIB (15360: larger tars are cut into parts of this size, e.g. an 8-layer model's 27 MB)
 set -uo pipefail
@@ -44,6 +45,7 @@ for pk in $AUG_PACK; do  # several packs are read as one dataset (train adapters
   log "unpack $pk"
   "$PY" -m simdiff train unpack "$pk" --out "$d" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log" \
     || { log "unpack of $pk failed"; exit 1; }
+  if [ "$SPLIT" = "adapt" ]; then cat "$d"/*.txt > "$d/adapt.txt"; fi  # every split file the pack brought, joined
   data+=("$d")
 done
 ( while sleep 30; do for r in $RUNS; do n=${r%%:*}; log "$n $(tail -n 1 "$WORK/$n/train_log.jsonl" 2>/dev/null)"; done; done ) &

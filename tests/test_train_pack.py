@@ -187,6 +187,8 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
     augment(corpus, aug, AugmentConfig(mode="paired", conditions=2, shard_size=4), projector=EchoProjector(),
             progress=False)
     pack(aug, tmp_path / "packs" / "aug")
+    (aug / "half.txt").write_text("".join((aug / "all.txt").read_text().splitlines(keepends=True)[::2]))
+    pack(aug, tmp_path / "packs" / "aug", splits=["half"])  # packs of one split each, joined as `adapt`
     pack(aug, tmp_path / "packs" / "aug2", splits=["all"])  # a second pack: both are read as one dataset
     write_caption_table(corpus_captions(corpus), FakeMiniLM(), tmp_path / "packs" / "captions.safetensors")
     tiny = backbone_preset("tiny")
@@ -202,6 +204,7 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
            "AUG_PACK": f"{tmp_path / 'packs' / 'aug'} {tmp_path / 'packs' / 'aug2'}",
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
            "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5:2", "LOADER_WORKERS": "0",
+           "SPLIT": "adapt",
            "MINUTES": "3", "WORK": str(tmp_path / "work"), "PART_KIB": "400"})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
                           text=True, timeout=240)
