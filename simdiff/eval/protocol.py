@@ -241,20 +241,15 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
     ``anchor_alpha``: the backbone or reference anchor's adapter strength (0: the backbone alone); ``anchor_t_max``:
     that anchor only at timesteps ≤ this (None: every step).
     """
+    from simdiff.model.generator import guidance_kwargs
+
     finish_log: list[dict[str, Any]] = []
 
     def generate(captions: list[str], lengths: list[int], seed: int) -> Tensor:
         kwargs: dict[str, Any] = {}
         if generator.is_simdiff:
-            kwargs = {"env": env, "env_index": env_index, "alpha": alpha}
-            if env_guidance != 1.0:
-                kwargs["env_guidance"] = env_guidance
-            if anchor != "adapters":
-                kwargs["anchor"] = anchor
-            if anchor_alpha:
-                kwargs["anchor_alpha"] = anchor_alpha
-            if anchor_t_max is not None:
-                kwargs["anchor_t_max"] = anchor_t_max
+            kwargs = {"env": env, "env_index": env_index, "alpha": alpha,
+                      **guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max)}
         if physdiff is not None:
             from simdiff.baselines.physdiff import physdiff_generate
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Callable, Iterable, Sequence
+from typing import Any, Callable, Iterable, Sequence
 
 import torch
 from torch import Tensor, nn
@@ -243,4 +243,22 @@ def impossible(features: Tensor, lengths: Tensor) -> Tensor:
         joints = features_to_joints(features[rows].detach().double().cpu()).numpy()
         lens = lengths[rows].cpu().numpy()
         out[rows] = torch.from_numpy(never_touches(joints, lens) | glides(joints, lens))
+    return out
+
+
+def guidance_kwargs(env_guidance: float = 1.0, anchor: str = "adapters", anchor_alpha: float = 0.0,
+                    anchor_t_max: int | None = None, env_guidance_fallback: float | None = None) -> dict[str, Any]:
+    """The environment-guidance and anchor keywords of :meth:`MotionGenerator.generate` that differ from its
+    defaults: callers pass only these, so wrappers (PhysDiff's) and test stand-ins need not know them all."""
+    out: dict[str, Any] = {}
+    if env_guidance != 1.0:
+        out["env_guidance"] = env_guidance
+    if anchor != "adapters":
+        out["anchor"] = anchor
+    if anchor_alpha:
+        out["anchor_alpha"] = anchor_alpha
+    if anchor_t_max is not None:
+        out["anchor_t_max"] = anchor_t_max
+    if env_guidance_fallback is not None:
+        out["env_guidance_fallback"] = env_guidance_fallback
     return out

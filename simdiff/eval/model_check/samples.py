@@ -54,17 +54,10 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
 
     from simdiff.motion.features import features_to_joints
 
+    from simdiff.model.generator import guidance_kwargs
+
     kwargs: dict[str, Any] = {"env": list(env), "alpha": alpha} if env is not None else {}
-    if env_guidance != 1.0:
-        kwargs["env_guidance"] = env_guidance
-    if anchor != "adapters":
-        kwargs["anchor"] = anchor
-    if anchor_alpha:
-        kwargs["anchor_alpha"] = anchor_alpha
-    if anchor_t_max is not None:
-        kwargs["anchor_t_max"] = anchor_t_max
-    if env_guidance_fallback is not None:
-        kwargs["env_guidance_fallback"] = env_guidance_fallback
+    kwargs.update(guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, env_guidance_fallback))
     out, flags = [], []
     for b in tqdm(batches, desc="prompts", disable=not progress, dynamic_ncols=True, leave=False):
         gen = generator.generate([b.prompt] * b.count, length, sampler="ddim", steps=steps, guidance=guidance,
