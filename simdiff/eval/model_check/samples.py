@@ -52,9 +52,8 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
     """
     from tqdm import tqdm
 
-    from simdiff.motion.features import features_to_joints
-
     from simdiff.model.generator import guidance_kwargs
+    from simdiff.motion.features import features_to_joints
 
     kwargs: dict[str, Any] = {"env": list(env), "alpha": alpha} if env is not None else {}
     kwargs.update(guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, env_guidance_fallback))
