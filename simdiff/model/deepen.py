@@ -15,9 +15,10 @@ the source model's; ``deepening.json`` records the recipe.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import torch
@@ -25,10 +26,10 @@ from torch import Tensor
 
 from simdiff.errors import SimdiffError
 from simdiff.fsio import write_json
-from simdiff.model.backbone import EncoderLayer
-from simdiff.model.config import BackboneConfig
-from simdiff.model.checkpoint import build_network, load_pretrained, save_derived
 from simdiff.model.adapter import MotionAdapter
+from simdiff.model.backbone import EncoderLayer
+from simdiff.model.checkpoint import build_network, load_pretrained, save_derived
+from simdiff.model.config import BackboneConfig
 from simdiff.model.shards import weights_sha256
 from simdiff.model.simdiff_net import SimDiffNet, adapter_bottleneck
 
@@ -37,11 +38,18 @@ COPIED = ("sampling.json", "provenance.json")
 _LAYER = "seqTransEncoder.layers."
 
 
+@contextlib.contextmanager
+def _seeded_from(generator: torch.Generator) -> Iterator[None]:
+    """Module initialisation inside draws from a seed taken from ``generator``; the global RNG is left as it was."""
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(int(torch.randint(0, 2**31 - 1, (1,), generator=generator)))
+        yield
+
+
 def _identity_layer(old: dict[str, Tensor], config: BackboneConfig, generator: torch.Generator) -> dict[str, Tensor]:
     """A fresh layer's weights (PyTorch's default init under ``generator``) with zero output paths; ``norm2`` = old's."""
     c = config
-    with torch.random.fork_rng(devices=[]):  # the global RNG is left as it was
-        torch.manual_seed(int(torch.randint(0, 2**31 - 1, (1,), generator=generator)))
+    with _seeded_from(generator):
         layer = EncoderLayer(c.latent_dim, c.num_heads, c.ff_size, c.dropout, c.activation)
     state = {k: v.detach().clone() for k, v in layer.state_dict().items()}
     for key in ("self_attn.out_proj.weight", "self_attn.out_proj.bias", "linear2.weight", "linear2.bias"):
@@ -53,7 +61,8 @@ def _identity_layer(old: dict[str, Tensor], config: BackboneConfig, generator: t
     return state
 
 
-def deepen_state(state: dict[str, Tensor], prefix: str, config: BackboneConfig, after: Sequence[int], generator: torch.Generator,
+def deepen_state(state: dict[str, Tensor], prefix: str, config: BackboneConfig, after: Sequence[int],
+                 generator: torch.Generator,
                  fresh_adapter: dict[str, Tensor] | None = None) -> dict[str, Tensor]:
     """The state dict of the deepened network (backbone keys under ``prefix``; adapters under ``adapters.``).
 
@@ -110,8 +119,7 @@ def deepen_model(model: str | os.PathLike[str], out: str | os.PathLike[str], aft
     generator = torch.Generator().manual_seed(int(seed))
     fresh = None
     if simdiff:  # one zero adapter (its input side drawn under the seed) fills every new slot
-        with torch.random.fork_rng(devices=[]):
-            torch.manual_seed(int(torch.randint(0, 2**31 - 1, (1,), generator=generator)))
+        with _seeded_from(generator):
             adapter = MotionAdapter(bb.latent_dim, adapter_bottleneck(config.sim, bb.latent_dim))
         fresh = {k: v.detach().clone() for k, v in adapter.state_dict().items()}
     state = deepen_state(network.state_dict(), "backbone." if simdiff else "", bb, after, generator, fresh)

@@ -67,20 +67,28 @@ def shard_tensors(tensors: Mapping[str, Tensor], folder: str | Path, max_bytes: 
     return files
 
 
+def _read_index(folder: Path) -> tuple[dict[str, str], list[Path]]:
+    """A sharded folder's weight map (tensor name → shard file) and its shard paths in name order, each checked to
+    exist (one :class:`SimdiffError` line otherwise)."""
+    index_path = folder / INDEX_NAME
+    try:
+        weight_map: dict[str, str] = json.loads(index_path.read_text(encoding="utf-8"))["weight_map"]
+        files = sorted(set(weight_map.values()))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise SimdiffError(f"{index_path}: cannot read shard index ({type(exc).__name__})") from None
+    paths = [folder / file for file in files]
+    for path in paths:
+        if not path.is_file():
+            raise SimdiffError(f"{path}: shard named in {INDEX_NAME} is missing")
+    return weight_map, paths
+
+
 def load_sharded(folder: str | Path, device: str = "cpu") -> dict[str, Tensor]:
     """All tensors of a sharded folder (checks every indexed name is present in its shard)."""
     folder = Path(folder)
-    index_path = folder / INDEX_NAME
-    try:
-        index = json.loads(index_path.read_text(encoding="utf-8"))
-        weight_map: dict[str, str] = index["weight_map"]
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise SimdiffError(f"{index_path}: cannot read shard index ({type(exc).__name__})") from None
+    weight_map, paths = _read_index(folder)
     tensors: dict[str, Tensor] = {}
-    for file in sorted(set(weight_map.values())):
-        path = folder / file
-        if not path.is_file():
-            raise SimdiffError(f"{path}: shard named in {INDEX_NAME} is missing")
+    for path in paths:
         tensors.update(load_file(str(path), device=device))
     missing = sorted(set(weight_map) - set(tensors))
     if missing:
@@ -104,22 +112,15 @@ def shard_model_folder(model: str | Path, out: str | Path, max_bytes: int) -> li
 
 def weights_sha256(folder: str | Path) -> str:
     """sha256 naming a model folder's weights: of ``model.safetensors`` when present, else of a sharded folder's
-    index followed by its shards' own sha256 in index order (one :class:`SimdiffError` line when it has neither)."""
+    index followed by its shards' own sha256 in name order (one :class:`SimdiffError` line when it has neither)."""
     folder = Path(folder)
     whole = folder / "model.safetensors"
     if whole.is_file():
         return hashlib.sha256(whole.read_bytes()).hexdigest()
-    index_path = folder / INDEX_NAME
-    if not index_path.is_file():
+    if not (folder / INDEX_NAME).is_file():
         raise SimdiffError(f"{folder}: no model.safetensors or {INDEX_NAME}")
-    h = hashlib.sha256(index_path.read_bytes())
-    try:
-        shards = sorted(set(json.loads(index_path.read_text(encoding="utf-8"))["weight_map"].values()))
-    except (ValueError, KeyError, TypeError, AttributeError) as exc:
-        raise SimdiffError(f"{index_path}: cannot read shard index ({type(exc).__name__})") from None
-    for name in shards:
-        path = folder / name
-        if not path.is_file():
-            raise SimdiffError(f"{path}: shard named in {INDEX_NAME} is missing")
-        h.update(name.encode() + b"\0" + hashlib.sha256(path.read_bytes()).digest())
+    _, paths = _read_index(folder)
+    h = hashlib.sha256((folder / INDEX_NAME).read_bytes())
+    for path in paths:
+        h.update(path.name.encode() + b"\0" + hashlib.sha256(path.read_bytes()).digest())
     return h.hexdigest()
