@@ -14,6 +14,8 @@
 # Overrides: BB_MINUTES (5.2) AD_MINUTES (2.4) BB_SPLIT (train_jumpx) BB_CONFIG (configs/backbone_deep_gpu.json)
 #   AD_CONFIG (configs/adapters_paired_gpu_finetune.json) ENV_PAIRS (10) DRIFT (20) SEED (63) DEVICE (cuda)
 #   WORKERS (cores - 2) PYTHON (python) EXTRA_BB / EXTRA_AD (more flags, e.g. "--steps 2" for a CPU rehearsal)
+#   DEEPEN (1; 0: train INIT's own layers, no deepening, e.g. session 63's G63 carried as float16 by
+#   `simdiff train precision`)
 #   DEADLINE_S (555): seconds from the start by which the adapters must have stopped (their minutes are cut to fit;
 #   the backbone's tar is written as soon as it is trained, so a late stop loses the adapters only)
 # Every pack's split files are joined into one split `adapt` (packs made with --splits SPLIT hold only SPLIT).
@@ -50,8 +52,13 @@ for pk in $AUG_PACK; do
   "$PY" -m simdiff train unpack "$pk" --out "$d" --workers 0 --no-progress > "$WORK/logs/unpack_$(basename "$pk").log" 2>&1 &
   pids+=($!)
 done
-"$PY" -m simdiff train deepen --model "$INIT" --out "$WORK/deep" --seed "$SEED" 2>&1 | tee -a "$WORK/logs/run.log"
-ok=${PIPESTATUS[0]}
+if [ "${DEEPEN:-1}" = "1" ]; then
+  "$PY" -m simdiff train deepen --model "$INIT" --out "$WORK/deep" --seed "$SEED" 2>&1 | tee -a "$WORK/logs/run.log"
+  ok=${PIPESTATUS[0]}
+else  # continue INIT as it is (e.g. an already deepened model carried as float16: `simdiff train precision`)
+  ln -s "$(cd "$INIT" && pwd)" "$WORK/deep" && ok=0 || ok=1
+  log "DEEPEN=0: $INIT continued without new layers"
+fi
 for p in "${pids[@]}"; do wait "$p" || ok=1; done
 cat "$WORK"/logs/unpack_*.log | tee -a "$WORK/logs/run.log"
 for d in "${data[@]}"; do cat "$d"/*.txt > "$d/adapt.txt" 2>/dev/null; done

@@ -160,3 +160,23 @@ def test_clip_refuses_torchscript_and_converts_a_trusted_copy(tmp_path, capsys) 
         load_text_encoder("clip", weights=str(tmp_path / "junk.pt"))
     assert convert_main([str(tmp_path / "plain.pt"), str(tmp_path / "x.safetensors")]) == 2
     assert "not a TorchScript archive" in capsys.readouterr().err
+
+
+def test_encoder_cache_builds_each_name_once() -> None:
+    from simdiff.text.base import EncoderCache
+
+    built: list[str] = []
+
+    class Stub:
+        dim = 4
+
+        def __init__(self, name: str) -> None:
+            self.name = name
+            built.append(name)
+
+    cache = EncoderCache("cpu", Stub)
+    first = cache("minilm")
+    assert cache("minilm") is first and cache("clip").name == "clip"
+    assert built == ["minilm", "clip"]
+    with pytest.raises(SimdiffError, match="'nope'"):
+        EncoderCache("cpu")("nope")

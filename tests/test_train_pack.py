@@ -296,16 +296,21 @@ def test_gpu_continue_script_rehearsal_warm_starts_backbone_then_adapters(corpus
     assert max(warm) < 0.05 and any(start[k].abs().max() > 0 for k in start if k.startswith("adapters."))
 
 
-def test_gpu_deepen_script_rehearsal_deepens_then_trains_backbone_and_adapters(corpus, tmp_path) -> None:
+@pytest.mark.parametrize("deepen", [True, False])
+def test_gpu_deepen_script_rehearsal_deepens_then_trains_backbone_and_adapters(corpus, tmp_path, deepen) -> None:
     """scripts/gpu_deepen.sh on CPU: a SimDiff folder deepened (2 -> 4 layers), its backbone trained two steps on the
-    train split's pack, its moved adapters two steps on an augmented pack; both models come back as tar parts."""
+    train split's pack, its moved adapters two steps on an augmented pack; both models come back as tar parts.
+    DEEPEN=0: a float16 copy of the folder continued as it is (the carry of an already deepened model)."""
     import tarfile
+
+    from simdiff.model.precision import convert_precision
 
     packs = _train_and_aug_packs(corpus, tmp_path)
     tiny = backbone_preset("tiny")
     model_config = ModelConfig(backbone=tiny, sim=SimConfig())
     torch.manual_seed(4)
-    save_pretrained(packs / "init", build_network(model_config), model_config)
+    save_pretrained(packs / "init32", build_network(model_config), model_config)
+    convert_precision(packs / "init32", packs / "init", "float32" if deepen else "float16")
     configs = {}
     for name, file in (("bb", "backbone_deep_gpu.json"), ("ad", "adapters_paired_gpu_finetune.json")):
         config = json.loads((ROOT / "configs" / file).read_text())
@@ -317,7 +322,7 @@ def test_gpu_deepen_script_rehearsal_deepens_then_trains_backbone_and_adapters(c
            "AUG_PACK": str(packs / "aug"), "TEXT_TABLE": str(packs / "captions.safetensors"),
            "INIT": str(packs / "init"), "BB_CONFIG": str(configs["bb"]), "AD_CONFIG": str(configs["ad"]),
            "BB_SPLIT": "train", "WORKERS": "0", "BB_MINUTES": "3", "AD_MINUTES": "3",
-           "WORK": str(tmp_path / "work")})
+           "WORK": str(tmp_path / "work"), "DEEPEN": "1" if deepen else "0"})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_deepen.sh")], env=env, capture_output=True,
                           text=True, timeout=300, cwd=ROOT)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
@@ -329,9 +334,13 @@ def test_gpu_deepen_script_rehearsal_deepens_then_trains_backbone_and_adapters(c
             tar.extractall(back / name, filter="data")
     logs = back / "logs" / "logs"
     assert json.loads((logs / "bb_train_log.jsonl").read_text().splitlines()[-1])["step"] == 2
-    assert json.loads((logs / "deepening.json").read_text())["layers"] == [tiny.num_layers, 2 * tiny.num_layers]
+    layers = 2 * tiny.num_layers if deepen else tiny.num_layers
+    if deepen:
+        assert json.loads((logs / "deepening.json").read_text())["layers"] == [tiny.num_layers, layers]
+    else:
+        assert not (logs / "deepening.json").exists() and "DEEPEN=0" in (logs / "run.log").read_text()
     assert "trained adapters to step 2" in (logs / "adapters.log").read_text()
     for name in ("ad", "bb"):
-        assert json.loads((back / name / "model" / "config.json").read_text())["backbone"]["num_layers"] == 2 * tiny.num_layers
+        assert json.loads((back / name / "model" / "config.json").read_text())["backbone"]["num_layers"] == layers
     gen = MotionGenerator.load(back / "ad" / "model", load_text=False)
     assert gen.is_simdiff

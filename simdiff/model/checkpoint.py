@@ -119,8 +119,9 @@ def read_config(folder: str | os.PathLike[str]) -> ModelConfig:
 
 
 def load_pretrained(folder: str | os.PathLike[str], device: torch.device | str = "cpu") -> tuple[nn.Module, ModelConfig, dict[str, Tensor]]:
-    """Load a model folder (whole ``model.safetensors`` or shards with an index); returns
-    ``(network, config, extra_tensors)`` with the network on ``device``."""
+    """Load a model folder (whole ``model.safetensors`` or shards with an index; weights stored as float32 or
+    float16, :mod:`simdiff.model.precision`); returns ``(network, config, extra_tensors)``, all float32, with the
+    network on ``device``."""
     config = read_config(folder)
     path = Path(folder) / WEIGHTS_NAME
     from simdiff.model.shards import INDEX_NAME, load_sharded
@@ -133,7 +134,7 @@ def load_pretrained(folder: str | os.PathLike[str], device: torch.device | str =
         raise SimdiffError(f"{path}: no such file")
     network = build_network(config)
     own = set(network.state_dict())
-    extra = {k: v for k, v in tensors.items() if k not in own}
+    extra = {k: v.float() if v.is_floating_point() else v for k, v in tensors.items() if k not in own}
     network.load_state_dict({k: v for k, v in tensors.items() if k in own}, strict=True)
     return network.to(device), config, extra
 

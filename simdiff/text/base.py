@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Protocol, Sequence, runtime_checkable
+from typing import Callable, Protocol, Sequence, runtime_checkable
 
 import torch
 from torch import Tensor
@@ -55,3 +55,18 @@ def load_text_encoder(name: str = "minilm", device: torch.device | str = "cpu", 
         return CLIPTextEncoder.from_file(weights, device=device)
     text_dim(name)
     raise AssertionError("unreachable")
+
+
+class EncoderCache:
+    """One encoder per name for a run: ``factory(name)`` when given (a test's stand-in), else
+    :func:`load_text_encoder` on ``device``; each built on first use."""
+
+    def __init__(self, device: torch.device | str = "cpu", factory: Callable[[str], TextEncoder] | None = None) -> None:
+        self.device = device
+        self.factory = factory
+        self._built: dict[str, TextEncoder] = {}
+
+    def __call__(self, name: str) -> TextEncoder:
+        if name not in self._built:
+            self._built[name] = self.factory(name) if self.factory is not None else load_text_encoder(name, self.device)
+        return self._built[name]

@@ -124,6 +124,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="old layer indices each followed by a new layer (default: every layer, doubling the depth)")
     dp.add_argument("--seed", type=int, default=0, help="seed of the new layers' input-side weights (default 0)")
     dp.set_defaults(func=run_deepen)
+    pr = group.add_parser("precision", help="store a model's weights as float16 (half the file) or float32",
+                          description="Write MODEL with its network weights stored as DTYPE (float16: half the "
+                                      "file, each weight within 2^-11 relative; float32). Mean/Std stay float32; "
+                                      "loading gives float32 weights either way. precision.json records the "
+                                      "recipe.")
+    pr.add_argument("--model", type=Path, required=True, help="model folder (SimDiff or backbone-only)")
+    pr.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
+    pr.add_argument("--dtype", choices=["float16", "float32"], default="float16", help="stored precision")
+    pr.set_defaults(func=run_precision)
 
 
 def run_export(args: argparse.Namespace) -> int:
@@ -137,6 +146,13 @@ def run_deepen(args: argparse.Namespace) -> int:
     from simdiff.model.deepen import deepen_model
 
     print(f"wrote {deepen_model(args.model, args.out, args.after, args.seed)}")
+    return 0
+
+
+def run_precision(args: argparse.Namespace) -> int:
+    from simdiff.model.precision import convert_precision
+
+    print(f"wrote {convert_precision(args.model, args.out, args.dtype)}")
     return 0
 
 

@@ -29,6 +29,7 @@ from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ExperimentConfig, ModelSpec
 from simdiff.eval.experiments.provenance import provenance
 from simdiff.eval.protocol import GenerateFn, ProtocolConfig, evaluate_t2m, finish_summary, generator_fn
+from simdiff.text.base import EncoderCache
 
 EARTH: tuple[float, float, float] = (-9.81, 0.0, 0.0)
 FPS: float = 20.0
@@ -77,7 +78,6 @@ class Runner:
         """``projector`` and ``text_encoder`` (a factory: encoder name → encoder) replace the simulator
         and the models' own text encoders (tests); neither enters the rows' fingerprints."""
         self.config = config
-        self._text_factory = text_encoder
         self.out = Path(config.out_dir) / config.name
         self.rows_dir = self.out / "rows"
         self.progress = progress
@@ -88,7 +88,7 @@ class Runner:
         self._projector: Any = projector
         self._finish_projector: Any = None
         self._models: dict[str, Any] = {}
-        self._encoders: dict[str, Any] = {}
+        self._encoders = EncoderCache(self.config.device, text_encoder)
         self._evaluator: Any = None
         self._dataset: Any = None
         self._lengths: np.ndarray | None = None
@@ -98,14 +98,7 @@ class Runner:
     # --- resources ------------------------------------------------------------------------
     def text_encoder(self, name: str) -> Any:
         """The sentence encoder ``name`` (one instance per run), or the injected stand-in's."""
-        if name not in self._encoders:
-            if self._text_factory is not None:
-                self._encoders[name] = self._text_factory(name)
-            else:
-                from simdiff.text.base import load_text_encoder
-
-                self._encoders[name] = load_text_encoder(name, self.config.device)
-        return self._encoders[name]
+        return self._encoders(name)
 
     def model(self, spec: ModelSpec) -> Any:
         """The :class:`simdiff.model.MotionGenerator` of ``spec`` (loaded once per folder and role).

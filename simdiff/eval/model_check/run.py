@@ -23,6 +23,7 @@ from simdiff.eval.model_check.config import EARTH, JUMP_PROMPTS, MOON_G, SPEED_P
 from simdiff.eval.model_check.samples import PromptBatch, generate_set_flags, plan_batches, units
 from simdiff.motion.foot_lock import CLEANUP_VERSION
 from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT, GLIDE_SPEED
+from simdiff.text.base import EncoderCache
 
 SCHEMA: str = "simdiff.model_check/1"
 FLOOR_RULE: dict[str, float] = {"never_touch_clearance_m": FLOOR_CLEARANCE}
@@ -88,8 +89,7 @@ class ModelCheck:
         self.progress = progress
         self.fresh = fresh
         self.command = command
-        self._text_factory = text_encoder
-        self._encoders: dict[str, Any] = {}
+        self._encoders = EncoderCache(self.config.device, text_encoder)
         self._injected = projector
         self._projector = projector
         self._generator: Any = None
@@ -98,14 +98,7 @@ class ModelCheck:
 
     # --- resources --------------------------------------------------------------------------
     def text_encoder(self, name: str) -> Any:
-        if name not in self._encoders:
-            if self._text_factory is not None:
-                self._encoders[name] = self._text_factory(name)
-            else:
-                from simdiff.text.base import load_text_encoder
-
-                self._encoders[name] = load_text_encoder(name, self.config.device)
-        return self._encoders[name]
+        return self._encoders(name)
 
     @property
     def generator(self) -> Any:

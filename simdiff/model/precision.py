@@ -1,0 +1,59 @@
+"""Store a model folder's network weights as float16 (half the file: a GPU machine's carry, a smaller shipped model)
+or back as float32.
+
+Only the network's floating-point weights change precision; the feature Mean/Std (``normalizer.*``, (263,)) stay
+float32, since generation and training compare and divide by them. :func:`simdiff.model.checkpoint.load_pretrained`
+loads either into a float32 network, so a float16 folder samples and trains with its weights rounded to float16
+(relative error ≤ 2⁻¹¹ ≈ 4.9e-4 each; values beyond ±65,504 are refused). The output records the recipe in
+``precision.json``; ``sampling.json``, ``provenance.json`` and the model's README and recipes are copied unchanged.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import torch
+
+from simdiff.errors import SimdiffError
+from simdiff.fsio import write_bytes, write_json
+from simdiff.model.checkpoint import CONFIG_NAME, WEIGHTS_NAME, atomic_save_tensors, load_pretrained
+from simdiff.model.shards import weights_sha256
+
+RECIPE_NAME = "precision.json"
+DTYPES = {"float16": torch.float16, "float32": torch.float32}
+COPIED = ("sampling.json", "provenance.json", "README.md", "deepening.json", "extrapolation.json")
+"""Files of the source folder carried over byte for byte when present."""
+KEPT_FLOAT32 = ("normalizer.",)
+
+
+def convert_precision(model: str | os.PathLike[str], out: str | os.PathLike[str], dtype: str = "float16") -> Path:
+    """Write ``out``: ``model`` with its network weights stored as ``dtype`` (``float16`` or ``float32``).
+
+    Refused (one line) for another dtype, ``out`` equal to ``model``, or a weight too large for float16.
+    """
+    if dtype not in DTYPES:
+        raise SimdiffError(f"precision must be one of {', '.join(DTYPES)}, got {dtype!r}")
+    src, dst = Path(model), Path(out)
+    if dst.resolve() == src.resolve():
+        raise SimdiffError(f"{dst}: the output folder must differ from the model")
+    network, _, extra = load_pretrained(src)
+    tensors: dict[str, torch.Tensor] = {}
+    for key, value in network.state_dict().items():
+        if value.is_floating_point():
+            if dtype == "float16" and bool(value.abs().max() > torch.finfo(torch.float16).max):
+                raise SimdiffError(f"{src}: weight {key} exceeds float16's range (±65504); keep it float32")
+            value = value.to(DTYPES[dtype])
+        tensors[key] = value
+    for key, value in extra.items():
+        keep = value.is_floating_point() and not key.startswith(KEPT_FLOAT32)
+        tensors[key] = value.to(DTYPES[dtype]) if keep else value.float() if value.is_floating_point() else value
+    dst.mkdir(parents=True, exist_ok=True)
+    atomic_save_tensors(tensors, dst / WEIGHTS_NAME, metadata={"format": "pt", "library": "simdiff"})
+    write_bytes(dst / CONFIG_NAME, (src / CONFIG_NAME).read_bytes())
+    for name in COPIED:
+        if (src / name).is_file():
+            write_bytes(dst / name, (src / name).read_bytes())
+    write_json(dst / RECIPE_NAME, {"rule": f"network weights stored as {dtype}; normalizer.* float32",
+                                   "dtype": dtype, "model": str(src), "model_sha256": weights_sha256(src)})
+    return dst
