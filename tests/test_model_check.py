@@ -181,6 +181,29 @@ def test_speed_summary_counts_walks_that_jump() -> None:
     assert bare["types"]["walk"]["jumping"]["corpus_train_fraction"] is None
 
 
+def test_speed_reference_is_the_corpus_clips_of_about_the_samples_length() -> None:
+    from simdiff.eval.model_check.prompts import length_matched, speed_summary
+
+    frames = [40, 50, 60, 70, 100, 120, 150, 151, 300]
+    many = frames * 10  # 10 clips at each length: 30 within [96, 150]
+    assert sorted({many[i] for i in length_matched(many, 120)}) == [100, 120, 150]
+    few = [40, 60, 100, 120, 300] + [50] * 30  # 2 within the window: the 20 closest by length instead
+    picked = length_matched(few, 120)
+    assert len(picked) == 20 and {1, 2, 3}.issubset(picked) and not {0, 4} & set(picked)  # 60, 100, 120, 17 × 50
+    assert length_matched([100, 120], 120) == [0, 1]  # fewer than 20 clips in all: every clip
+    batches = plan_batches(["a person runs"], 2, [0])
+    joints = np.stack([walk(80, speed=1.5), walk(80, speed=1.7)])
+    speeds = [3.0] * 20 + np.linspace(1.3, 1.9, 20).tolist()  # short clips fast, 80-frame clips slow
+    lengths = [40] * 20 + [80] * 20
+    out = speed_summary(joints, batches, {"run": ["a person runs"]}, {"run": speeds}, None, {"run": lengths})
+    run = out["types"]["run"]
+    assert run["corpus_train"]["median"] == pytest.approx(1.6) and run["corpus_train"]["n"] == 20
+    assert run["corpus_train_all_lengths"]["n"] == 40 and run["median_in_iqr"] is True
+    assert "[64, 100] frames (samples: 80" in out["rule"]
+    unmatched = speed_summary(joints, batches, {"run": ["a person runs"]}, {"run": speeds})
+    assert unmatched["types"]["run"]["median_in_iqr"] is False  # against every length the samples are too slow
+
+
 def test_generate_set_flags_keeps_the_generators_fallback_rows_in_order() -> None:
     import torch
 

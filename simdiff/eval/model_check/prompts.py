@@ -4,9 +4,12 @@
   (:func:`simdiff.eval.model_check.detect.jump_stats`) with a Wilson 95 % interval over samples
   (samples of one prompt are not fully independent; the per-prompt rows show the spread).
 * Speeds (:func:`speed_summary`): quartiles of the samples' mean horizontal root speed per motion
-  type against the quartiles of the corpus's *train* clips of that ``motion_type``
-  (``manifest.json``; mirrors left out: they have their original's speed). A type passes when
-  the samples' median lies within the corpus clips' interquartile range. Beside it (no verdict): how many
+  type against the quartiles of the corpus's *train* clips of that ``motion_type`` and of about the samples'
+  length (:func:`length_matched`; ``manifest.json``; mirrors left out: they have their original's speed). A type
+  passes when the samples' median lies within those clips' interquartile range. The length matters: mocap runs are
+  short because capture volumes are (corpus3's train runs: median 2.90 m/s under 60 frames, 1.45 m/s at 120 frames
+  or more, session 65), so a 6 s sample is compared with the corpus's long clips; the all-lengths quartiles are
+  reported beside (no verdict). Beside it (no verdict): how many
   walk / run samples jump by the jump rule, against the corpus clips' rate over the samples' length (session 53:
   a model pushed to jump more can start hopping when asked to walk).
 
@@ -63,10 +66,30 @@ def _row(prompt: str, stats: list[dict[str, Any]]) -> dict[str, Any]:
             "median_rise_m": float(np.median([s["rise_m"] for s in stats])) if stats else float("nan")}
 
 
+LENGTH_WINDOW: float = 1.25
+"""Corpus clips within [L / 1.25, L × 1.25] frames are compared with samples of L frames."""
+MIN_MATCHED: int = 20
+"""With fewer clips in the window, the 20 clips closest in length (log ratio) are used instead."""
+SPEED_REFERENCE: dict[str, float | int] = {"speed_length_window": LENGTH_WINDOW, "speed_min_matched": MIN_MATCHED}
+"""In the speeds section's fingerprint: the corpus reference is length-matched since session 65."""
+
+
+def length_matched(frames: Sequence[int], length: int) -> list[int]:
+    """Indices of the clips (``frames`` each) compared with samples of ``length`` frames: those within
+    [length / :data:`LENGTH_WINDOW`, length × :data:`LENGTH_WINDOW`], or, when fewer than :data:`MIN_MATCHED` are,
+    the :data:`MIN_MATCHED` closest in length by |log(frames / length)| (all clips when there are fewer)."""
+    inside = [i for i, n in enumerate(frames) if length / LENGTH_WINDOW <= n <= length * LENGTH_WINDOW]
+    if len(inside) >= MIN_MATCHED or len(frames) <= len(inside):
+        return inside
+    order = sorted(range(len(frames)), key=lambda i: (abs(np.log(max(frames[i], 1) / length)), i))
+    return sorted(order[:MIN_MATCHED])
+
+
 def corpus_clips(corpus: str | Path, types: Sequence[str], limit: int = 0, seed: int = 0,
-                 frames: int = 0) -> dict[str, list[tuple[float, bool]]]:
-    """(mean horizontal root speed m/s, jumps by :func:`jump_stats`) of the corpus's train clips per ``motion_type``
-    (originals only); the jump rule reads each clip's first ``frames`` frames (0: all), the samples' length.
+                 frames: int = 0) -> dict[str, list[tuple[float, bool, int]]]:
+    """(mean horizontal root speed m/s, jumps by :func:`jump_stats`, frames) of the corpus's train clips per
+    ``motion_type`` (originals only); the jump rule reads each clip's first ``frames`` frames (0: all), the samples'
+    length.
 
     Args:
         corpus: a corpus folder with ``manifest.json`` (``clips`` with ``id``, ``split``, ``motion_type``,
@@ -85,7 +108,7 @@ def corpus_clips(corpus: str | Path, types: Sequence[str], limit: int = 0, seed:
     if not isinstance(clips, list) or not all(isinstance(c, dict) and "motion_type" in c for c in clips):
         raise SimdiffError(f"{path}: clips without 'motion_type' (build the corpus with `simdiff data build`)")
     rng = np.random.default_rng(seed)
-    out: dict[str, list[tuple[float, bool]]] = {}
+    out: dict[str, list[tuple[float, bool, int]]] = {}
     for kind in types:
         ids = sorted(c["id"] for c in clips if c.get("split") == "train" and c["motion_type"] == kind
                      and not c.get("mirror_of"))
@@ -97,28 +120,39 @@ def corpus_clips(corpus: str | Path, types: Sequence[str], limit: int = 0, seed:
             if not f.is_file():
                 raise SimdiffError(f"{f}: missing (listed in manifest.json)")
             joints = np.load(f)
-            rows.append((root_speed(joints), bool(jump_stats(joints[:frames] if frames else joints)["jump"])))
+            rows.append((root_speed(joints), bool(jump_stats(joints[:frames] if frames else joints)["jump"]),
+                         int(len(joints))))
         out[kind] = rows
     return out
 
 
 def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dict[str, Sequence[str]],
-                  corpus: dict[str, list[float]], corpus_jumps: dict[str, list[bool]] | None = None) -> dict[str, Any]:
-    """Per motion type: quartiles of the samples' speeds (and per prompt) against the corpus clips'; how many samples
-    jump (a walk or run that jumps is not what was asked; the corpus clips' rate beside it when given)."""
+                  corpus: dict[str, list[float]], corpus_jumps: dict[str, list[bool]] | None = None,
+                  corpus_frames: dict[str, list[int]] | None = None) -> dict[str, Any]:
+    """Per motion type: quartiles of the samples' speeds (and per prompt) against the corpus clips' (only those of
+    about the samples' length, :func:`length_matched`, when ``corpus_frames`` gives the clips' lengths); how many
+    samples jump (a walk or run that jumps is not what was asked; the corpus clips' rate beside it when given)."""
     owners = _per_sample(batches)
+    length = int(joints.shape[1])
     speeds = [root_speed(j) for j in joints]
     jumping = [bool(jump_stats(j)["jump"]) for j in joints]
     floating = never_touches(joints)
     out: dict[str, Any] = {"speed": "mean horizontal pelvis speed over the motion (m/s)",
                            "rule": "pass when the samples' median lies in the corpus train clips' [Q1, Q3]",
                            "types": {}}
+    if corpus_frames is not None:
+        out["rule"] = (f"pass when the samples' median lies in [Q1, Q3] of the corpus train clips within "
+                       f"[{length / LENGTH_WINDOW:.0f}, {length * LENGTH_WINDOW:.0f}] frames (samples: {length}; "
+                       f"the {MIN_MATCHED} closest in length when fewer)")
     for kind, prompts in kinds.items():
         mine = [v for v, b in zip(speeds, owners) if b.prompt in prompts]
-        ref = quartiles(corpus.get(kind, []))
+        every = list(corpus.get(kind, []))
+        lengths = None if corpus_frames is None else list(corpus_frames.get(kind, []))
+        ref = quartiles(every if lengths is None else [every[i] for i in length_matched(lengths, length)])
         gen = quartiles(mine)
         out["types"][kind] = {
             "prompts": list(prompts), "samples": gen, "corpus_train": ref,
+            **({} if lengths is None else {"corpus_train_all_lengths": quartiles(every)}),
             "per_prompt": {p: quartiles([v for v, b in zip(speeds, owners) if b.prompt == p]) for p in prompts},
             "never_touch": int(sum(f for f, b in zip(floating, owners) if b.prompt in prompts)),
             "jumping": _jumping([k for k, b in zip(jumping, owners) if b.prompt in prompts],

@@ -108,10 +108,13 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
     if "skipped" in s:
         return [f"Not measured: {s['skipped']}."]
     lines = [f"Speed: {s['speed']}; {s['rule']}. Quartiles Q1 / median / Q3.", "",
-             "| type | prompts | samples | corpus train clips | median in IQR | never touch floor | jumping (corpus) |",
-             "|---|---|---|---|---|---|---|"]
+             "| type | prompts | samples | corpus train clips | all lengths (no verdict) | median in IQR | "
+             "never touch floor | jumping (corpus) |",
+             "|---|---|---|---|---|---|---|---|"]
     for kind, t in s["types"].items():
+        every = t.get("corpus_train_all_lengths")
         lines.append(f"| {kind} | {'; '.join(t['prompts'])} | {_q(t['samples'])} | {_q(t['corpus_train'])} | "
+                     f"{'—' if every is None else _q(every)} | "
                      f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} | "
                      f"{_jumping(t.get('jumping'))} |")
     return lines

@@ -241,7 +241,7 @@ class ModelCheck:
                          lambda: jump_summary(self.samples("jumps", batches, EARTH), batches))
 
     def speeds(self) -> dict[str, Any]:
-        from simdiff.eval.model_check.prompts import corpus_clips, speed_summary
+        from simdiff.eval.model_check.prompts import SPEED_REFERENCE, corpus_clips, speed_summary
 
         c = self.config
 
@@ -253,10 +253,12 @@ class ModelCheck:
                 return {"skipped": str(exc)}
             batches = self.speed_batches()
             return speed_summary(self.samples("speeds", batches, EARTH), batches, SPEED_PROMPTS,
-                                 {k: [v for v, _ in rows] for k, rows in clips.items()},
-                                 {k: [j for _, j in rows] for k, rows in clips.items()})
+                                 {k: [v for v, _, _ in rows] for k, rows in clips.items()},
+                                 {k: [j for _, j, _ in rows] for k, rows in clips.items()},
+                                 {k: [n for _, _, n in rows] for k, rows in clips.items()})
 
         return self.part("speeds", {"prompts": SPEED_PROMPTS, "options": c.prompts.__dict__, **JUMPING_RULE,
+                                    **SPEED_REFERENCE,
                                     "corpus": _stamp(c.corpus, "manifest.json")}, measure)
 
     def response(self) -> dict[str, Any]:
