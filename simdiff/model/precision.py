@@ -45,9 +45,8 @@ def convert_precision(model: str | os.PathLike[str], out: str | os.PathLike[str]
                 raise SimdiffError(f"{src}: weight {key} exceeds float16's range (±65504); keep it float32")
             value = value.to(DTYPES[dtype])
         tensors[key] = value
-    for key, value in extra.items():
-        keep = value.is_floating_point() and not key.startswith(KEPT_FLOAT32)
-        tensors[key] = value.to(DTYPES[dtype]) if keep else value.float() if value.is_floating_point() else value
+    for key, value in extra.items():  # float32 from load_pretrained
+        tensors[key] = value if key.startswith(KEPT_FLOAT32) or not value.is_floating_point() else value.to(DTYPES[dtype])
     dst.mkdir(parents=True, exist_ok=True)
     atomic_save_tensors(tensors, dst / WEIGHTS_NAME, metadata={"format": "pt", "library": "simdiff"})
     write_bytes(dst / CONFIG_NAME, (src / CONFIG_NAME).read_bytes())
