@@ -16,8 +16,8 @@ from pathlib import Path
 import torch
 
 from simdiff.errors import SimdiffError
-from simdiff.fsio import write_bytes, write_json
-from simdiff.model.checkpoint import CONFIG_NAME, WEIGHTS_NAME, atomic_save_tensors, load_pretrained
+from simdiff.fsio import write_json
+from simdiff.model.checkpoint import load_pretrained, save_derived
 from simdiff.model.shards import weights_sha256
 
 RECIPE_NAME = "precision.json"
@@ -37,22 +37,15 @@ def convert_precision(model: str | os.PathLike[str], out: str | os.PathLike[str]
     src, dst = Path(model), Path(out)
     if dst.resolve() == src.resolve():
         raise SimdiffError(f"{dst}: the output folder must differ from the model")
-    network, _, extra = load_pretrained(src)
-    tensors: dict[str, torch.Tensor] = {}
-    for key, value in network.state_dict().items():
-        if value.is_floating_point():
-            if dtype == "float16" and bool(value.abs().max() > torch.finfo(torch.float16).max):
+    network, config, extra = load_pretrained(src)
+    if dtype == "float16":
+        for key, value in network.state_dict().items():
+            if value.is_floating_point() and bool(value.abs().max() > torch.finfo(torch.float16).max):
                 raise SimdiffError(f"{src}: weight {key} exceeds float16's range (±65504); keep it float32")
-            value = value.to(DTYPES[dtype])
-        tensors[key] = value
-    for key, value in extra.items():  # float32 from load_pretrained
-        tensors[key] = value if key.startswith(KEPT_FLOAT32) or not value.is_floating_point() else value.to(DTYPES[dtype])
-    dst.mkdir(parents=True, exist_ok=True)
-    atomic_save_tensors(tensors, dst / WEIGHTS_NAME, metadata={"format": "pt", "library": "simdiff"})
-    write_bytes(dst / CONFIG_NAME, (src / CONFIG_NAME).read_bytes())
-    for name in COPIED:
-        if (src / name).is_file():
-            write_bytes(dst / name, (src / name).read_bytes())
+    network.to(DTYPES[dtype])
+    extra = {k: v if k.startswith(KEPT_FLOAT32) or not v.is_floating_point() else v.to(DTYPES[dtype])
+             for k, v in extra.items()}  # float32 from load_pretrained
+    save_derived(dst, network, config, extra, src, COPIED)
     write_json(dst / RECIPE_NAME, {"rule": f"network weights stored as {dtype}; normalizer.* float32",
                                    "dtype": dtype, "model": str(src), "model_sha256": weights_sha256(src)})
     return dst

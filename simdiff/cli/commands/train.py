@@ -98,18 +98,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
                                      "Mean/Std, provenance) as its own model folder: the MDM rows of an evaluation.")
-    e.add_argument("--model", type=Path, required=True, help="SimDiff model folder (model.safetensors + config.json)")
-    e.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
+    _model_and_out(e, "SimDiff model folder (model.safetensors + config.json)")
     e.set_defaults(func=run_export)
     x = group.add_parser("extrapolate", help="move a fine-tuned backbone further along its fine-tune (task arithmetic)",
                          description="Write MODEL with its backbone weights at model + LAMBDA x (model - parent): "
                                      "LAMBDA 0 copies MODEL, LAMBDA > 0 goes further in the direction the fine-tune "
                                      "from PARENT moved them. Adapters, Mean/Std, config and sampling.json are "
                                      "MODEL's; extrapolation.json records the recipe.")
-    x.add_argument("--model", type=Path, required=True, help="the fine-tuned model folder (SimDiff or backbone-only)")
+    _model_and_out(x, "the fine-tuned model folder (SimDiff or backbone-only)")
     x.add_argument("--parent", type=Path, required=True, help="the model folder it was fine-tuned from")
     x.add_argument("--lam", type=float, required=True, metavar="LAMBDA", help="extrapolation factor (e.g. 2)")
-    x.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
     x.set_defaults(func=run_extrapolate)
     dp = group.add_parser("deepen", help="insert identity layers into a model's backbone (same output, more depth)",
                           description="Write MODEL with one new transformer layer after each listed backbone layer. "
@@ -118,8 +116,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                       "them), so the deeper model gives the same x0 until it is trained further "
                                       "(`train backbone --init`). Adapters keep their inputs; new adapter slots are "
                                       "zero. deepening.json records the recipe.")
-    dp.add_argument("--model", type=Path, required=True, help="model folder (SimDiff or backbone-only)")
-    dp.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
+    _model_and_out(dp, "model folder (SimDiff or backbone-only)")
     dp.add_argument("--after", type=int, nargs="+", metavar="LAYER",
                     help="old layer indices each followed by a new layer (default: every layer, doubling the depth)")
     dp.add_argument("--seed", type=int, default=0, help="seed of the new layers' input-side weights (default 0)")
@@ -129,8 +126,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                       "file, each weight within 2^-11 relative; float32). Mean/Std stay float32; "
                                       "loading gives float32 weights either way. precision.json records the "
                                       "recipe.")
-    pr.add_argument("--model", type=Path, required=True, help="model folder (SimDiff or backbone-only)")
-    pr.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
+    _model_and_out(pr, "model folder (SimDiff or backbone-only)")
     pr.add_argument("--dtype", choices=["float16", "float32"], default="float16", help="stored precision")
     pr.set_defaults(func=run_precision)
 
@@ -147,6 +143,12 @@ def run_deepen(args: argparse.Namespace) -> int:
 
     print(f"wrote {deepen_model(args.model, args.out, args.after, args.seed)}")
     return 0
+
+
+def _model_and_out(parser: argparse.ArgumentParser, model_help: str) -> None:
+    """``--model`` (the source folder) and ``--out`` of the commands that write a model derived from another."""
+    parser.add_argument("--model", type=Path, required=True, help=model_help)
+    parser.add_argument("--out", type=Path, required=True, help="output model folder (files in it are replaced)")
 
 
 def run_precision(args: argparse.Namespace) -> int:
