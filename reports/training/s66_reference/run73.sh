@@ -1,0 +1,42 @@
+# Rule 73 (session 66; rule73.txt): G63r (G63's weights, reference anchor at anchor_alpha 0, s_e 3, fallback 2) through
+# the gate, C', A, B, C+ and T, each only after the one before passed. Verdict lines go to rule73_stages.txt.
+# Re-running skips every draw already on disk (the check folders under /work/scratch/s39/eval11).
+# Rule 74 (rule74.txt) runs the same with RULE=74 N=G63r5 SE=5 FB=4 AS=142 (run74.sh).
+set -u
+RULE=${RULE:-73} N=${N:-G63r} SE=${SE:-3} FB=${FB:-2} AS=${AS:-140}
+cd /work/main; . .venv/bin/activate
+R=reports/training/s66_reference; S=/work/scratch/s39; M=/work/scratch/s66/${N}_model
+OUT=$R/rule${RULE}_stages.txt; R57=reports/training/s57_pooled_a
+export SIMDIFF_SCRATCH=$S STEPS=50 ANCHOR=reference AA=0 ANCHOR_ALPHA=0 PROBE_ANCHOR=reference PROBE_ANCHOR_ALPHA=0
+stamp() { echo "[$(date -u +%H:%M)] $*" >&2; }
+PROBE=/work/scratch/s66/${N}_probe.log
+stamp gate; [ -s $PROBE ] || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $M > $PROBE 2>&1
+python - "$PROBE" $RULE <<'PY' | tee -a $OUT | grep -q "gate PASS" || { echo "rule $RULE: gate failed"; exit 0; }
+import json, sys
+r = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")][-1]
+wind = sum(v["downwind"] for v in r["wind"].values())
+apex, ratio = r["gravity"]["apex_change_median_m"], r["moon"]["speed_ratio_median"]
+ok = wind >= 60 and apex >= 0.32 and ratio >= 0.80
+print(f"rule {sys.argv[2]} gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
+PY
+guard() {  # $1 phi, $2 seeds, $3 folder
+  [ -f $3/$1/check.json ] || SEEDS="$2" /usr/bin/time -f "stage $3 %e s" python reports/training/s37_env_guidance/guard.py \
+    $1 $SE $3/$1 $M >&2 || exit 1
+}
+stamp "C'"; guard -1.6,0,0 "1 2" $S/eval11/C12_$N
+{ echo -n "C' g -1.6 seeds 1 2: "; python $R/v73.py text $S/eval11/C12_$N/-1.6,0,0; } | tee -a $OUT | grep -q PASS \
+  || { echo "rule $RULE: C' failed"; exit 0; }
+stamp A; A=$S/eval11/A_${N}_s$AS
+[ -f $A/check.json ] || JS=32 ASEEDS="$AS $((AS + 1))" FB=$FB bash reports/training/s39_drift_gpu/check.sh A ${N}_s$AS $M $SE
+python $R57/stage_a55.py $A | tee -a $OUT | grep -q PASS || { echo "rule $RULE: A failed"; exit 0; }
+stamp B; W=$(cd reports/training/s53_extrapolate && python walk_probe.py $M | tee /work/scratch/s66/walk$RULE.txt \
+  | sed -n 's/.*jumping \([0-9]*\)\/.*/\1/p')
+{ echo -n "B Earth seeds 0 1 (session 65's draw): "; python $R/v73.py earth $S/eval11/B_G63a0_s65 "$W"; } | tee -a $OUT \
+  | grep -q PASS || { echo "rule $RULE: B failed"; exit 0; }
+stamp C+; guard -9.81,10,0 "0" $S/eval11/Cp_$N
+{ echo -n "C+ w_x +10 N seed 0: "; python $R/v73.py text $S/eval11/Cp_$N/-9.81,10,0; } | tee -a $OUT | grep -q PASS \
+  || { echo "rule $RULE: C+ failed"; exit 0; }
+stamp T; T=$S/eval11/T_${N}_se${SE}_fb$FB
+[ -f $T/check.json ] || FB=$FB bash reports/training/s39_drift_gpu/check.sh T ${N}_se${SE}_fb$FB $M $SE
+{ echo -n "T test seeds 0-4: "; python $R/v73.py test $T; } | tee -a $OUT
+stamp done
