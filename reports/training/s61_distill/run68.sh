@@ -10,14 +10,8 @@ S=/work/scratch/s39; O=${O:-/work/scratch/s61}; R=${R:-reports/training/s61_dist
 R56=reports/training/s56_source_anchored; R57=reports/training/s57_pooled_a
 export SIMDIFF_SCRATCH=$S STEPS=50
 PROBE=${PROBE:-/work/scratch/s61_$(echo $NAME | tr D d).log}
-python - "$PROBE" $RULE <<'PY' | tee -a $R/rule${RULE}_stages.txt | grep -q "gate PASS" || { echo "rule $RULE: gate failed"; exit 0; }
-import json, sys
-r = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")][-1]
-wind = sum(v["downwind"] for v in r["wind"].values())
-apex, ratio = r["gravity"]["apex_change_median_m"], r["moon"]["speed_ratio_median"]
-ok = wind >= 60 and apex >= 0.32 and ratio >= 0.80
-print(f"rule {sys.argv[2]} gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
-PY
+python reports/training/s61_distill/gate68.py "$PROBE" $RULE | tee -a $R/rule${RULE}_stages.txt | grep -q "gate PASS" \
+  || { echo "rule $RULE: gate failed"; exit 0; }
 ${CPRIME:-bash reports/training/s61_distill/cprime.sh} $NAME $M | tee -a $R/rule${RULE}_stages.txt | grep -q PASS || { echo "rule $RULE: C' failed"; exit 0; }
 JS=32 ASEEDS="$AS $((AS + 1))" FB=$FB bash reports/training/s39_drift_gpu/check.sh A ${NAME}_se${SE}_fb${FB}_js32_s$AS $M $SE
 python $R57/stage_a55.py $S/eval11/A_${NAME}_se${SE}_fb${FB}_js32_s$AS | tee -a $R/rule${RULE}_stages.txt | grep -q PASS \

@@ -11,14 +11,8 @@ export SIMDIFF_SCRATCH=$S STEPS=50 ANCHOR=reference AA=0 ANCHOR_ALPHA=0 PROBE_AN
 stamp() { echo "[$(date -u +%H:%M)] $*" >&2; }
 PROBE=/work/scratch/s66/${N}_probe.log
 stamp gate; [ -s $PROBE ] || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $M > $PROBE 2>&1
-python - "$PROBE" $RULE <<'PY' | tee -a $OUT | grep -q "gate PASS" || { echo "rule $RULE: gate failed"; exit 0; }
-import json, sys
-r = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")][-1]
-wind = sum(v["downwind"] for v in r["wind"].values())
-apex, ratio = r["gravity"]["apex_change_median_m"], r["moon"]["speed_ratio_median"]
-ok = wind >= 60 and apex >= 0.32 and ratio >= 0.80
-print(f"rule {sys.argv[2]} gate: wind {wind}/64, apex change {apex:.3f} m, speed ratio {ratio:.3f} -> gate {'PASS' if ok else 'FAIL'}")
-PY
+python reports/training/s61_distill/gate68.py "$PROBE" $RULE | tee -a $OUT | grep -q "gate PASS" \
+  || { echo "rule $RULE: gate failed"; exit 0; }
 guard() {  # $1 phi, $2 seeds, $3 folder
   [ -f $3/$1/check.json ] || SEEDS="$2" /usr/bin/time -f "stage $3 %e s" python reports/training/s37_env_guidance/guard.py \
     $1 $SE $3/$1 $M >&2 || exit 1
