@@ -1,0 +1,96 @@
+"""Ballistic flight: a body with no foot on the ground falls with the gravity it is under.
+
+A generated flight (every foot joint off the floor: :func:`simdiff.motion.flight.flights`) may hang, float or
+drop at a rate no gravity gives. Between the last frame on the ground before a flight (take-off, frame ``a``)
+and the first frame on it after (landing, frame ``b``) nothing but gravity acts on the body, so its height
+follows a parabola of curvature g through the take-off and landing heights:
+
+    p(τ) = y_a + (y_b − y_a)·τ/D + ½·|g|·τ·(D − τ),   τ = (k − a)/fps,  D = (b − a)/fps,
+
+rising |g|·D²/8 above the chord at mid-flight (0.20 m for a 0.4 s jump on Earth, 0.80 m for a 2 s flight under
+g = −1.6). The whole body is moved vertically, frame by frame, by ``strength``·(p − y) with y the pelvis height
+(the pelvis stands for the centre of mass; the poses, the horizontal path, the flight's timing and the contact
+channels stay as generated). Only flights with a take-off and a landing inside the clip are corrected (a clip
+that ends in the air keeps its last flight). In the 263 features the shift moves the root height (feature 3),
+the "ric" heights of the other joints and the vertical joint velocities.
+
+Input: (B, T, 263) or (T, 263) un-normalised HumanML3D features, metres, Y-up, 20 fps; gravity as g_z m/s²
+(negative, −9.81 on Earth), one per clip or one for all.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+import torch
+
+from simdiff.errors import SimdiffError
+from simdiff.motion.features import SLICES, features_to_joints
+from simdiff.motion.flight import flights
+from simdiff.motion.floor import RIC_Y
+from simdiff.motion.foot_lock import batch_features
+from simdiff.motion.skeleton import FPS
+
+VEL_Y: slice = slice(SLICES["vel"].start + 1, SLICES["vel"].stop, 3)
+"""The vertical velocity channels of the 22 joints in the features."""
+
+
+def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: float = FPS) -> np.ndarray:
+    """(T,) metres to add to ``height`` (T,) so each flight ``[s, e)`` of ``spans`` (landing frame e < T, take-off
+    frame s − 1 ≥ 0) follows the parabola of gravity ``g`` m/s² (sign ignored) between take-off and landing."""
+    h = np.asarray(height, dtype=np.float64)
+    d = np.zeros_like(h)
+    for s, e in spans:
+        a, b = s - 1, e
+        if a < 0 or b >= h.shape[0]:
+            continue
+        tau = (np.arange(a, b + 1) - a) / fps
+        dur = (b - a) / fps
+        p = h[a] + (h[b] - h[a]) * tau / dur + 0.5 * abs(g) * tau * (dur - tau)
+        d[a:b + 1] = p - h[a:b + 1]
+    return d
+
+
+def ballistic_flights(features: torch.Tensor, gravity: float | Sequence[float] | torch.Tensor,
+                      lengths: torch.Tensor | None = None, strength: float = 1.0, fps: float = FPS) -> torch.Tensor:
+    """Features whose flights rise and fall as the given gravity makes them (see the module docstring).
+
+    Args:
+        features: (B, T, 263) or (T, 263) un-normalised features.
+        gravity: g_z in m/s² (e.g. −9.81), a number or B numbers; each must be finite and non-zero.
+        lengths: (B,) valid frames (None: all T); frames past a length are returned unchanged.
+        strength: share of the correction applied, in [0, 1] (0: unchanged, 1: exactly ballistic).
+        fps: frames per second.
+    Returns:
+        Features of the same shape, dtype and device.
+    """
+    if not 0.0 <= strength <= 1.0:
+        raise SimdiffError(f"ballistic strength must be in [0, 1], got {strength}")
+    f, single, valid = batch_features(features, lengths, "ballistic flight")
+    b, t = f.shape[:2]
+    g = torch.as_tensor(gravity, dtype=torch.float64).reshape(-1).cpu()
+    if g.numel() not in (1, b):
+        raise SimdiffError(f"ballistic flight needs 1 or {b} gravity values, got {g.numel()}")
+    bad = [float(v) for v in g if not (torch.isfinite(v) and v != 0)]
+    if bad:
+        raise SimdiffError(f"ballistic flight needs a finite, non-zero gravity, got {bad[0]}")
+    g = g.expand(b)
+    if strength == 0.0 or t < 3:
+        return features.clone()
+    joints = features_to_joints(f).cpu().numpy()  # (B, T, 22, 3)
+    lens = valid.sum(dim=1).cpu().tolist()
+    shift = np.zeros((b, t))
+    for i in range(b):
+        n = int(lens[i])
+        if n < 3:
+            continue
+        spans = flights(joints[i, :n])
+        shift[i, :n] = strength * parabola_shift(joints[i, :n, 0, 1], spans, float(g[i]), fps)
+    d = torch.from_numpy(shift).to(f)
+    f[..., SLICES["root_y"]] += d[..., None]
+    f[..., RIC_Y] += d[..., None]
+    step = (d[:, 1:] - d[:, :-1]) * valid[:, 1:]  # velocity row r is the step r -> r + 1
+    f[:, :-1, VEL_Y] += step[..., None]
+    out = f.to(features.dtype)
+    return out[0] if single else out
