@@ -60,6 +60,9 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
                         "backbone alone)")
     p.add_argument("--anchor-t-max", type=int, default=None, metavar="T",
                    help="with --anchor backbone or reference: that anchor only at timesteps <= T (default every step)")
+    p.add_argument("--ballistic", type=float, default=0.0, metavar="S",
+                   help="ballistic flight strength in [0, 1] (0: off): flights follow the parabola of the sample's "
+                        "gravity")
     p.add_argument("--workers", type=int, default=0, help="simulator processes (0: all cores)")
     p.add_argument("--no-response", action="store_true", help="skip the physics-response section")
     p.add_argument("--speed", action="store_true", help="also run benchmarks/bench_generate.py (3 runs)")
@@ -102,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
                              steps=args.steps, guidance=args.guidance, alpha=args.alpha,
                              foot_lock=args.foot_lock, env_guidance=args.env_guidance, anchor=args.anchor,
                              env_guidance_fallback=args.env_guidance_fallback, anchor_alpha=args.anchor_alpha,
-                             anchor_t_max=args.anchor_t_max,
+                             anchor_t_max=args.anchor_t_max, ballistic=args.ballistic,
                              more_evaluators=list(args.also_evaluator), device=args.device,
                              split=SplitOptions(split=args.split, n=args.n),
                              prompts=PromptOptions(jump_samples=args.jump_samples, speed_samples=args.speed_samples,

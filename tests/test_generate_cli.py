@@ -230,6 +230,28 @@ def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path:
     assert "--foot-lock must be in [0, 1], got 2" in err and err.count("\n") == 1
 
 
+def test_generate_ballistic_option_is_recorded_stored_and_checked(tiny_model: Path, tmp_path: Path, capsys) -> None:
+    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(tiny_model), "--threads",
+            "1", "--format", "npy", "--no-video", "-q"]
+    assert main([*argv, "--ballistic", "1", "--out", str(tmp_path / "on")]) == 0, capsys.readouterr().err
+    assert json.loads((tmp_path / "on" / "generation.json").read_text())["ballistic"] == 1.0
+    assert main([*argv, "--out", str(tmp_path / "off")]) == 0, capsys.readouterr().err
+    assert json.loads((tmp_path / "off" / "generation.json").read_text())["ballistic"] == 0.0
+    assert main([*argv, "--ballistic", "2", "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "--ballistic must be in [0, 1], got 2" in err and err.count("\n") == 1
+    try:
+        (tiny_model / "sampling.json").write_text('{"ballistic": 1.0}')
+        assert main([*argv, "--out", str(tmp_path / "stored")]) == 0, capsys.readouterr().err
+        assert json.loads((tmp_path / "stored" / "generation.json").read_text())["ballistic"] == 1.0
+        (tiny_model / "sampling.json").write_text('{"ballistic": 3}')
+        assert main([*argv, "--out", str(tmp_path / "bad2")]) == 2
+        err = capsys.readouterr().err
+        assert "ballistic must be in [0, 1], got 3" in err and err.count("\n") == 1
+    finally:
+        (tiny_model / "sampling.json").unlink(missing_ok=True)
+
+
 def test_generate_env_guidance_changes_only_motions_off_earth(tmp_path: Path, capsys) -> None:
     from simdiff.serve.testing import write_tiny_model
 

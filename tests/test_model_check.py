@@ -402,6 +402,13 @@ def test_env_guidance_measures_only_the_response_again(checked: dict, tmp_path: 
     assert "foot_cleanup" not in report["settings"]  # recorded (the cleanup's version) only when a foot lock ran
     with pytest.raises(SimdiffError, match="--env-guidance must be a finite number ≥ 0, got -1"):
         CheckConfig(**{**config.__dict__, "env_guidance": -1.0}).validate()
+    config.ballistic = 1.0  # every motion is changed by it, Earth's and the test split's included
+    report = ModelCheck(config, text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert not any(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))
+    assert report["settings"]["ballistic"] == 1.0 and "ballistic flight 1.0" in (tmp_path / "out" / "check.md").read_text()
+    with pytest.raises(SimdiffError, match=r"--ballistic must be in \[0, 1\], got 2"):
+        CheckConfig(**{**config.__dict__, "ballistic": 2.0}).validate()
 
 
 def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: Path) -> None:

@@ -159,3 +159,35 @@ def test_masked_batch_gives_each_sample_at_its_own_length(mask_frames: bool) -> 
     first = sample(net, make_scheduler("ddim", 5), Condition(text=text[:1], frame_mask=torch.ones(1, 20, dtype=torch.bool),
                                                             env=env[:1], alpha=0.5), 20, x_init=x_init[:1], **kw)
     assert torch.allclose(batch[0], first[0], atol=1e-4)  # the longest sample has no padding either way
+
+
+def test_ballistic_runs_last_with_each_rows_gravity_and_is_validated(monkeypatch) -> None:
+    import simdiff.motion.ballistic as ballistic
+
+    seen: dict = {}
+
+    def lift(features, gravity, lengths, strength):  # stands in for the projection (tested on its own)
+        seen.update(g=torch.as_tensor(gravity, dtype=torch.float64).reshape(-1).tolist(), lengths=lengths.tolist(),
+                    strength=strength)
+        out = features.clone()
+        out[..., 3] += 1.0
+        return out
+
+    monkeypatch.setattr(ballistic, "ballistic_flights", lift)
+    gen = reacting_generator()
+    envs = [[-9.81, 0.0, 0.0], [-1.6, 0.0, 0.0]]
+    plain = gen.generate(["walk", "jump"], [12, 10], env=envs, alpha=0.5, steps=2, seed=1)
+    assert not seen  # off by default
+    on = gen.generate(["walk", "jump"], [12, 10], env=envs, alpha=0.5, steps=2, seed=1, ballistic=0.5)
+    assert seen["g"] == pytest.approx([-9.81, -1.6]) and seen["lengths"] == [12, 10] and seen["strength"] == 0.5
+    assert torch.allclose(on.features[0, :, 3], plain.features[0, :, 3] + 1.0)
+    assert torch.all(on.features[1, 10:] == 0)  # padding stays zero
+    assert torch.allclose(on.normalized[0], (on.features[0] - gen.mean) / gen.std, atol=1e-5)
+    backbone = MotionGenerator(build_network(tiny()), tiny(), HashText())
+    backbone.generate(["walk"], 12, steps=2, ballistic=1.0)
+    assert seen["g"] == pytest.approx([-9.81])  # a backbone-only model generates under Earth
+    with pytest.raises(SimdiffError, match=r"ballistic strength must be in \[0, 1\], got 2.0"):
+        gen.generate(["walk"], 12, steps=2, ballistic=2.0)
+    cat = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig(mode="categorical"))
+    with pytest.raises(SimdiffError, match="ballistic flight needs gravity as a number"):
+        MotionGenerator(build_network(cat), cat, HashText()).generate(["walk"], 12, env_index=1, steps=2, ballistic=1.0)

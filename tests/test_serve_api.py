@@ -197,6 +197,7 @@ def test_generation_requests_are_serialised(server):
     ({"text": "walk", "simulate": "yes"}, "simulate must be true or false, got 'yes'"),
     ({"text": "walk", "foot_lock": 2}, "foot_lock must be in [0, 1], got 2"),
     ({"text": "walk", "foot_lock": "on"}, "foot_lock must be a finite number, got 'on'"),
+    ({"text": "walk", "ballistic": 1.5}, "ballistic must be in [0, 1], got 1.5"),
     (["walk"], "request body must be a JSON object"),
 ])
 def test_bad_generate_request_is_a_400_with_one_line(server, body, needle):

@@ -13,7 +13,7 @@ from typing import Any, Callable, Iterable, Sequence
 import torch
 from torch import Tensor, nn
 
-from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha, check_anchor_t_max
+from simdiff.diffusion.guidance import ANCHORS, REFERENCE_ENV, check_anchor_alpha, check_anchor_t_max
 from simdiff.diffusion.sampling import X0Hook, make_scheduler, sample
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
@@ -115,6 +115,7 @@ class MotionGenerator:
         env_guidance_fallback: float | None = None,
         anchor_alpha: float = 0.0,
         anchor_t_max: int | None = None,
+        ballistic: float = 0.0,
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -148,6 +149,9 @@ class MotionGenerator:
                 answer to φ is α's).
             anchor_t_max: with ``anchor="backbone"`` or ``"reference"``, that anchor only at the denoising steps
                 whose timestep is ≤ this (0..999), the adapters anchor at the earlier ones (None: every step).
+            ballistic: strength in [0, 1] of :func:`simdiff.motion.ballistic.ballistic_flights` applied after the foot
+                cleanup (0: off): every flight's pelvis height follows the parabola of the sample's gravity (φ's g_z;
+                Earth for a backbone-only model), the whole body moved with it; not for categorical SimDiff models.
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -179,6 +183,7 @@ class MotionGenerator:
                                "this model has none (leave it at 'adapters')")
         anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
         anchor_t_max = check_anchor_t_max(anchor_t_max, anchor)
+        ballistic = check_ballistic(ballistic, self.config)
         # options checked first: a bad one fails before the text encoder runs
         text = text_embeddings.float().to(self.device) if text_embeddings is not None else self.encode_text(texts)
         frames = int(lens.max())
@@ -205,6 +210,12 @@ class MotionGenerator:
 
             features = clean_feet(features, lens, foot_lock) * mask[..., None]
             x = torch.where(mask[..., None], (features - self.mean) / self.std, x)
+        if ballistic and frames >= 3:  # a flight needs a take-off frame and two in the air
+            from simdiff.motion.ballistic import ballistic_flights
+
+            gravity = cond.env[:, 0] if cond.env is not None else REFERENCE_ENV[0]
+            features = ballistic_flights(features, gravity, lens, ballistic) * mask[..., None]
+            x = torch.where(mask[..., None], (features - self.mean) / self.std, x)
         return Generation(features=features, normalized=x, lengths=lens, fell_back=fell_back)
 
     def _env(self, b: int, env: Sequence[float] | Tensor | None,
@@ -230,6 +241,17 @@ class MotionGenerator:
         return {"env_index": idx.expand(b).to(self.device)}
 
 
+def check_ballistic(value: float, config: ModelConfig) -> float:
+    """``value`` as a float in [0, 1] usable with ``config``'s model; a one-line :class:`SimdiffError` otherwise."""
+    value = float(value)
+    if not 0.0 <= value <= 1.0:
+        raise SimdiffError(f"ballistic strength must be in [0, 1], got {value}")
+    if value and config.sim is not None and config.sim.mode != "continuous":
+        raise SimdiffError("ballistic flight needs gravity as a number: a continuous SimDiff model or a backbone-only "
+                           "one, not a categorical SimDiff model (leave it at 0)")
+    return value
+
+
 def impossible(features: Tensor, lengths: Tensor) -> Tensor:
     """(B,) bool: raw samples no body could perform — never within 0.10 m of the floor, or gliding (the pelvis
     travels while no foot joint lifts; :mod:`simdiff.motion.metrics`). Features (B, T, 263) un-normalised; clips
@@ -247,7 +269,8 @@ def impossible(features: Tensor, lengths: Tensor) -> Tensor:
 
 
 def guidance_kwargs(env_guidance: float = 1.0, anchor: str = "adapters", anchor_alpha: float = 0.0,
-                    anchor_t_max: int | None = None, env_guidance_fallback: float | None = None) -> dict[str, Any]:
+                    anchor_t_max: int | None = None, env_guidance_fallback: float | None = None,
+                    ballistic: float = 0.0) -> dict[str, Any]:
     """The environment-guidance and anchor keywords of :meth:`MotionGenerator.generate` that differ from its
     defaults: callers pass only these, so wrappers (PhysDiff's) and test stand-ins need not know them all."""
     out: dict[str, Any] = {}
@@ -261,4 +284,6 @@ def guidance_kwargs(env_guidance: float = 1.0, anchor: str = "adapters", anchor_
         out["anchor_t_max"] = anchor_t_max
     if env_guidance_fallback is not None:
         out["env_guidance_fallback"] = env_guidance_fallback
+    if ballistic:
+        out["ballistic"] = ballistic
     return out

@@ -129,6 +129,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
                     **({"anchor": request.anchor} if request.anchor != "adapters" else {}),
                     **({"anchor_alpha": request.anchor_alpha} if request.anchor_alpha else {}),
                     **({"anchor_t_max": request.anchor_t_max} if request.anchor_t_max is not None else {}),
+                    **({"ballistic": request.ballistic} if request.ballistic else {}),
                 )
                 features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
                 fell_back.append(None if out.fell_back is None else bool(out.fell_back[0]))
@@ -260,6 +261,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "alpha_source": alpha_source if simdiff_model else None,
         "foot_lock": request.foot_lock,
         "foot_cleanup": CLEANUP_VERSION if request.foot_lock else None,
+        "ballistic": request.ballistic,
         "env_guidance": request.env_guidance if simdiff_model else None,
         "env_guidance_fallback": request.env_guidance_fallback if simdiff_model else None,
         "anchor": request.anchor if simdiff_model else None,

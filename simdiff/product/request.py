@@ -53,6 +53,8 @@ class GenerationRequest:
             (0: the backbone alone; :mod:`simdiff.diffusion.guidance`).
         anchor_t_max: with the ``backbone`` or ``reference`` anchor, the last timestep (0..999) it runs at from
             below, the adapters anchor at the earlier steps (None: every step).
+        ballistic: ballistic-flight strength in [0, 1] (0: off; :mod:`simdiff.motion.ballistic`): flights follow the
+            parabola of the sample's gravity.
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
     """
@@ -73,6 +75,7 @@ class GenerationRequest:
     anchor: str = "adapters"
     anchor_alpha: float = 0.0
     anchor_t_max: int | None = None
+    ballistic: float = 0.0
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
 
@@ -209,7 +212,7 @@ def check_finite(name: str, value: float, minimum: float | None = None) -> float
     return value
 
 
-STORED_NUMBERS: tuple[str, ...] = ("guidance", "alpha", "foot_lock", "env_guidance")
+STORED_NUMBERS: tuple[str, ...] = ("guidance", "alpha", "foot_lock", "env_guidance", "ballistic")
 """The numeric ``sampling.json`` settings."""
 
 ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference")
@@ -273,10 +276,11 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     Args:
         stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance``,
             ``env_guidance_fallback``,
-            ``anchor``, ``anchor_alpha``, ``anchor_t_max`` (see :func:`simdiff.model.default.sampling_defaults`).
+            ``anchor``, ``anchor_alpha``, ``anchor_t_max``, ``ballistic`` (see
+            :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
             ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``, ``anchor_alpha``,
-            ``anchor_t_max``). A stored ``anchor_alpha`` or ``anchor_t_max`` belongs to the stored anchor: it is
+            ``anchor_t_max``, ``ballistic``). A stored ``anchor_alpha`` or ``anchor_t_max`` belongs to the stored anchor: it is
             dropped when the user picks another anchor.
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
@@ -304,9 +308,10 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
 
 def stored_setting(stored: dict[str, float | int | str], name: str, default: float) -> float:
     """A model's stored value of the numeric setting ``name`` (``default`` when it has none), checked as the
-    option is: ``foot_lock`` in [0, 1], ``alpha`` finite, the others finite and ≥ 0 (one-line errors naming it)."""
+    option is: ``foot_lock`` and ``ballistic`` in [0, 1], ``alpha`` finite, the others finite and ≥ 0 (one-line
+    errors naming it)."""
     value = stored.get(name, default)
-    if name == "foot_lock":
+    if name in ("foot_lock", "ballistic"):
         return check_unit(name, value)
     return check_finite(name, value, None if name == "alpha" else 0.0)  # type: ignore[arg-type]
 
@@ -324,7 +329,8 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                   sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5, alpha: float = 1.0,
                   foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
                   env_guidance_fallback: float | None = None, anchor_alpha: float = 0.0,
-                  anchor_t_max: int | None = None, compare: str | None = None, formats: str | None = None,
+                  anchor_t_max: int | None = None, ballistic: float = 0.0, compare: str | None = None,
+                  formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
     if seed < 0:
@@ -351,6 +357,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         anchor=check_anchor("--anchor", anchor),
         anchor_alpha=check_finite("--anchor-alpha", anchor_alpha, 0.0),
         anchor_t_max=check_anchor_t_max("--anchor-t-max", anchor_t_max),
+        ballistic=check_unit("--ballistic", ballistic),
         formats=parse_formats(formats, no_video),
         force=bool(force),
     )

@@ -59,6 +59,8 @@ class GenerateParams:
             for the model's ``sampling.json`` value when the anchor is the stored one (0 otherwise).
         anchor_t_max: that anchor only at timesteps ≤ this (0..999), or None for the model's ``sampling.json``
             value when the anchor is the stored one (every step otherwise).
+        ballistic: ballistic-flight strength in [0, 1] (:mod:`simdiff.motion.ballistic`), or None for the model's
+            ``sampling.json`` value (0, off, without one).
     """
 
     text: str
@@ -77,6 +79,7 @@ class GenerateParams:
     env_guidance_fallback: float | None = None
     anchor_alpha: float | None = None
     anchor_t_max: int | None = None
+    ballistic: float | None = None
 
     @property
     def frames(self) -> int:
@@ -125,7 +128,8 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
-            simulate, foot_lock, env_guidance, anchor, env_guidance_fallback, anchor_alpha, anchor_t_max}``;
+            simulate, foot_lock, env_guidance, anchor, env_guidance_fallback, anchor_alpha, anchor_t_max,
+            ballistic}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -185,7 +189,11 @@ def parse_generate(body: Any) -> GenerateParams:
         anchor_alpha = _number(body, "anchor_alpha", 0.0)
         _check_range("anchor_alpha", anchor_alpha, 0.0, ALPHA_RANGE[1])
     anchor_t_max = check_anchor_t_max("anchor_t_max", body.get("anchor_t_max"))
+    ballistic = body.get("ballistic")
+    if ballistic is not None:
+        ballistic = _number(body, "ballistic", 0.0)
+        _check_range("ballistic", ballistic, 0.0, 1.0)
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
                           guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance,
                           anchor=anchor, env_guidance_fallback=fallback, anchor_alpha=anchor_alpha,
-                          anchor_t_max=anchor_t_max, **wind)
+                          anchor_t_max=anchor_t_max, ballistic=ballistic, **wind)

@@ -163,6 +163,7 @@ class MotionService:
                 fallback = stored_setting(stored, "env_guidance_fallback", 1.0)
             anchor_alpha = stored_anchor_alpha(stored, anchor) if params.anchor_alpha is None else 0.0
             t_max = stored_anchor_t_max(stored, anchor) if params.anchor_t_max is None else None
+            ballistic = params.ballistic if params.ballistic is not None else stored_setting(stored, "ballistic", 0.0)
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
@@ -171,13 +172,15 @@ class MotionService:
             anchor = params.anchor or "adapters"
             fallback = params.env_guidance_fallback
             anchor_alpha, t_max = 0.0, None
+            ballistic = params.ballistic or 0.0
         # the request's own values against the anchor: its error (400), not the model's
         if params.anchor_alpha is not None:
             anchor_alpha = check_anchor_alpha("anchor_alpha", params.anchor_alpha, anchor)
         if params.anchor_t_max is not None:
             t_max = check_anchor_t_max("anchor_t_max", params.anchor_t_max, anchor)
         return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor,
-                       env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha), anchor_t_max=t_max)
+                       env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha), anchor_t_max=t_max,
+                       ballistic=float(ballistic))
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -251,7 +254,7 @@ class MotionService:
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
                                      guidance=params.guidance, seed=params.seed, progress=self._progress,
-                                     foot_lock=params.foot_lock,
+                                     foot_lock=params.foot_lock, ballistic=params.ballistic or 0.0,
                                      **({"env_guidance": params.env_guidance, "anchor": params.anchor,
                                          "env_guidance_fallback": params.env_guidance_fallback,
                                          "anchor_alpha": params.anchor_alpha or 0.0,
@@ -265,6 +268,7 @@ class MotionService:
 
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
                 "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": params.foot_lock,
+                "ballistic": params.ballistic,
                 "env_guidance": params.env_guidance if uses_env else None,
                 "env_guidance_fallback": params.env_guidance_fallback if uses_env else None,
                 **({"fell_back": bool(out.fell_back[0])} if out.fell_back is not None else {}),

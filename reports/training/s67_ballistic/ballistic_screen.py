@@ -1,5 +1,5 @@
 """Screen (no simulator, no verdict): what the ballistic flight projection does to a model's jumps.
-python ballistic_screen.py MODEL [--seed S] [--n N] [--env-guidance SE]
+python ballistic_screen.py MODEL [--seed S] [--n N] [--env-guidance SE] [--dump FILE]
 
 The six jump prompts of the model check x N samples, 120 frames, under Earth and g -1.6 with the same noise (seeds
 S + prompt index), the model's sampling.json settings (anchor included; fallback not applied). For the raw samples
@@ -18,7 +18,7 @@ import torch
 
 from simdiff.eval.model_check.config import JUMP_PROMPTS
 from simdiff.model.generator import MotionGenerator
-from ballistic import ballistic_flights
+from simdiff.motion.ballistic import ballistic_flights
 from simdiff.motion.features import features_to_joints
 from simdiff.motion.flight import flight_stats
 
@@ -41,6 +41,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=7700)
     ap.add_argument("--n", type=int, default=8)
     ap.add_argument("--env-guidance", type=float, default=None)
+    ap.add_argument("--dump", default=None, help="write every sample's flight stats here (JSON)")
     a = ap.parse_args()
     torch.set_num_threads(2)
     s = json.loads((Path(a.model) / "sampling.json").read_text())
@@ -59,6 +60,8 @@ def main() -> None:
     res = {"model": a.model, "s_e": s["env_guidance"], "seed": a.seed, "seconds": round(time.time() - t0)}
     res.update({k: stats(v["earth"], v["moon"]) for k, v in out.items()})
     print(json.dumps(res), flush=True)
+    if a.dump:
+        Path(a.dump).write_text(json.dumps(out))
 
 
 if __name__ == "__main__":

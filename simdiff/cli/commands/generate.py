@@ -100,6 +100,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="with --anchor backbone or reference: use it only at the denoising steps whose timestep is "
                           "at most T (0-999), the adapters anchor at the earlier ones (default every step, or the "
                           "model's sampling.json)")
+    smp.add_argument("--ballistic", type=float, metavar="S",
+                     help="ballistic flight strength in [0, 1]: while no foot is on the ground the body's height "
+                          "follows the parabola of the chosen gravity (1), as generated (0); default 0, or the "
+                          "model's sampling.json")
     out = p.add_argument_group("output")
     out.add_argument("--out", type=Path, metavar="DIR",
                      help="output folder, files in it are replaced (default ./out/<prompt>, or <prompt>-2, -3, ... "
@@ -140,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
         env_guidance=1.0 if args.env_guidance is None else args.env_guidance, anchor=args.anchor or "adapters",
         env_guidance_fallback=args.env_guidance_fallback,
         anchor_alpha=0.0 if args.anchor_alpha is None else args.anchor_alpha,
-        anchor_t_max=args.anchor_t_max,
+        anchor_t_max=args.anchor_t_max, ballistic=0.0 if args.ballistic is None else args.ballistic,
         compare=args.compare, formats=args.format,
         no_video=args.no_video, force=args.force,
     )
@@ -173,7 +177,7 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
     read_recipe(folder)  # likewise extrapolation.json
     given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance",
-                               "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max")
+                               "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max", "ballistic")
              if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")

@@ -96,6 +96,8 @@ class CheckConfig:
             anchor_t_max: that anchor only at timesteps ≤ this, the adapters anchor above (None: every step);
             env_guidance_fallback: s_e for the prompt samples that float or glide at ``env_guidance`` (re-sampled;
             None: off). The test split is generated at Earth without wind, where any s_e gives the same motion.
+            ballistic: strength in [0, 1] of the generator's ballistic flight (:mod:`simdiff.motion.ballistic`; 0: off),
+            applied to every motion the check generates, the test split's included.
         more_evaluators: further evaluator folders that score the same test-split motions (each motion generated
             once); the verdicts use ``evaluator``. FID differences between models or settings depend on which
             evaluator was trained (session 47), so a claimed FID change should hold under a second one.
@@ -116,6 +118,7 @@ class CheckConfig:
     env_guidance_fallback: float | None = None
     anchor_alpha: float = 0.0
     anchor_t_max: int | None = None
+    ballistic: float = 0.0
     more_evaluators: list[str] = field(default_factory=list)
     device: str = "cpu"
     quick: bool = False
@@ -139,6 +142,8 @@ class CheckConfig:
                 raise SimdiffError(f"{name} must be at least {low}, got {value}")
         if not 0.0 <= self.foot_lock <= 1.0:
             raise SimdiffError(f"--foot-lock must be in [0, 1], got {self.foot_lock}")
+        if not 0.0 <= self.ballistic <= 1.0:
+            raise SimdiffError(f"--ballistic must be in [0, 1], got {self.ballistic}")
         if not 0.0 <= self.env_guidance < float("inf"):
             raise SimdiffError(f"--env-guidance must be a finite number ≥ 0, got {self.env_guidance}")
         if self.env_guidance_fallback is not None and not 0.0 <= self.env_guidance_fallback < float("inf"):

@@ -230,6 +230,7 @@ def markdown(report: dict[str, Any]) -> str:
              + (f"; guidance anchor {c['anchor']}" if c.get("anchor", "adapters") != "adapters" else "")
              + (f" at α {c['anchor_alpha']}" if c.get("anchor_alpha") else "")
              + (f" at t ≤ {c['anchor_t_max']}" if c.get("anchor_t_max") is not None else "")
+             + (f"; ballistic flight {c['ballistic']}" if c.get("ballistic") else "")
              + ("; **quick preset (smoke run, not a claim)**" if c["quick"] else "") + ".",
              f"Command: `{p['command']}`; commit {p['git_commit']}{' (dirty tree)' if p['git_dirty'] else ''}; "
              f"{p['machine']['cpus']} CPUs, torch threads {p['machine']['torch_threads']}; finished {report['finished']}.",

@@ -145,7 +145,8 @@ class ModelCheck:
         return {"schema": SCHEMA, "model": _stamp(c.model), "seeds": c.seeds, "steps": c.steps, "guidance": c.guidance,
                 "alpha": c.alpha, "device": c.device, **lock, **({"anchor": c.anchor} if c.anchor != "adapters" else {}),
                 **({"anchor_alpha": c.anchor_alpha} if c.anchor_alpha else {}),
-                **({"anchor_t_max": c.anchor_t_max} if c.anchor_t_max is not None else {})}
+                **({"anchor_t_max": c.anchor_t_max} if c.anchor_t_max is not None else {}),
+                **({"ballistic": c.ballistic} if c.ballistic else {})}
 
     def part(self, name: str, inputs: dict[str, Any], measure: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         """The stored result of section ``name`` when its fingerprint matches, else measured and stored."""
@@ -178,7 +179,8 @@ class ModelCheck:
                                                  steps=c.steps, guidance=c.guidance, progress=self.progress,
                                                  foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor,
                                                  env_guidance_fallback=c.env_guidance_fallback,
-                                                 anchor_alpha=c.anchor_alpha, anchor_t_max=c.anchor_t_max)
+                                                 anchor_alpha=c.anchor_alpha, anchor_t_max=c.anchor_t_max,
+                                                 ballistic=c.ballistic)
         return self._sets[key][0]
 
     def fell_back(self, name: str, phis: Sequence[Sequence[float]]) -> dict[str, Any]:
@@ -211,7 +213,7 @@ class ModelCheck:
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
                               steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock,
                               env_guidance=c.env_guidance, anchor=c.anchor, anchor_alpha=c.anchor_alpha,
-                              anchor_t_max=c.anchor_t_max)
+                              anchor_t_max=c.anchor_t_max, ballistic=c.ballistic)
             if c.more_evaluators:
                 fn = _memoised(fn)
             result = score(c.evaluator, dataset, fn)

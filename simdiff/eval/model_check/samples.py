@@ -43,12 +43,13 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
                        alpha: float, steps: int, guidance: float, progress: bool = False, foot_lock: float = 0.0,
                        env_guidance: float = 1.0, anchor: str = "adapters",
                        env_guidance_fallback: float | None = None,
-                       anchor_alpha: float = 0.0, anchor_t_max: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+                       anchor_alpha: float = 0.0, anchor_t_max: int | None = None,
+                       ballistic: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Generate every batch; returns joints (N, length, 22, 3) float32 (metres, Y-up, 20 fps) and (N,) bool: the
     samples re-sampled at ``env_guidance_fallback`` (the generator's ``Generation.fell_back``; all False without one).
 
     ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone (``env_guidance`` then
-    and ``anchor`` must stay at their defaults).
+    and ``anchor`` must stay at their defaults). ``ballistic``: the generator's ballistic flight strength (0: off).
     """
     from tqdm import tqdm
 
@@ -56,7 +57,7 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
     from simdiff.motion.features import features_to_joints
 
     kwargs: dict[str, Any] = {"env": list(env), "alpha": alpha} if env is not None else {}
-    kwargs.update(guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, env_guidance_fallback))
+    kwargs.update(guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, env_guidance_fallback, ballistic))
     out, flags = [], []
     for b in tqdm(batches, desc="prompts", disable=not progress, dynamic_ncols=True, leave=False):
         gen = generator.generate([b.prompt] * b.count, length, sampler="ddim", steps=steps, guidance=guidance,

@@ -1,4 +1,4 @@
-"""Session 67 screen helper checks (pytest reports/training/s67_ballistic/check_ballistic.py): flights rise and fall with the gravity they are under."""
+"""simdiff.motion.ballistic: flights rise and fall with the gravity they are under."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from simdiff.errors import SimdiffError
-from ballistic import VEL_Y, ballistic_flights, parabola_shift
+from simdiff.motion.ballistic import VEL_Y, ballistic_flights, parabola_shift
 from simdiff.motion.features import features_to_joints, joints_to_features
 from simdiff.motion.flight import flight_stats, flights
 from simdiff.motion.synthetic import jump
@@ -68,21 +68,30 @@ def test_batches_take_one_gravity_per_clip_and_keep_padding_and_open_flights() -
     out = ballistic_flights(batch, torch.tensor([-12.8, -1.6]), lengths=torch.tensor([60, 55]))
     assert out.dtype == torch.float32 and out.shape == batch.shape
     assert torch.allclose(out[0], batch[0], atol=1e-5)
-    assert torch.equal(out[1], batch[1])  # its flight has no landing inside the clip
+    # no landing inside its 55 frames: an already ballistic open flight is kept; under g -1.6 it becomes a parabola
+    # of that curvature from its take-off
+    c = _features(jump(60, height=0.4, start=48, airtime=0.5))[None]  # 12.8 m/s², in the air past frame 54
+    kept = ballistic_flights(c, -12.8, lengths=torch.tensor([55]))
+    assert torch.allclose(kept, c, atol=1e-5)
+    low = _pelvis(ballistic_flights(c, -1.6, lengths=torch.tensor([55]))[0, :55])
+    assert np.allclose(np.diff(low[48:55], 2), -1.6 * 0.05 ** 2, atol=1e-6)
+    assert np.allclose(low[:49], _pelvis(c[0, :49]), atol=1e-6)
     single = ballistic_flights(a, [-1.6])
     assert single.shape == a.shape
 
 
 def test_parabola_shift_skips_spans_without_take_off_or_landing() -> None:
     h = np.zeros(10)
-    assert np.array_equal(parabola_shift(h, [(0, 4), (6, 10)], -9.81), np.zeros(10))
+    assert np.array_equal(parabola_shift(h, [(0, 4)], -9.81), np.zeros(10))
+    up = parabola_shift(h, [(6, 10)], -9.81)  # flat to the end: the best v0 keeps it near the take-off height
+    assert up[:5].tolist() == [0.0] * 5 and abs(up[5:]).max() < 0.05
     d = parabola_shift(h, [(3, 6)], -9.81)  # take-off 2, landing 6: 0.2 s
     assert d[2] == 0 and d[6] == 0 and d[4] == pytest.approx(9.81 * 0.2 ** 2 / 8)
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"gravity": 0.0}, "non-zero gravity, got 0.0"),
-    ({"gravity": float("nan")}, "non-zero gravity, got nan"),
+    ({"gravity": float("nan")}, "finite gravity, got nan"),
+    ({"gravity": float("inf")}, "finite gravity, got inf"),
     ({"gravity": [-9.81, -1.6, -3.7]}, "1 or 1 gravity values, got 3"),
     ({"gravity": -9.81, "strength": 1.5}, "ballistic strength must be in [0, 1], got 1.5"),
 ])

@@ -10,8 +10,8 @@ follows a parabola of curvature g through the take-off and landing heights:
 rising |g|·D²/8 above the chord at mid-flight (0.20 m for a 0.4 s jump on Earth, 0.80 m for a 2 s flight under
 g = −1.6). The whole body is moved vertically, frame by frame, by ``strength``·(p − y) with y the pelvis height
 (the pelvis stands for the centre of mass; the poses, the horizontal path, the flight's timing and the contact
-channels stay as generated). Only flights with a take-off and a landing inside the clip are corrected (a clip
-that ends in the air keeps its last flight). In the 263 features the shift moves the root height (feature 3),
+channels stay as generated). A flight still under way at the clip's last frame has no landing: it follows the
+parabola from its take-off height whose take-off speed v0 fits its heights best (least squares over its frames). In the 263 features the shift moves the root height (feature 3),
 the "ric" heights of the other joints and the vertical joint velocities.
 
 Input: (B, T, 263) or (T, 263) un-normalised HumanML3D features, metres, Y-up, 20 fps; gravity as g_z m/s²
@@ -37,13 +37,20 @@ VEL_Y: slice = slice(SLICES["vel"].start + 1, SLICES["vel"].stop, 3)
 
 
 def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: float = FPS) -> np.ndarray:
-    """(T,) metres to add to ``height`` (T,) so each flight ``[s, e)`` of ``spans`` (landing frame e < T, take-off
-    frame s − 1 ≥ 0) follows the parabola of gravity ``g`` m/s² (sign ignored) between take-off and landing."""
+    """(T,) metres to add to ``height`` (T,) so each flight ``[s, e)`` of ``spans`` (take-off frame s − 1 ≥ 0) follows
+    the parabola of gravity ``g`` m/s² (sign ignored) between take-off and landing (frame e), or from take-off with
+    its best-fitting take-off speed when e = T (no landing in the clip)."""
     h = np.asarray(height, dtype=np.float64)
     d = np.zeros_like(h)
     for s, e in spans:
         a, b = s - 1, e
-        if a < 0 or b >= h.shape[0]:
+        if a < 0:
+            continue
+        if b >= h.shape[0]:  # still in the air at the end: the take-off speed that fits the flight best
+            tau = (np.arange(a, h.shape[0]) - a) / fps
+            fall = h[a:] - h[a] + 0.5 * abs(g) * tau ** 2  # = v0·τ for a ballistic flight
+            v0 = float(tau @ fall / (tau @ tau))
+            d[a:] = h[a] + v0 * tau - 0.5 * abs(g) * tau ** 2 - h[a:]
             continue
         tau = (np.arange(a, b + 1) - a) / fps
         dur = (b - a) / fps
@@ -58,7 +65,7 @@ def ballistic_flights(features: torch.Tensor, gravity: float | Sequence[float] |
 
     Args:
         features: (B, T, 263) or (T, 263) un-normalised features.
-        gravity: g_z in m/s² (e.g. −9.81), a number or B numbers; each must be finite and non-zero.
+        gravity: g_z in m/s² (e.g. −9.81; the sign is ignored), a number or B finite numbers.
         lengths: (B,) valid frames (None: all T); frames past a length are returned unchanged.
         strength: share of the correction applied, in [0, 1] (0: unchanged, 1: exactly ballistic).
         fps: frames per second.
@@ -72,9 +79,9 @@ def ballistic_flights(features: torch.Tensor, gravity: float | Sequence[float] |
     g = torch.as_tensor(gravity, dtype=torch.float64).reshape(-1).cpu()
     if g.numel() not in (1, b):
         raise SimdiffError(f"ballistic flight needs 1 or {b} gravity values, got {g.numel()}")
-    bad = [float(v) for v in g if not (torch.isfinite(v) and v != 0)]
+    bad = [float(v) for v in g if not torch.isfinite(v)]
     if bad:
-        raise SimdiffError(f"ballistic flight needs a finite, non-zero gravity, got {bad[0]}")
+        raise SimdiffError(f"ballistic flight needs a finite gravity, got {bad[0]}")
     g = g.expand(b)
     if strength == 0.0 or t < 3:
         return features.clone()
