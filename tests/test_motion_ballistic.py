@@ -83,8 +83,9 @@ def test_batches_take_one_gravity_per_clip_and_keep_padding_and_open_flights() -
 def test_parabola_shift_skips_spans_without_take_off_or_landing() -> None:
     h = np.zeros(10)
     assert np.array_equal(parabola_shift(h, [(0, 4)], -9.81), np.zeros(10))
-    up = parabola_shift(h, [(6, 10)], -9.81)  # flat to the end: the best v0 keeps it near the take-off height
-    assert up[:5].tolist() == [0.0] * 5 and abs(up[5:]).max() < 0.05
+    up = parabola_shift(h, [(6, 10)], -9.81)  # a flat hover to the end: it has not landed, so it is back at the
+    assert up[:5].tolist() == [0.0] * 5 and up[9] == pytest.approx(0.0)  # take-off height no sooner than the end
+    assert up[7] == pytest.approx(0.5 * 9.81 * 0.2 * 0.1 - 0.5 * 9.81 * 0.1 ** 2)  # v0 = g·D/2, D 0.2 s
     d = parabola_shift(h, [(3, 6)], -9.81)  # take-off 2, landing 6: 0.2 s
     assert d[2] == 0 and d[6] == 0 and d[4] == pytest.approx(9.81 * 0.2 ** 2 / 8)
 

@@ -11,7 +11,9 @@ rising |g|·D²/8 above the chord at mid-flight (0.20 m for a 0.4 s jump on Eart
 g = −1.6). The whole body is moved vertically, frame by frame, by ``strength``·(p − y) with y the pelvis height
 (the pelvis stands for the centre of mass; the poses, the horizontal path, the flight's timing and the contact
 channels stay as generated). A flight still under way at the clip's last frame has no landing: it follows the
-parabola from its take-off height whose take-off speed v0 fits its heights best (least squares over its frames). In the 263 features the shift moves the root height (feature 3),
+parabola from its take-off height whose take-off speed v0 fits its heights best (least squares over its frames), and
+at least the speed that keeps it above the take-off height until that frame (½·|g|·D for D s in the air), since it
+has not landed (a 5-s hover under g = −1.6 becomes a 5-m jump: what that flight time means under that gravity). In the 263 features the shift moves the root height (feature 3),
 the "ric" heights of the other joints and the vertical joint velocities.
 
 Input: (B, T, 263) or (T, 263) un-normalised HumanML3D features, metres, Y-up, 20 fps; gravity as g_z m/s²
@@ -39,7 +41,7 @@ VEL_Y: slice = slice(SLICES["vel"].start + 1, SLICES["vel"].stop, 3)
 def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: float = FPS) -> np.ndarray:
     """(T,) metres to add to ``height`` (T,) so each flight ``[s, e)`` of ``spans`` (take-off frame s − 1 ≥ 0) follows
     the parabola of gravity ``g`` m/s² (sign ignored) between take-off and landing (frame e), or from take-off with
-    its best-fitting take-off speed when e = T (no landing in the clip)."""
+    its best-fitting take-off speed, at least ½·|g|·D, when e = T (no landing in the clip, D s in the air)."""
     h = np.asarray(height, dtype=np.float64)
     d = np.zeros_like(h)
     for s, e in spans:
@@ -49,7 +51,7 @@ def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: floa
         if b >= h.shape[0]:  # still in the air at the end: the take-off speed that fits the flight best
             tau = (np.arange(a, h.shape[0]) - a) / fps
             fall = h[a:] - h[a] + 0.5 * abs(g) * tau ** 2  # = v0·τ for a ballistic flight
-            v0 = float(tau @ fall / (tau @ tau))
+            v0 = max(float(tau @ fall / (tau @ tau)), 0.5 * abs(g) * tau[-1])  # not down before the last frame
             d[a:] = h[a] + v0 * tau - 0.5 * abs(g) * tau ** 2 - h[a:]
             continue
         tau = (np.arange(a, b + 1) - a) / fps
