@@ -5,7 +5,7 @@ Wind: the two val walk prompts of the model check x N samples, each under Earth 
 wind grows against Earth (the check's rule, :func:`simdiff.eval.response.quantities`). Gravity: the six jump
 prompts x N samples under Earth and g -1.6; medians of the generated change of apex gain and of the longest flight
 (the simulator's side of the check's size ratios is not computed here). Shipped sampling settings of each model
-(sampling.json, its anchor and anchor_alpha included since session 66; fallback not applied;
+(sampling.json, its anchor and anchor_alpha included since session 66, ballistic since 67; fallback not applied;
 --env-guidance overrides s_e), 120 frames, seeds S + prompt index.
 Ordinary motions under low gravity (--moon N, session 61): the two walk and two run prompts x N under Earth and g -1.6
 with the same noise; mean floating (mm, the model check's metric) at g -1.6 and at Earth, and the median ratio of root
@@ -35,7 +35,8 @@ WINDS = [(-9.81, 10.0, 0.0), (-9.81, -10.0, 0.0), (-9.81, 0.0, 10.0), (-9.81, 0.
 def joints(gen: MotionGenerator, prompt: str, n: int, seed: int, env, s: dict) -> np.ndarray:
     out = gen.generate([prompt] * n, 120, seed=seed, steps=s["steps"], guidance=s["guidance"], alpha=s["alpha"],
                        foot_lock=s["foot_lock"], env=list(env), env_guidance=s["env_guidance"],
-                       anchor=s.get("anchor", "adapters"), anchor_alpha=s.get("anchor_alpha", 0.0))  # session 66
+                       anchor=s.get("anchor", "adapters"), anchor_alpha=s.get("anchor_alpha", 0.0),  # session 66
+                       ballistic=s.get("ballistic", 0.0))  # session 67
     return features_to_joints(out.features.double()).numpy()
 
 

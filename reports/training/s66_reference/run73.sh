@@ -4,12 +4,13 @@
 # Rule 74 (rule74.txt) runs the same with RULE=74 N=G63r5 SE=5 FB=4 AS=142 (run74.sh).
 # Session 67: MODELS (folder holding ${N}_model, default /work/scratch/s66), R (where the verdict lines go, default
 # this folder) and STAGES (their order, default "gate C' A B C+ T") for later rules; the defaults are rule 73's run.
+# BALLISTIC (the model's ballistic strength, default off) goes to every draw; BDRAW: stage B's draw (see stage_B).
 set -u
 RULE=${RULE:-73} N=${N:-G63r} SE=${SE:-3} FB=${FB:-2} AS=${AS:-140}
 cd /work/main; . .venv/bin/activate
 V=reports/training/s66_reference; R=${R:-$V}; S=/work/scratch/s39; MODELS=${MODELS:-/work/scratch/s66}; M=$MODELS/${N}_model
 OUT=$R/rule${RULE}_stages.txt; R57=reports/training/s57_pooled_a
-export SIMDIFF_SCRATCH=$S STEPS=50 ANCHOR=reference AA=0 ANCHOR_ALPHA=0 PROBE_ANCHOR=reference PROBE_ANCHOR_ALPHA=0
+export BALLISTIC=${BALLISTIC:-} SIMDIFF_SCRATCH=$S STEPS=50 ANCHOR=reference AA=0 ANCHOR_ALPHA=0 PROBE_ANCHOR=reference PROBE_ANCHOR_ALPHA=0
 stamp() { echo "[$(date -u +%H:%M)] $*" >&2; }
 guard() {  # $1 phi, $2 seeds, $3 folder
   [ -f $3/$1/check.json ] || SEEDS="$2" /usr/bin/time -f "stage $3 %e s" python reports/training/s37_env_guidance/guard.py \
@@ -29,11 +30,12 @@ stage_A() {
   [ -f $A/check.json ] || JS=32 ASEEDS="$AS $((AS + 1))" FB=$FB bash reports/training/s39_drift_gpu/check.sh A ${N}_s$AS $M $SE
   python $R57/stage_a55.py $A | tee -a $OUT | grep -q PASS
 }
-stage_B() {
+stage_B() {  # BDRAW: session 65's Earth draw unless given (drawn here when missing: BDRAW=$S/eval11/B_$N)
+  B=${BDRAW:-$S/eval11/B_G63a0_s65}
+  [ -f $B/check.json ] || bash reports/training/s39_drift_gpu/check.sh B ${B##*/B_} $M $SE
   W=$(cd reports/training/s53_extrapolate && python walk_probe.py $M | tee $MODELS/walk$RULE.txt \
     | sed -n 's/.*jumping \([0-9]*\)\/.*/\1/p')
-  { echo -n "B Earth seeds 0 1 (session 65's draw): "; python $V/v73.py earth $S/eval11/B_G63a0_s65 "$W"; } | tee -a $OUT \
-    | grep -q PASS
+  { echo -n "B Earth seeds 0 1 (${B##*/}): "; python $V/v73.py earth $B "$W"; } | tee -a $OUT | grep -q PASS
 }
 stage_C+() {
   guard -9.81,10,0 "0" $S/eval11/Cp_$N
