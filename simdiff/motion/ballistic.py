@@ -13,8 +13,9 @@ g = −1.6). The whole body is moved vertically, frame by frame, by ``strength``
 channels stay as generated). A flight still under way at the clip's last frame has no landing: it follows the
 parabola from its take-off height whose take-off speed v0 fits its heights best (least squares over its frames), and
 at least the speed that keeps it above the take-off height until that frame (½·|g|·D for D s in the air), since it
-has not landed (a 5-s hover under g = −1.6 becomes a 5-m jump: what that flight time means under that gravity). In the 263 features the shift moves the root height (feature 3),
-the "ric" heights of the other joints and the vertical joint velocities.
+has not landed (a 5-s hover under g = −1.6 becomes a 5-m jump: what that flight time means under that gravity).
+In the 263 features the shift moves the root height (feature 3), the "ric" heights of the other joints and the
+vertical joint velocities.
 
 Input: (B, T, 263) or (T, 263) un-normalised HumanML3D features, metres, Y-up, 20 fps; gravity as g_z m/s²
 (negative, −9.81 on Earth), one per clip or one for all.
