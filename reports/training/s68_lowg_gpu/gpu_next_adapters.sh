@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The next GPU session's first command (session 68's plan, README.md): G63's adapters (G63's backbone frozen) trained
+# on one H200 with the low-gravity replays of rule 75 added (aug_lowg: 418 low-g pairs with an Earth twin, 96 of them
+# from Earth jumps >= 0.25 m), two variants side by side: G63's recipe (lambda 10, mu 20) and a stronger pair term
+# (lambda 30, mu 20). Why: every inference-time variant of sessions 66-67 answers g -1.6 with an apex change of
+# 0.32-0.37 m (the simulator asks 0.82-0.90 m for G63's Earth jumps) and CPU continuations (1,800 and 1,200 steps of
+# batch 64) did not raise it; the adapters had 3,000 GPU steps on this backbone, the shipped ones over 10,000.
+# Travel (measured 2026-12-01): code ~3 MB + G63 float16 13.4 MB + captions 2.3 MB + four aug packs 18.6 MB = ~37 MB;
+# reports/, the default model and the corpus pack (not needed: the backbone is frozen) must not travel.
+# Run from the repository root, step by step (the device tool's run needs the repository as it is).
+set -eu
+. .venv/bin/activate
+[ -d .gpu/G63_fp16 ] || simdiff train precision --model reports/training/s63_deepen/G63_model --out .gpu/G63_fp16 --dtype float16
+[ -d .gpu/aug_lowg ] || simdiff train pack /work/scratch/s67/aug_lowg --out .gpu/aug_lowg --splits train --workers 2   # 3.24 MiB
+cp reports/training/s68_lowg_gpu/ad68_gpu_config.json .gpu/ad68_gpu_config.json
+git rm -r -q --cached reports simdiff/assets/default_model
+printf '/reports/\n/simdiff/assets/default_model/\n/.gpu/corpus/\n' >> .git/info/exclude
+git commit -qm "TEMP: travel"
+# device call (timeout_s 590; .gpu/ is untracked and not ignored, so it travels without carry; carry the mujoco-free
+# project as it is: train adapters needs no simulator):
+#   OUT=$OUT AUG_PACK=".gpu/aug_weakg .gpu/aug_gen .gpu/aug_wind .gpu/aug_lowg" TEXT_TABLE=.gpu/captions.safetensors \
+#     BACKBONE=.gpu/G63_fp16 ADAPTERS_INIT=.gpu/G63_fp16 CONFIG=.gpu/ad68_gpu_config.json SPLIT=adapt SEED=68 \
+#     RUNS="l10:10:20 l30:30:20" MINUTES=7 PYTHON=python3 bash scripts/gpu_adapters.sh
+# then, whatever the call gave:
+#   git reset -q --mixed HEAD~1 && sed -i '\#^/reports/$#d; \#^/simdiff/assets/default_model/$#d; \#^/.gpu/corpus/$#d' .git/info/exclude
+#   for r in l10 l30; do mkdir -p /work/scratch/s68/$r && cat $FILES_AT/$r.tar* | tar -x -C /work/scratch/s68/$r; done
+# and screen each model (its sampling.json: rule 74's, /work/scratch/s66/G63r5_model/sampling.json) with
+# reports/training/s67_ballistic/ballistic_screen.py (seeds 7700+), then rule 77 (README.md).
