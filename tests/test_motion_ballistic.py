@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from simdiff.errors import SimdiffError
-from simdiff.motion.ballistic import VEL_Y, ballistic_flights, parabola_shift
+from simdiff.motion.ballistic import VEL_Y, ballistic_flights, foot_clearance, parabola_shift
 from simdiff.motion.features import features_to_joints, joints_to_features
 from simdiff.motion.flight import flight_stats, flights
 from simdiff.motion.synthetic import jump
@@ -102,3 +102,24 @@ def test_bad_input_gets_one_clear_line(kwargs: dict, message: str) -> None:
         ballistic_flights(f, **kwargs)
     with pytest.raises(SimdiffError, match="needs \\(B, T >= 2, 263\\)"):
         ballistic_flights(torch.zeros(4, 10), -9.81)
+
+
+def test_a_flight_too_high_for_its_duration_stops_on_the_floor_not_under_it() -> None:
+    # 0.75 m up in 1 s: under g -1.6 the parabola rises 0.2 m, so the pelvis would be pulled about 0.55 m down; with
+    # the legs hanging so that the feet are 8 cm over the floor mid-flight, they would go through it
+    f = _features(jump(60, height=0.75, start=20, airtime=1.0))
+    feet = [4 + 3 * (k - 1) + 1 for k in (7, 10, 8, 11)]  # the feet's "ric" heights (absolute in HumanML3D)
+    f[27:34, feet] = 0.08 + f[27:34, feet] - f[27:34, feet].amin(dim=1, keepdim=True)
+    before = features_to_joints(f).numpy()
+    assert flights(before) == [(21, 40)]
+    floor = np.percentile(before[:, (7, 10, 8, 11), 1], 5, axis=0)
+    free = parabola_shift(before[:, 0, 1], flights(before), -1.6)  # without a floor: feet under it
+    assert (before[:, (7, 10, 8, 11), 1] + free[:, None] < floor - 0.3).any()
+    j = features_to_joints(ballistic_flights(f, -1.6)).numpy()
+    assert (j[:, (7, 10, 8, 11), 1] >= floor - 1e-5).all()  # nothing below its own ground
+    assert (j[:, 0, 1] <= before[:, 0, 1] + 1e-6).all()  # only ever moved down in this flight
+    assert j[25, 0, 1] < before[25, 0, 1] - 0.1  # where the feet had room, down to the parabola
+    assert j[25, 0, 1] == pytest.approx(before[20, 0, 1] + 0.5 * 1.6 * 0.25 * 0.75, abs=1e-5)
+    assert np.isclose(j[30, (7, 10, 8, 11), 1] - floor, 0.0, atol=1e-5).any()  # where they had not, on the floor
+    assert np.allclose(foot_clearance(before), (before[:, (7, 10, 8, 11), 1] - floor).min(axis=1))
+    assert foot_clearance(before)[20] < 0.05 < foot_clearance(before)[30] < 0.09  # on the ground / hanging legs

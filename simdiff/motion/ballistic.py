@@ -14,6 +14,9 @@ channels stay as generated). A flight still under way at the clip's last frame h
 parabola from its take-off height whose take-off speed v0 fits its heights best (least squares over its frames), and
 at least the speed that keeps it above the take-off height until that frame (½·|g|·D for D s in the air), since it
 has not landed (a 5-s hover under g = −1.6 becomes a 5-m jump: what that flight time means under that gravity).
+The body is never moved down through the floor: where the parabola lies lower than the lowest foot's clearance allows
+(a flight too high for its duration under that g, e.g. a 0.75-m rise in 1 s under g = −1.6), it stops with that foot
+on its ground level (the per-foot level of :mod:`simdiff.motion.flight`), i.e. the motion touches down there.
 In the 263 features the shift moves the root height (feature 3), the "ric" heights of the other joints and the
 vertical joint velocities.
 
@@ -30,7 +33,7 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints
-from simdiff.motion.flight import flights
+from simdiff.motion.flight import FEET, GROUND_PERCENTILE, flights
 from simdiff.motion.floor import RIC_Y
 from simdiff.motion.foot_lock import batch_features
 from simdiff.motion.skeleton import FPS
@@ -39,11 +42,21 @@ VEL_Y: slice = slice(SLICES["vel"].start + 1, SLICES["vel"].stop, 3)
 """The vertical velocity channels of the 22 joints in the features."""
 
 
-def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: float = FPS) -> np.ndarray:
+def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: float = FPS,
+                   clearance: np.ndarray | None = None) -> np.ndarray:
     """(T,) metres to add to ``height`` (T,) so each flight ``[s, e)`` of ``spans`` (take-off frame s − 1 ≥ 0) follows
     the parabola of gravity ``g`` m/s² (sign ignored) between take-off and landing (frame e), or from take-off with
-    its best-fitting take-off speed, at least ½·|g|·D, when e = T (no landing in the clip, D s in the air)."""
-    h = np.asarray(height, dtype=np.float64)
+    its best-fitting take-off speed, at least ½·|g|·D, when e = T (no landing in the clip, D s in the air).
+    ``clearance`` (T,) m, when given: how far each frame may move down (its lowest foot's height over its ground);
+    no frame is moved down by more."""
+    d = _parabola(np.asarray(height, dtype=np.float64), spans, g, fps)
+    if clearance is None:
+        return d
+    return np.maximum(d, -np.maximum(np.asarray(clearance, dtype=np.float64), 0.0))
+
+
+def _parabola(h: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: float) -> np.ndarray:
+    """:func:`parabola_shift` without a floor."""
     d = np.zeros_like(h)
     for s, e in spans:
         a, b = s - 1, e
@@ -60,6 +73,13 @@ def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: floa
         p = h[a] + (h[b] - h[a]) * tau / dur + 0.5 * abs(g) * tau * (dur - tau)
         d[a:b + 1] = p - h[a:b + 1]
     return d
+
+
+def foot_clearance(joints: np.ndarray) -> np.ndarray:
+    """(T,) m: the lowest foot joint's height over its own ground level (:data:`simdiff.motion.flight.FEET`,
+    :data:`~simdiff.motion.flight.GROUND_PERCENTILE`) in each frame of ``joints`` (T, 22, 3)."""
+    h = np.asarray(joints, dtype=np.float64)[:, FEET, 1]
+    return (h - np.percentile(h, GROUND_PERCENTILE, axis=0)).min(axis=1)
 
 
 def ballistic_flights(features: torch.Tensor, gravity: float | Sequence[float] | torch.Tensor,
@@ -96,7 +116,8 @@ def ballistic_flights(features: torch.Tensor, gravity: float | Sequence[float] |
         if n < 3:
             continue
         spans = flights(joints[i, :n])
-        shift[i, :n] = strength * parabola_shift(joints[i, :n, 0, 1], spans, float(g[i]), fps)
+        shift[i, :n] = strength * parabola_shift(joints[i, :n, 0, 1], spans, float(g[i]), fps,
+                                                 clearance=foot_clearance(joints[i, :n]))
     d = torch.from_numpy(shift).to(f)
     f[..., SLICES["root_y"]] += d[..., None]
     f[..., RIC_Y] += d[..., None]
