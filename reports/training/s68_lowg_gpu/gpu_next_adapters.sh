@@ -7,6 +7,11 @@
 # batch 64) did not raise it; the adapters had 3,000 GPU steps on this backbone, the shipped ones over 10,000.
 # Travel (measured 2026-12-01): code ~3 MB + G63 float16 13.4 MB + captions 2.3 MB + four aug packs 18.6 MB = ~37 MB;
 # reports/, the default model and the corpus pack (not needed: the backbone is frozen) must not travel.
+# Rehearsed on CPU (session 68, these packs, .gpu/G63_fp16, CONFIG a copy of ad68_gpu_config.json with steps 2,
+# batch 4, save_every 1; DEVICE=cpu LOADER_WORKERS=0 MINUTES=3; 130 s on 2 cores, 90 s of it unpacking): both runs
+# trained to step 2 from G63's adapters and came back as l10.tar.part_aa/ab and l30.tar.part_aa/ab (15.0 + 10.6 MiB
+# each), an 8-layer SimDiff folder with the run's lambda / mu in train_config.json. The rehearsal caught a missing
+# .gpu/G63_fp16 (session 65 had left it in its scratch): the first lines below make it.
 # Run from the repository root, step by step (the device tool's run needs the repository as it is).
 set -eu
 . .venv/bin/activate
