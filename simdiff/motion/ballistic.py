@@ -33,7 +33,7 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints
-from simdiff.motion.flight import FEET, GROUND_PERCENTILE, flights
+from simdiff.motion.flight import flights, heights_over_ground
 from simdiff.motion.floor import RIC_Y
 from simdiff.motion.foot_lock import batch_features
 from simdiff.motion.skeleton import FPS
@@ -49,14 +49,7 @@ def parabola_shift(height: np.ndarray, spans: Sequence[tuple[int, int]], g: floa
     its best-fitting take-off speed, at least ½·|g|·D, when e = T (no landing in the clip, D s in the air).
     ``clearance`` (T,) m, when given: how far each frame may move down (its lowest foot's height over its ground);
     no frame is moved down by more."""
-    d = _parabola(np.asarray(height, dtype=np.float64), spans, g, fps)
-    if clearance is None:
-        return d
-    return np.maximum(d, -np.maximum(np.asarray(clearance, dtype=np.float64), 0.0))
-
-
-def _parabola(h: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: float) -> np.ndarray:
-    """:func:`parabola_shift` without a floor."""
+    h = np.asarray(height, dtype=np.float64)
     d = np.zeros_like(h)
     for s, e in spans:
         a, b = s - 1, e
@@ -72,14 +65,15 @@ def _parabola(h: np.ndarray, spans: Sequence[tuple[int, int]], g: float, fps: fl
         dur = (b - a) / fps
         p = h[a] + (h[b] - h[a]) * tau / dur + 0.5 * abs(g) * tau * (dur - tau)
         d[a:b + 1] = p - h[a:b + 1]
+    if clearance is not None:
+        d = np.maximum(d, -np.maximum(np.asarray(clearance, dtype=np.float64), 0.0))
     return d
 
 
 def foot_clearance(joints: np.ndarray) -> np.ndarray:
-    """(T,) m: the lowest foot joint's height over its own ground level (:data:`simdiff.motion.flight.FEET`,
-    :data:`~simdiff.motion.flight.GROUND_PERCENTILE`) in each frame of ``joints`` (T, 22, 3)."""
-    h = np.asarray(joints, dtype=np.float64)[:, FEET, 1]
-    return (h - np.percentile(h, GROUND_PERCENTILE, axis=0)).min(axis=1)
+    """(T,) m: the lowest foot joint's height over its own ground level
+    (:func:`simdiff.motion.flight.heights_over_ground`) in each frame of ``joints`` (T, 22, 3)."""
+    return heights_over_ground(joints).min(axis=1)
 
 
 def ballistic_flights(features: torch.Tensor, gravity: float | Sequence[float] | torch.Tensor,

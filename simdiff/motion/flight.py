@@ -60,10 +60,15 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return [(int(s), int(e)) for s, e in zip(edges[::2], edges[1::2])]
 
 
+def heights_over_ground(joints: np.ndarray) -> np.ndarray:
+    """(T, 4) m: each foot joint of :data:`FEET` over its own ground level (see the module docstring)."""
+    h = check_joints(joints)[:, FEET, 1]
+    return h - np.percentile(h, GROUND_PERCENTILE, axis=0)
+
+
 def feet_up(joints: np.ndarray, lift: float = LIFT) -> np.ndarray:
     """(T, 4) bool: each foot joint of :data:`FEET` more than ``lift`` m above its own ground level."""
-    h = check_joints(joints)[:, FEET, 1]
-    return h > np.percentile(h, GROUND_PERCENTILE, axis=0) + lift
+    return heights_over_ground(joints) > lift
 
 
 def flights(joints: np.ndarray) -> list[tuple[int, int]]:
