@@ -15,6 +15,8 @@
 #     RUNS="plain:0 pair10:10" bash scripts/gpu_adapters.sh
 # RUNS: space-separated NAME:LAMBDA[:MU] (λ of --env-pairs, 0 = the paper's plain loss; MU of --env-pairs-drift,
 #   the twins' mean root-velocity term, default 0).
+# AUG_PACK_<NAME> (optional, per run): that run's packs instead of AUG_PACK, so runs side by side can differ in their
+#   data mix; a pack listed k times is drawn k times as often (each pack is unpacked once).
 # Overrides: CONFIG (configs/adapters_paired_gpu.json) SPLIT (all; `adapt`: each pack's split files joined, for
 #   packs made with --splits NAME) MINUTES (7) LOADER_WORKERS (cores / runs)
 #   DEVICE (cuda) PYTHON (python) ADAPTERS_INIT (a SimDiff folder to warm-start the adapters from) SEED
@@ -38,15 +40,25 @@ export PYTHONPATH="$PWD${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
 start=$(date +%s)
 mkdir -p "$OUT" "$WORK"
 log() { echo "[$(( $(date +%s) - start ))s] $*" | tee -a "$OUT/run.log"; }
-data=()
-for pk in $AUG_PACK; do  # several packs are read as one dataset (train adapters --data A B …)
-  d="$WORK/data/$(basename "$pk")"
-  case " ${data[*]} " in *" $d "*) echo "gpu_adapters.sh: two packs named $(basename "$pk") in AUG_PACK" >&2; exit 2;; esac
-  log "unpack $pk"
-  "$PY" -m simdiff train unpack "$pk" --out "$d" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log" \
-    || { log "unpack of $pk failed"; exit 1; }
+declare -A unpacked=()  # pack path -> its unpacked folder
+unpack() {  # $1 pack path; sets $d to its unpacked folder, unpacking it the first time
+  d="$WORK/data/$(basename "$1")"
+  if [ -n "${unpacked[$1]:-}" ]; then return 0; fi
+  local other
+  for other in "${!unpacked[@]}"; do
+    [ "${unpacked[$other]}" = "$d" ] && { echo "gpu_adapters.sh: two packs named $(basename "$1"): $other and $1" >&2; exit 2; }
+  done
+  log "unpack $1"
+  "$PY" -m simdiff train unpack "$1" --out "$d" --workers 0 --no-progress 2>&1 | tee -a "$OUT/run.log" \
+    || { log "unpack of $1 failed"; exit 1; }
   if [ "$SPLIT" = "adapt" ]; then cat "$d"/*.txt > "$d/adapt.txt"; fi  # every split file the pack brought, joined
-  data+=("$d")
+  unpacked[$1]=$d
+}
+declare -A run_data=()  # run name -> its --data folders (several packs are read as one dataset)
+for r in $RUNS; do
+  n=${r%%:*}; packs_var="AUG_PACK_$n"; packs="${!packs_var:-$AUG_PACK}"; folders=""
+  for pk in $packs; do unpack "$pk"; folders+="$d "; done
+  run_data[$n]=$folders
 done
 ( while sleep 30; do for r in $RUNS; do n=${r%%:*}; log "$n $(tail -n 1 "$WORK/$n/train_log.jsonl" 2>/dev/null)"; done; done ) &
 watcher=$!
@@ -55,8 +67,8 @@ pids=()
 for r in $RUNS; do
   n=${r%%:*}; rest=${r#*:}; lam=${rest%%:*}; mu=0
   [ "$rest" != "$lam" ] && mu=${rest#*:}
-  log "train $n: --env-pairs $lam --env-pairs-drift $mu --max-minutes $MINUTES --loader-workers $LOADER_WORKERS"
-  "$PY" -m simdiff train adapters --data "${data[@]}" --split "$SPLIT" --init "$BACKBONE" --out "$WORK/$n" \
+  log "train $n: --data ${run_data[$n]}--env-pairs $lam --env-pairs-drift $mu --max-minutes $MINUTES --loader-workers $LOADER_WORKERS"
+  "$PY" -m simdiff train adapters --data ${run_data[$n]} --split "$SPLIT" --init "$BACKBONE" --out "$WORK/$n" \
     --config "$CONFIG" --env-pairs "$lam" --env-pairs-drift "$mu" --device "$DEVICE" --text-table "$TEXT_TABLE" --max-minutes "$MINUTES" \
     --loader-workers "$LOADER_WORKERS" --no-progress ${ADAPTERS_INIT:+--adapters-init "$ADAPTERS_INIT"} \
     ${SEED:+--seed "$SEED"} > "$WORK/logs/$n.log" 2>&1 &

@@ -180,7 +180,8 @@ def test_gpu_backbone_script_rehearsal_from_a_train_split_pack(corpus, tmp_path)
 
 def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, tmp_path) -> None:
     """scripts/gpu_adapters.sh on CPU: unpack two paired augmented packs (read as one dataset), train a plain and a paired adapter run side by
-    side from the caption table without MiniLM, and tar each run (model + logs) into OUT."""
+    side from the caption table without MiniLM, and tar each run (model + logs) into OUT. The paired run has its own
+    mix (AUG_PACK_pair5: the first pack listed twice, each pack unpacked once)."""
     import tarfile
 
     aug = tmp_path / "aug"
@@ -204,7 +205,8 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
            "AUG_PACK": f"{tmp_path / 'packs' / 'aug'} {tmp_path / 'packs' / 'aug2'}",
            "TEXT_TABLE": str(tmp_path / "packs" / "captions.safetensors"), "CONFIG": str(tmp_path / "config.json"),
            "BACKBONE": str(tmp_path / "packs" / "backbone"), "RUNS": "plain:0 pair5:5:2", "LOADER_WORKERS": "0",
-           "SPLIT": "adapt",
+           "SPLIT": "adapt", "AUG_PACK_pair5": f"{tmp_path / 'packs' / 'aug'} {tmp_path / 'packs' / 'aug'} "
+                                                f"{tmp_path / 'packs' / 'aug2'}",
            "MINUTES": "3", "WORK": str(tmp_path / "work"), "PART_KIB": "400"})
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
                           text=True, timeout=240)
@@ -213,7 +215,13 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
     assert "run.log" in names and all(n == "run.log" or n.startswith(("plain.tar", "pair5.tar")) for n in names)
     assert all((out / n).stat().st_size <= 400 * 1024 for n in names if n != "run.log")
     assert any(".part_" in n for n in names)  # a tar of ~0.7 MB is cut
-    for name, lam, mu in (("plain", 0.0, 0.0), ("pair5", 5.0, 2.0)):
+    log = (out / "run.log").read_text()
+    assert log.count("unpack ") == 2
+    aug_dir = str(tmp_path / "work" / "data" / "aug") + " "
+    plain_line = next(line for line in log.splitlines() if "train plain: --data" in line)
+    pair_line = next(line for line in log.splitlines() if "train pair5: --data" in line)
+    assert plain_line.count(aug_dir) == 1 and pair_line.count(aug_dir) == 2
+    for name, lam, mu, parts_in in (("plain", 0.0, 0.0, 2), ("pair5", 5.0, 2.0, 3)):
         parts = sorted(out.glob(f"{name}.tar.part_*")) or [out / f"{name}.tar"]
         (tmp_path / f"{name}.joined.tar").write_bytes(b"".join(p.read_bytes() for p in parts))
         with tarfile.open(tmp_path / f"{name}.joined.tar") as tar:
@@ -223,8 +231,21 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
         train = json.loads((run / "train_config.json").read_text())["train"]
         assert (train["env_pairs"], train["env_pairs_drift"]) == (lam, mu)
         assert "trained adapters to step 2" in (run / f"{name}.log").read_text()
-        assert len(json.loads((run / "model" / "provenance.json").read_text())["trained_on"]) == 3  # bb + 2 parts
+        assert len(json.loads((run / "model" / "provenance.json").read_text())["trained_on"]) == 1 + parts_in  # bb
         assert MotionGenerator.load(run / "model", load_text=False).is_simdiff
+
+
+def test_gpu_adapters_script_refuses_two_packs_of_one_name(tmp_path) -> None:
+    """Two different packs with the same folder name would unpack into one place: a one-line error, exit 2."""
+    for sub in ("a", "b"):
+        (tmp_path / sub / "aug").mkdir(parents=True)
+    env = _device_env(tmp_path, {"OUT": str(tmp_path / "OUT"), "DEVICE": "cpu", "AUG_PACK": str(tmp_path / "a" / "aug"),
+           "AUG_PACK_r2": f"{tmp_path / 'a' / 'aug'} {tmp_path / 'b' / 'aug'}", "TEXT_TABLE": "t", "BACKBONE": "b",
+           "RUNS": "r1:0 r2:5", "WORK": str(tmp_path / "work")})
+    env["PYTHON"] = "true"  # the first pack's unpack is not what is tested
+    proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 2 and "two packs named aug" in proc.stderr, proc.stderr
 
 
 def _train_and_aug_packs(corpus: Path, tmp_path: Path) -> Path:
