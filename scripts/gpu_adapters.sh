@@ -56,7 +56,9 @@ unpack() {  # $1 pack path; sets $d to its unpacked folder, unpacking it the fir
 }
 declare -A run_data=()  # run name -> its --data folders (several packs are read as one dataset)
 for r in $RUNS; do
-  n=${r%%:*}; packs_var="AUG_PACK_$n"; packs="${!packs_var:-$AUG_PACK}"; folders=""
+  n=${r%%:*}
+  [[ "$n" =~ ^[A-Za-z0-9_]+$ ]] || { echo "gpu_adapters.sh: run name '$n' in RUNS: use letters, digits and _ only" >&2; exit 2; }
+  packs_var="AUG_PACK_$n"; packs="${!packs_var:-$AUG_PACK}"; folders=""
   for pk in $packs; do unpack "$pk"; folders+="$d "; done
   run_data[$n]=$folders
 done

@@ -235,8 +235,9 @@ def test_gpu_adapters_script_rehearsal_two_runs_from_an_augmented_pack(corpus, t
         assert MotionGenerator.load(run / "model", load_text=False).is_simdiff
 
 
-def test_gpu_adapters_script_refuses_two_packs_of_one_name(tmp_path) -> None:
-    """Two different packs with the same folder name would unpack into one place: a one-line error, exit 2."""
+def test_gpu_adapters_script_refuses_two_packs_of_one_name_and_odd_run_names(tmp_path) -> None:
+    """Two different packs with the same folder name would unpack into one place, and a run name that is not a shell
+    name could not carry AUG_PACK_<NAME>: one-line errors, exit 2."""
     for sub in ("a", "b"):
         (tmp_path / sub / "aug").mkdir(parents=True)
     env = _device_env(tmp_path, {"OUT": str(tmp_path / "OUT"), "DEVICE": "cpu", "AUG_PACK": str(tmp_path / "a" / "aug"),
@@ -246,6 +247,10 @@ def test_gpu_adapters_script_refuses_two_packs_of_one_name(tmp_path) -> None:
     proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
                           text=True, timeout=60)
     assert proc.returncode == 2 and "two packs named aug" in proc.stderr, proc.stderr
+    env["RUNS"] = "r-1:0"  # not a shell name: AUG_PACK_r-1 could not be read
+    proc = subprocess.run(["bash", str(ROOT / "scripts" / "gpu_adapters.sh")], env=env, capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 2 and "run name 'r-1'" in proc.stderr, proc.stderr
 
 
 def _train_and_aug_packs(corpus: Path, tmp_path: Path) -> Path:
