@@ -2,7 +2,9 @@
 guidance object's s_e is swapped per call). python early_screen.py MODEL --t-early T --se-early S [ballistic_screen args]
 Steps with timestep > T use s_e = S, the rest the model's own s_e (sampling.json). Why: fit_probe.py found the
 adapters' answer to gravity only where x_t no longer shows the jump (t >= 950); below it x̂₀ follows x_t's height."""
+import runpy
 import sys
+from pathlib import Path
 
 import simdiff.diffusion.guidance as guidance
 
@@ -25,7 +27,6 @@ def boosted(self, x, timesteps, cond):
 
 cls.__call__ = boosted
 sys.argv = ["ballistic_screen.py"] + argv
-sys.path.insert(0, "/work/main/reports/training/s67_ballistic")
-import runpy  # noqa: E402
-
-runpy.run_path("/work/main/reports/training/s67_ballistic/ballistic_screen.py", run_name="__main__")
+screen = Path(__file__).resolve().parent.parent / "s67_ballistic" / "ballistic_screen.py"
+sys.path.insert(0, str(screen.parent))
+runpy.run_path(str(screen), run_name="__main__")

@@ -7,7 +7,7 @@ noise draw, and read the apex gain of the network's x̂₀ (alpha 1, as in train
   lowg->earth x_t of the low-g replay, Earth φ
   earth->phi  x_t of the Earth twin, the low-g φ          (what the answer has to do from an Earth-like x_t)
 Prints medians per t beside the targets. python fit_probe.py MODEL [MODEL ...] --data AUG [--n 32]"""
-import argparse, json
+import argparse, functools, json
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +33,12 @@ a = ap.parse_args()
 torch.set_num_threads(2)
 root = a.data
 env = json.loads((root / "env.json").read_text())
-joints = lambda k: np.load(root / "new_joints" / f"{k}.npy")
+@functools.lru_cache(maxsize=None)
+def joints(k: str) -> np.ndarray:
+    """(T, 22, 3) joints of item k, read once."""
+    return np.load(root / "new_joints" / f"{k}.npy")
+
+
 by: dict[str, dict] = {}
 for k, v in env.items():
     by.setdefault(v["source"], {})[k] = v
