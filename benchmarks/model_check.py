@@ -56,10 +56,15 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--anchor", default="adapters", choices=ANCHORS,
                    help="what the text guidance runs on (backbone: the adapters add only their answer to φ vs Earth)")
     p.add_argument("--anchor-alpha", type=float, default=0.0, metavar="A",
-                   help="with --anchor backbone or reference: the adapter strength of its text guidance (0: the "
+                   help="with --anchor backbone, reference or edit: the adapter strength of its text guidance (0: the "
                         "backbone alone)")
     p.add_argument("--anchor-t-max", type=int, default=None, metavar="T",
                    help="with --anchor backbone or reference: that anchor only at timesteps <= T (default every step)")
+    p.add_argument("--eta", type=float, default=0.0, metavar="ETA",
+                   help="DDIM eta in [0, 1] (0: deterministic, the default; 1: fresh noise at every step)")
+    p.add_argument("--edit-t", type=int, default=None, metavar="T",
+                   help="with --anchor edit: motions off Earth follow their Earth motion down to timestep T "
+                        "(default 800)")
     p.add_argument("--ballistic", type=float, default=0.0, metavar="S",
                    help="ballistic flight strength in [0, 1] (0: off): flights follow the parabola of the sample's "
                         "gravity")
@@ -105,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
                              steps=args.steps, guidance=args.guidance, alpha=args.alpha,
                              foot_lock=args.foot_lock, env_guidance=args.env_guidance, anchor=args.anchor,
                              env_guidance_fallback=args.env_guidance_fallback, anchor_alpha=args.anchor_alpha,
-                             anchor_t_max=args.anchor_t_max, ballistic=args.ballistic,
+                             anchor_t_max=args.anchor_t_max, edit_t=args.edit_t, eta=args.eta, ballistic=args.ballistic,
                              more_evaluators=list(args.also_evaluator), device=args.device,
                              split=SplitOptions(split=args.split, n=args.n),
                              prompts=PromptOptions(jump_samples=args.jump_samples, speed_samples=args.speed_samples,

@@ -79,7 +79,7 @@ def test_sampling_defaults(tmp_path: Path) -> None:
     assert with_model_defaults(build_request("walk"), {}, given=set()).anchor == "adapters"
     assert with_model_defaults(build_request("walk", anchor="adapters"), {"anchor": "backbone"},
                                given={"anchor"}).anchor == "adapters"
-    with pytest.raises(SimdiffError, match="anchor must be one of adapters, backbone, reference, got 'sim'"):
+    with pytest.raises(SimdiffError, match="anchor must be one of adapters, backbone, reference, edit, got 'sim'"):
         with_model_defaults(build_request("walk"), {"anchor": "sim"}, given=set())
 
 

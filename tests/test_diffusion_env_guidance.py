@@ -145,7 +145,7 @@ def test_anchor_alpha_is_checked_in_one_line() -> None:
     for bad in (-0.1, float("nan"), float("inf")):
         with pytest.raises(SimdiffError, match="anchor alpha must be a finite number ≥ 0"):
             GuidedDenoiser(simdiff_net(), 2.5, anchor="backbone", anchor_alpha=bad)
-    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone or reference anchor"):
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone, reference or edit anchor"):
         GuidedDenoiser(simdiff_net(), 2.5, anchor="adapters", anchor_alpha=0.25)
 
 
@@ -271,6 +271,64 @@ def test_sampling_earth_rows_equal_the_backbone_alone() -> None:
     alone = sample(sd, s, with_env(c, ENVS, alpha=0.0), 10, generator=torch.Generator().manual_seed(0))
     assert torch.equal(anchored[1], alone[1])
     assert not torch.allclose(anchored[0], alone[0], atol=1e-3)
+
+
+# --- the edit anchor ---------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("env_scale", [1.0, 3.0])
+def test_edit_anchor_follows_earth_above_edit_t_then_the_adapters_at_phi(env_scale: float) -> None:
+    sd, c = simdiff_net(), cond()  # rows: g −1.6, Earth, wind
+    x = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(6))
+    edit = GuidedDenoiser(sd, 2.5, env_scale=env_scale, anchor="edit", anchor_alpha=0.25, edit_t=600)
+    at_ref = GuidedDenoiser(sd, 2.5)  # the reference anchor's text guidance, used at φ_ref and α a
+    adapters = GuidedDenoiser(sd, 2.5, env_scale=env_scale)
+    with torch.no_grad():
+        for step in (999, 601):
+            t = torch.full((3,), step)
+            assert torch.equal(edit(x, t, c), at_ref(x, t, earth(with_env(c, ENVS, alpha=0.25)))), step
+        for step in (600, 20):
+            t = torch.full((3,), step)
+            out, base, phi = edit(x, t, c), at_ref(x, t, earth(with_env(c, ENVS, alpha=0.25))), adapters(x, t, c)
+            assert torch.allclose(out[1], base[1], atol=1e-5), step  # the Earth row stays on the reference anchor
+            assert torch.allclose(out[[0, 2]], phi[[0, 2]], atol=1e-5), step  # the others: the adapters anchor at φ
+            assert (out[0] - base[0]).abs().max() > 1e-3
+
+
+def test_edit_anchor_costs_one_2b_forward_per_step() -> None:
+    sd, sizes = simdiff_net(), []
+
+    def counting(x: torch.Tensor, t: torch.Tensor, c: Condition) -> torch.Tensor:
+        sizes.append(x.shape[0])
+        return sd(x, t, c)
+
+    x = torch.randn(3, 8, 263)
+    with torch.no_grad():
+        GuidedDenoiser(counting, 2.5, anchor="edit", edit_t=500)(x, torch.full((3,), 900), cond())
+        GuidedDenoiser(counting, 2.5, anchor="edit", edit_t=500)(x, torch.full((3,), 300), cond())
+    assert sizes == [6, 2, 4]  # early: one batch at φ_ref; late: the Earth row and the two rows off it
+
+
+def test_edit_t_is_checked_in_one_line() -> None:
+    from simdiff.diffusion.guidance import DEFAULT_EDIT_T
+    from simdiff.product.request import DEFAULT_EDIT_T as REQUEST_DEFAULT
+
+    assert GuidedDenoiser(simdiff_net(), 2.5, anchor="edit").edit_t == DEFAULT_EDIT_T == REQUEST_DEFAULT
+    for bad in (-1, 1000, 2.5, True):
+        with pytest.raises(SimdiffError, match="edit t must be a whole timestep in 0..999"):
+            GuidedDenoiser(simdiff_net(), 2.5, anchor="edit", edit_t=bad)
+    with pytest.raises(SimdiffError, match="edit t 500 needs the edit anchor"):
+        GuidedDenoiser(simdiff_net(), 2.5, anchor="reference", edit_t=500)
+    with pytest.raises(SimdiffError, match="anchor t max 500 needs the backbone or reference anchor"):
+        GuidedDenoiser(simdiff_net(), 2.5, anchor="edit", anchor_t_max=500)
+
+
+def test_sampling_with_the_edit_anchor_keeps_earth_rows_on_the_backbone() -> None:
+    sd, c = simdiff_net(), cond()
+    s = make_scheduler("ddim", 6)
+    edited = sample(sd, s, c, 10, generator=torch.Generator().manual_seed(0), anchor="edit", edit_t=500)
+    alone = sample(sd, s, with_env(c, ENVS, alpha=0.0), 10, generator=torch.Generator().manual_seed(0))
+    assert torch.allclose(edited[1], alone[1], atol=1e-5)
+    assert not torch.allclose(edited[0], alone[0], atol=1e-3)
 
 
 def test_condition_stacked() -> None:

@@ -132,3 +132,25 @@ def test_shipped_table_configs_carry_claims() -> None:
     for c in (t1, t2):
         assert c.protocol.replications >= 5 and c.protocol.samples_limit >= 256
     assert t1.ddpm_samples >= 32
+
+
+def test_generator_fn_passes_eta_and_refuses_it_with_physdiff() -> None:
+    """The DDIM η reaches the generator only when set (stand-ins need not know it); PhysDiff takes none."""
+    import torch
+
+    from simdiff.eval.protocol import generator_fn
+
+    calls: list[dict] = []
+
+    class Stub:
+        is_simdiff = False
+
+        def generate(self, captions, lengths, **kwargs):  # noqa: ANN001, ANN003
+            calls.append(kwargs)
+            return type("G", (), {"features": torch.zeros(len(captions), 4, 263)})()
+
+    generator_fn(Stub())(["a"], [4], 0)
+    generator_fn(Stub(), eta=1.0)(["a"], [4], 0)
+    assert "eta" not in calls[0] and calls[1]["eta"] == 1.0
+    with pytest.raises(SimdiffError, match="DDIM eta 1.0 is a generator option; the PhysDiff baseline takes none"):
+        generator_fn(Stub(), eta=1.0, physdiff=object())

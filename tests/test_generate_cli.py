@@ -297,7 +297,7 @@ def test_generate_backbone_anchor_from_the_option_or_sampling_json(tmp_path: Pat
     (model / "sampling.json").write_text('{"anchor": "sim"}')
     assert main([*argv, "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
-    assert "anchor must be one of adapters, backbone, reference, got 'sim'" in err and err.count("\n") == 1
+    assert "anchor must be one of adapters, backbone, reference, edit, got 'sim'" in err and err.count("\n") == 1
 
 
 def test_generate_anchor_alpha_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
@@ -321,7 +321,7 @@ def test_generate_anchor_alpha_from_the_option_or_sampling_json(tmp_path: Path, 
                                                                        "--anchor-alpha", "0"))  # stored value dropped
     assert main([*argv, "--anchor", "adapters", "--anchor-alpha", "0.25", "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
-    assert "--anchor-alpha 0.25 needs the backbone or reference anchor" in err and err.count("\n") == 1
+    assert "--anchor-alpha 0.25 needs the backbone, reference or edit anchor" in err and err.count("\n") == 1
     reference = run("reference", "--anchor", "reference", "--anchor-alpha", "0.25")
     assert np.array_equal(reference, run("a25", "--alpha", "0.25"))  # Earth without wind: the adapters at 0.25
     assert json.loads((tmp_path / "reference" / "generation.json").read_text())["anchor"] == "reference"
@@ -428,3 +428,40 @@ def test_generate_reports_an_extrapolated_backbone(tmp_path: Path, capsys) -> No
     err = capsys.readouterr().err
     assert "extrapolation.json: not valid JSON" in err and err.count("\n") == 1
     assert not (tmp_path / "bad" / "generation.json").exists()
+
+
+def test_generate_edit_anchor_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
+    from simdiff.serve.testing import write_tiny_model
+
+    model = write_tiny_model(tmp_path / "editing")
+    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
+            "--format", "npy", "--no-video", "-q", "--alpha", "0.5"]
+
+    def run(name: str, *extra: str) -> np.ndarray:
+        assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
+        return np.load(tmp_path / name / "sample0_features.npy")
+
+    def meta(name: str) -> dict:
+        return json.loads((tmp_path / name / "generation.json").read_text())
+
+    earth = run("earth", "--anchor", "edit")
+    assert np.array_equal(earth, run("a0", "--alpha", "0"))  # Earth without wind: the reference anchor at α 0
+    assert meta("earth")["edit_t"] == 800 and meta("a0")["edit_t"] is None
+    # DDIM 2 runs t 500 and 0: edit t 100 keeps the first step at Earth, edit t 600 runs both under φ
+    late, early = (run(n, "--anchor", "edit", "--edit-t", t, "--gravity", "-1.6") for n, t in (("late", "100"),
+                                                                                               ("early", "600")))
+    assert meta("late")["edit_t"] == 100 and not np.allclose(late, early, atol=1e-4)
+    assert not np.allclose(late, earth, atol=1e-4)  # the last step ran under φ
+    (model / "sampling.json").write_text('{"anchor": "edit", "edit_t": 100}')
+    assert np.array_equal(run("stored", "--gravity", "-1.6"), late)
+    assert meta("stored")["edit_t"] == 100
+    assert meta("stored")["anchor"] == "edit"
+    assert main([*argv, "--anchor", "reference", "--gravity", "-1.6", "--out", str(tmp_path / "ref")]) == 0
+    assert meta("ref")["edit_t"] is None  # the stored edit t belongs to the stored anchor
+    (model / "sampling.json").unlink()
+    assert main([*argv, "--edit-t", "500", "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "--edit-t 500 needs the edit anchor" in err and err.count("\n") == 1
+    assert main([*argv, "--anchor", "edit", "--edit-t", "1000", "--out", str(tmp_path / "bad2")]) == 2
+    err = capsys.readouterr().err
+    assert "--edit-t must be a whole timestep in 0..999, got 1000" in err and err.count("\n") == 1

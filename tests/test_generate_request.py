@@ -114,7 +114,7 @@ def test_anchor_is_checked_and_matches_the_sampler() -> None:
 
     assert ANCHORS == SAMPLER_ANCHORS
     assert build_request("walk").anchor == "adapters" and build_request("walk", anchor="backbone").anchor == "backbone"
-    with pytest.raises(SimdiffError, match="--anchor must be one of adapters, backbone, reference, got 'nope'"):
+    with pytest.raises(SimdiffError, match="--anchor must be one of adapters, backbone, reference, edit, got 'nope'"):
         build_request("walk", anchor="nope")
     with pytest.raises(SimdiffError, match="--num-samples must be 1..64, got 0"):
         build_request("walk", num_samples=0)

@@ -366,7 +366,7 @@ def test_config_refuses_bad_values(checked: dict) -> None:
         CheckConfig(**{**config.__dict__, "seeds": [1, 1]}).validate()
     with pytest.raises(SimdiffError, match="corpus"):
         CheckConfig(**{**config.__dict__, "corpus": str(checked["root"])}).validate()
-    with pytest.raises(SimdiffError, match="--anchor must be one of adapters, backbone, reference, got 'sim'"):
+    with pytest.raises(SimdiffError, match="--anchor must be one of adapters, backbone, reference, edit, got 'sim'"):
         CheckConfig(**{**config.__dict__, "anchor": "sim"}).validate()
 
 
@@ -428,13 +428,27 @@ def test_backbone_anchor_measures_every_section_again(checked: dict, tmp_path: P
     assert not any(report[k].get("cached") for k in ("test_split", "jumps", "speeds"))
     assert report["settings"]["anchor_alpha"] == 0.25
     assert "guidance anchor backbone at α 0.25" in (tmp_path / "out" / "check.md").read_text()
-    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone or reference anchor"):
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone, reference or edit anchor"):
         CheckConfig(**{**config.__dict__, "anchor": "adapters"}).validate()
     config.anchor_t_max = 500  # the early steps change: measured again
     report = ModelCheck(config.validate(), text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
                         progress=False).run()
     assert not report["test_split"].get("cached") and report["settings"]["anchor_t_max"] == 500
     assert "guidance anchor backbone at α 0.25 at t ≤ 500" in (tmp_path / "out" / "check.md").read_text()
+    config.anchor, config.anchor_t_max, config.edit_t = "edit", None, 300  # φ from t 300: measured again
+    report = ModelCheck(config.validate(), text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert not report["jumps"].get("cached") and report["settings"]["edit_t"] == 300
+    assert "guidance anchor edit at α 0.25, φ from t ≤ 300" in (tmp_path / "out" / "check.md").read_text()
+    with pytest.raises(SimdiffError, match="edit t 300 needs the edit anchor"):
+        CheckConfig(**{**config.__dict__, "anchor": "backbone"}).validate()
+    config.eta = 1.0  # stochastic DDIM: every motion changes, measured again
+    report = ModelCheck(config.validate(), text_encoder=lambda name: HashTextEncoder(), projector=EchoProjector(),
+                        progress=False).run()
+    assert not report["test_split"].get("cached") and report["settings"]["eta"] == 1.0
+    assert "DDIM η 1.0" in (tmp_path / "out" / "check.md").read_text()
+    with pytest.raises(SimdiffError, match=r"--eta must be in \[0, 1\], got 1.5"):
+        CheckConfig(**{**config.__dict__, "eta": 1.5}).validate()
 
 
 def test_a_config_change_measures_every_section_again(checked: dict, tmp_path: Path) -> None:

@@ -83,7 +83,7 @@ def test_anchor_alpha_gives_alpha_a_at_earth_and_is_validated() -> None:
     backbone = gen.generate(["walk", "jump"], 12, env=envs, alpha=0.5, steps=3, seed=1, env_guidance=2.0,
                             anchor="backbone").features
     assert torch.equal(anchored[0], quarter[0]) and not torch.allclose(anchored[0], backbone[0], atol=1e-4)
-    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone or reference anchor"):
+    with pytest.raises(SimdiffError, match="anchor alpha 0.25 needs the backbone, reference or edit anchor"):
         gen.generate(["walk"], 12, env=envs[1], steps=2, anchor_alpha=0.25)
     with pytest.raises(SimdiffError, match="anchor alpha must be a finite number"):
         gen.generate(["walk"], 12, env=envs[1], steps=2, anchor="backbone", anchor_alpha=-1.0)

@@ -384,7 +384,7 @@ def test_generate_anchor_alpha_from_sampling_json_or_the_request(server, model_d
     status, out, _ = call(server, "/api/generate", {**earth, "anchor_alpha": -1})
     assert status == 400 and "anchor_alpha must be in" in out["error"]
     status, out, _ = call(server, "/api/generate", {**earth, "anchor_alpha": 0.25})  # the request's error: 400
-    assert status == 400 and "anchor_alpha 0.25 needs the backbone or reference anchor" in out["error"], out
+    assert status == 400 and "anchor_alpha 0.25 needs the backbone, reference or edit anchor" in out["error"], out
 
 
 def test_generate_anchor_t_max_from_sampling_json_or_the_request(server, model_dir):
@@ -404,6 +404,23 @@ def test_generate_anchor_t_max_from_sampling_json_or_the_request(server, model_d
         assert status == 400 and message in out["error"], out
 
 
+def test_generate_edit_t_from_sampling_json_or_the_request(server, model_dir):
+    moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5, "gravity": -1.6}
+    edit = {**moon, "anchor": "edit"}
+    status, given, _ = call(server, "/api/generate", {**edit, "edit_t": 100})
+    assert status == 200 and given["meta"]["params"]["edit_t"] == 100
+    assert given["joints"] != call(server, "/api/generate", edit)[1]["joints"]
+    (model_dir / "sampling.json").write_text('{"anchor": "edit", "edit_t": 100}')
+    try:
+        status, stored, _ = call(server, "/api/generate", moon)
+        assert status == 200 and stored["joints"] == given["joints"]
+    finally:
+        (model_dir / "sampling.json").unlink()
+    for bad, message in ((1000, "edit_t must be a whole timestep"), (500, "edit_t 500 needs the edit anchor")):
+        status, out, _ = call(server, "/api/generate", {**moon, "edit_t": bad})
+        assert status == 400 and message in out["error"], out
+
+
 def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):
     earth = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5}
     status, plain, _ = call(server, "/api/generate", earth)
@@ -418,4 +435,4 @@ def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):
     finally:
         (model_dir / "sampling.json").unlink()
     status, out, _ = call(server, "/api/generate", {**earth, "anchor": "sim"})
-    assert status == 400 and "anchor must be one of adapters, backbone, reference, got 'sim'" in out["error"]
+    assert status == 400 and "anchor must be one of adapters, backbone, reference, edit, got 'sim'" in out["error"]

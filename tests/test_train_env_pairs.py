@@ -315,3 +315,41 @@ def test_drift_pairs_wind_leaves_gravity_twins_out_of_the_drift_term(tmp_path: P
     with pytest.raises(SimdiffError, match="drift_pairs must be 'all' or 'wind', got 'gusts'"):
         Trainer(tmp_path / "bad", run_config(2, mode="adapters", sim=True, env_pairs=1.0, drift_pairs="gusts"),
                 ShiftTwins(), text_encoder=HashText(), init_model=bb)
+
+
+def test_cross_twins_noise_each_twin_from_the_other(tmp_path: Path) -> None:
+    bb = _backbone(tmp_path)
+    seen: list[torch.Tensor] = []
+    x0 = torch.randn(6, 8, 263, generator=torch.Generator().manual_seed(1))
+    paired = torch.tensor([True, True, False])
+    for p in (0.0, 1.0):
+        cfg = run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=p, batch_size=6, seed=4)
+        trainer = Trainer(tmp_path / f"x{p}", cfg, ShiftTwins(), text_encoder=HashText(), init_model=bb)
+        trainer.model = lambda x, t, c: seen.append(x) or x  # type: ignore[assignment]
+        trainer._paired_prediction(x0, None, torch.Generator().manual_seed(0), paired)  # type: ignore[arg-type]
+    g = torch.Generator().manual_seed(0)
+    t = torch.randint(0, trainer.scheduler.num_train_timesteps, (3,), generator=g).repeat(2)
+    noise = torch.randn((3, 8, 263), generator=g).repeat(2, 1, 1)
+    own = trainer.scheduler.add_noise(x0, noise, t)
+    crossed = trainer.scheduler.add_noise(torch.cat([x0[3:], x0[:3]]), noise, t)
+    assert torch.equal(seen[0], own)  # p 0: each twin from its own motion, as before
+    for row, source in ((0, crossed), (1, crossed), (2, own), (3, crossed), (4, crossed), (5, own)):
+        assert torch.equal(seen[1][row], source[row]), row  # p 1: paired twins swapped, the unpaired row kept
+
+
+def test_cross_twins_train_and_are_checked(tmp_path: Path) -> None:
+    bb = _backbone(tmp_path)
+    losses = {}
+    for p in (0.0, 0.5):
+        cfg = run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=p, batch_size=6, seed=4)
+        losses[p] = Trainer(tmp_path / f"c{p}", cfg, ShiftTwins(), text_encoder=HashText(),
+                            init_model=bb).train(progress=False)
+    assert all(np.isfinite(losses[0.5])) and losses[0.5] != losses[0.0]
+    for bad, match in ((1.5, r"cross_twins must be a share in \[0, 1\], got 1.5"),
+                       (-0.1, r"cross_twins must be a share in \[0, 1\], got -0.1")):
+        with pytest.raises(SimdiffError, match=match):
+            Trainer(tmp_path / "bad", run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=bad),
+                    ShiftTwins(), text_encoder=HashText(), init_model=bb)
+    with pytest.raises(SimdiffError, match="cross_twins = 0.5 needs env_pairs > 0"):
+        Trainer(tmp_path / "bad2", run_config(2, mode="adapters", sim=True, cross_twins=0.5), ShiftTwins(),
+                text_encoder=HashText(), init_model=bb)

@@ -17,6 +17,12 @@
   exactly the adapters anchor at α = a; elsewhere the change of φ moves the motion exactly as far as the adapters
   anchor at α would, text guidance included (session 55: the backbone anchor's push, outside the text guidance,
   cost text fidelity under low gravity). Costs one 2B forward plus one 4K forward over the K rows off φ_ref.
+* ``"edit"``: every row follows the reference anchor at φ_ref (``anchor_alpha`` a: exactly the backbone at a = 0) at
+  the steps whose timestep is above ``edit_t`` T_e; at and below T_e the rows off φ_ref run the adapters anchor at their
+  φ (x̃₀ = G_α(c, φ), environment guidance included). A sample off Earth is then its Earth sample of the same noise
+  until T_e, re-played under φ from there: what adapters trained on crossed twins (``TrainConfig.cross_twins``: the
+  other twin's x_t, one's own target) learn to do. Earth rows are exactly the reference anchor's. Costs one 2B forward
+  per step (plus one K forward over the K rows off φ_ref at T_e and below when s_e ≠ 1).
 * ``anchor_t_max`` T: the backbone or reference anchor runs only at the steps whose timestep is ≤ T, the adapters
   anchor at the earlier ones (session 55: what the text asks for is settled by the early, noisy steps, the adapters'
   answer to Earth, a matter of detail, by the late ones).
@@ -41,12 +47,19 @@ Denoiser = Callable[[Tensor, Tensor, "Condition"], Tensor]
 REFERENCE_ENV: tuple[float, float, float] = (-9.81, 0.0, 0.0)
 """φ_ref of environment guidance: Earth's gravity (m/s², along z) and no wind (N)."""
 
-ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference")
-"""What the text guidance runs on: the network with its adapters at α, the backbone alone, or the network at the
-reference φ (see the module)."""
+ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference", "edit")
+"""What the text guidance runs on: the network with its adapters at α, the backbone alone, the network at the
+reference φ, or that until ``edit_t`` and the adapters at φ after it (see the module)."""
 
-ALPHA_ANCHORS: tuple[str, ...] = ("backbone", "reference")
+ALPHA_ANCHORS: tuple[str, ...] = ("backbone", "reference", "edit")
 """The anchors that take an ``anchor_alpha``."""
+
+T_MAX_ANCHORS: tuple[str, ...] = ("backbone", "reference")
+"""The anchors that take an ``anchor_t_max``."""
+
+DEFAULT_EDIT_T: int = 800
+"""The edit anchor's last timestep at the reference φ unless told (of the two that session 70 screened, 600 and 800,
+the one with the larger answer to low gravity; neither passed that screen)."""
 
 
 def check_anchor_t_max(value: int | None, anchor: str) -> int | None:
@@ -56,9 +69,21 @@ def check_anchor_t_max(value: int | None, anchor: str) -> int | None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) or not 0 <= value <= 999:
         raise SimdiffError(f"anchor t max must be a whole timestep in 0..999, got {value}")
-    if anchor not in ALPHA_ANCHORS:
+    if anchor not in T_MAX_ANCHORS:
         raise SimdiffError(f"anchor t max {int(value)} needs the backbone or reference anchor (--anchor backbone or "
                            f"reference), not {anchor!r}")
+    return int(value)
+
+
+def check_edit_t(value: int | None, anchor: str) -> int | None:
+    """``value`` as an int in [0, 999] when ``anchor`` is ``"edit"`` (None there: :data:`DEFAULT_EDIT_T`); None for
+    the other anchors, which take none (a value given with them is one :class:`SimdiffError` line naming it)."""
+    if value is None:
+        return DEFAULT_EDIT_T if anchor == "edit" else None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) or not 0 <= value <= 999:
+        raise SimdiffError(f"edit t must be a whole timestep in 0..999, got {value}")
+    if anchor != "edit":
+        raise SimdiffError(f"edit t {int(value)} needs the edit anchor (--anchor edit), not {anchor!r}")
     return int(value)
 
 
@@ -69,8 +94,8 @@ def check_anchor_alpha(value: float, anchor: str) -> float:
     if not (0.0 <= value < float("inf")):
         raise SimdiffError(f"anchor alpha must be a finite number ≥ 0, got {value}")
     if value and anchor not in ALPHA_ANCHORS:
-        raise SimdiffError(f"anchor alpha {value} needs the backbone or reference anchor (--anchor backbone or "
-                           f"reference), not {anchor!r}")
+        raise SimdiffError(f"anchor alpha {value} needs the backbone, reference or edit anchor (--anchor backbone, "
+                           f"reference or edit), not {anchor!r}")
     return value
 
 
@@ -93,11 +118,13 @@ class GuidedDenoiser:
             alone); only with ``anchor="backbone"`` or ``"reference"``.
         anchor_t_max: the backbone or reference anchor only at timesteps ≤ this (0..999), the adapters anchor
             above it (None: every step).
+        edit_t: the edit anchor's last timestep at φ_ref (0..999; None: :data:`DEFAULT_EDIT_T`); only with
+            ``anchor="edit"``.
     """
 
     def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True, env_scale: float = 1.0,
                  reference_env: Sequence[float] = REFERENCE_ENV, anchor: str = "adapters",
-                 anchor_alpha: float = 0.0, anchor_t_max: int | None = None) -> None:
+                 anchor_alpha: float = 0.0, anchor_t_max: int | None = None, edit_t: int | None = None) -> None:
         self.denoiser = denoiser
         self.scale = float(scale)
         self.batched = batched
@@ -110,12 +137,15 @@ class GuidedDenoiser:
         self.anchor = anchor
         self.anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
         self.anchor_t_max = check_anchor_t_max(anchor_t_max, anchor)
+        self.edit_t = check_edit_t(edit_t, anchor)
 
     def __call__(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
         """x: (B, T, F), timesteps: (B,) → guided x̂₀ (B, T, F)."""
         anchor = self.anchor
         if self.anchor_t_max is not None and int(timesteps.max()) > self.anchor_t_max:
             anchor = "adapters"  # an early step
+        if anchor == "edit":
+            return self._edit_anchor(x, timesteps, cond)
         rows, ref = self._plan(cond, anchor)
         if anchor == "reference":
             return self._reference_anchor(x, timesteps, cond, rows, ref)
@@ -161,6 +191,29 @@ class GuidedDenoiser:
         cond_out, text_out = self._text_guided(torch.cat([xr, xr]), torch.cat([tr, tr]), cond.select(rows).stacked(ref))
         (c_phi, c_ref), (g_phi, g_ref) = cond_out.chunk(2), text_out.chunk(2)
         guided[rows] += (g_phi - g_ref) + (self.env_scale - 1.0) * (c_phi - c_ref)
+        return guided
+
+    def _edit_anchor(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
+        """G_a(c, φ_ref) for every row above ``edit_t`` and for the rows at φ_ref; the adapters anchor's x̃₀ at φ for
+        the others at and below it (see the module)."""
+        rows, ref = self._plan(cond, "edit")
+        assert cond.env is not None  # _plan checked it
+        assert self.edit_t is not None
+        phi = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
+        at_ref = replace(cond, alpha=self.anchor_alpha, env=phi.expand_as(cond.env).clone())
+        if rows is None or ref is None or int(timesteps.max()) > self.edit_t:
+            return self._text_guided(x, timesteps, at_ref)[1]
+        earth = torch.ones(x.shape[0], dtype=torch.bool, device=x.device)
+        earth[rows] = False
+        guided = torch.empty_like(x)
+        if bool(earth.any()):
+            keep = earth.nonzero().flatten()
+            guided[keep] = self._text_guided(x[keep], timesteps[keep], at_ref.select(keep))[1]
+        xr, tr = x[rows], timesteps[rows]
+        cond_out, g = self._text_guided(xr, tr, cond.select(rows))
+        if self.env_scale != 1.0:
+            g = g + (self.env_scale - 1.0) * (cond_out - self.denoiser(xr, tr, ref))
+        guided[rows] = g
         return guided
 
     def _plan(self, cond: Condition, anchor: str) -> tuple[Tensor | None, Condition | None]:

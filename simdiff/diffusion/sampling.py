@@ -53,6 +53,7 @@ def sample(
     anchor: str = "adapters",
     anchor_alpha: float = 0.0,
     anchor_t_max: int | None = None,
+    edit_t: int | None = None,
 ) -> Tensor:
     """Run the reverse process from pure noise; returns x₀ (B, num_frames, nfeats) normalised features.
 
@@ -70,6 +71,7 @@ def sample(
             (:class:`GuidedDenoiser`).
         anchor_alpha: adapter strength of the backbone or reference anchor's text guidance (0: the backbone alone).
         anchor_t_max: that anchor only at timesteps ≤ this, the adapters anchor above (None: every step).
+        edit_t: the edit anchor's last timestep at the reference φ (None: its default; :class:`GuidedDenoiser`).
     """
     device = cond.text.device
     b = cond.batch_size
@@ -77,7 +79,7 @@ def sample(
         (b, num_frames, nfeats), generator=generator, device=generator.device if generator else device
     ).to(device)
     model = GuidedDenoiser(denoiser, guidance, batched_cfg, env_scale=env_guidance, anchor=anchor,
-                           anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max)
+                           anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max, edit_t=edit_t)
     hooked = None if hook_timesteps is None else {int(t) for t in hook_timesteps}
     steps: Iterable[Tensor] = scheduler.timesteps
     if progress is not None:

@@ -229,7 +229,7 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
                  physdiff: Any = None, projector: Any = None, simulate: bool = False,
                  finish_projector: Any = None, foot_lock: float = 0.0, env_guidance: float = 1.0,
                  anchor: str = "adapters", anchor_alpha: float = 0.0, anchor_t_max: int | None = None,
-                 ballistic: float = 0.0) -> GenerateFn:
+                 ballistic: float = 0.0, edit_t: int | None = None, eta: float = 0.0) -> GenerateFn:
     """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
 
     ``simulate``: the simulated finish: every final sample is re-tracked by ``finish_projector``
@@ -240,22 +240,27 @@ def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_inde
     generator's foot lock strength (0: off; not with ``physdiff``); ``env_guidance``: environment guidance s_e
     (1: off; SimDiff continuous models); ``anchor``: what the text guidance runs on (:mod:`simdiff.diffusion.guidance`);
     ``anchor_alpha``: the backbone or reference anchor's adapter strength (0: the backbone alone); ``anchor_t_max``:
-    that anchor only at timesteps ≤ this (None: every step); ``ballistic``: the generator's ballistic flight strength
-    (0: off; not with ``physdiff``).
+    that anchor only at timesteps ≤ this (None: every step); ``edit_t``: the edit anchor's last timestep at Earth (None:
+    its default); ``ballistic``: the generator's ballistic flight strength (0: off; not with ``physdiff``); ``eta``: the
+    DDIM sampler's η (0: deterministic; not with ``physdiff``).
     """
     from simdiff.model.generator import guidance_kwargs
 
     if ballistic and physdiff is not None:
         raise SimdiffError("ballistic flight is a generator option; the PhysDiff baseline takes none (leave it at 0)")
+    if eta and physdiff is not None:
+        raise SimdiffError(f"DDIM eta {eta} is a generator option; the PhysDiff baseline takes none (leave it at 0)")
     finish_log: list[dict[str, Any]] = []
 
     def generate(captions: list[str], lengths: list[int], seed: int) -> Tensor:
         kwargs: dict[str, Any] = {}
         if generator.is_simdiff:
             kwargs = {"env": env, "env_index": env_index, "alpha": alpha,
-                      **guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max)}
+                      **guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, edit_t=edit_t)}
         if ballistic:
             kwargs["ballistic"] = ballistic
+        if eta:
+            kwargs["eta"] = eta
         if physdiff is not None:
             from simdiff.baselines.physdiff import physdiff_generate
 

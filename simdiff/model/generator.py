@@ -13,7 +13,7 @@ from typing import Any, Callable, Iterable, Sequence
 import torch
 from torch import Tensor, nn
 
-from simdiff.diffusion.guidance import ANCHORS, REFERENCE_ENV, check_anchor_alpha, check_anchor_t_max
+from simdiff.diffusion.guidance import ANCHORS, REFERENCE_ENV, check_anchor_alpha, check_anchor_t_max, check_edit_t
 from simdiff.diffusion.sampling import X0Hook, make_scheduler, sample
 from simdiff.errors import SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
@@ -116,6 +116,7 @@ class MotionGenerator:
         anchor_alpha: float = 0.0,
         anchor_t_max: int | None = None,
         ballistic: float = 0.0,
+        edit_t: int | None = None,
     ) -> Generation:
         """Sample one motion per caption.
 
@@ -144,6 +145,8 @@ class MotionGenerator:
                 without wind are the backbone's (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only.
                 ``"reference"``: the text guidance runs under Earth without wind with the adapters at
                 ``anchor_alpha`` and the adapters anchor's own answer to φ (text guidance and s_e included) is added.
+                ``"edit"``: every motion is its Earth-without-wind motion (the reference anchor) until the step
+                ``edit_t``, then the motions off it continue under their φ with the adapters anchor.
             anchor_alpha: with ``anchor="backbone"`` or ``"reference"``, the adapter strength its text guidance runs
                 at (0: the backbone alone; e.g. 0.25: motions under Earth without wind are those of α 0.25, the
                 answer to φ is α's).
@@ -152,6 +155,8 @@ class MotionGenerator:
             ballistic: strength in [0, 1] of :func:`simdiff.motion.ballistic.ballistic_flights` applied after the foot
                 cleanup (0: off): every flight's pelvis height follows the parabola of the sample's gravity (φ's g_z;
                 Earth for a backbone-only model), the whole body moved with it; not for categorical SimDiff models.
+            edit_t: with ``anchor="edit"``, the last timestep (0..999) at which motions off Earth still follow their
+                Earth motion (None: :data:`simdiff.diffusion.guidance.DEFAULT_EDIT_T`).
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:
@@ -183,6 +188,7 @@ class MotionGenerator:
                                "this model has none (leave it at 'adapters')")
         anchor_alpha = check_anchor_alpha(anchor_alpha, anchor)
         anchor_t_max = check_anchor_t_max(anchor_t_max, anchor)
+        edit_t = check_edit_t(edit_t, anchor)
         ballistic = check_ballistic(ballistic, self.config)
         # options checked first: a bad one fails before the text encoder runs
         text = text_embeddings.float().to(self.device) if text_embeddings is not None else self.encode_text(texts)
@@ -194,7 +200,8 @@ class MotionGenerator:
             return sample(self.network, make_scheduler(sampler, steps, eta), cond, frames,
                           nfeats=self.config.backbone.nfeats, guidance=guidance, batched_cfg=batched_cfg,
                           generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps, progress=progress,
-                          env_guidance=push, anchor=anchor, anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max)
+                          env_guidance=push, anchor=anchor, anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max,
+                          edit_t=edit_t)
 
         x = run(env_guidance)
         fell_back = None
@@ -270,7 +277,7 @@ def impossible(features: Tensor, lengths: Tensor) -> Tensor:
 
 def guidance_kwargs(env_guidance: float = 1.0, anchor: str = "adapters", anchor_alpha: float = 0.0,
                     anchor_t_max: int | None = None, env_guidance_fallback: float | None = None,
-                    ballistic: float = 0.0) -> dict[str, Any]:
+                    ballistic: float = 0.0, edit_t: int | None = None) -> dict[str, Any]:
     """The environment-guidance and anchor keywords of :meth:`MotionGenerator.generate` that differ from its
     defaults: callers pass only these, so wrappers (PhysDiff's) and test stand-ins need not know them all."""
     out: dict[str, Any] = {}
@@ -286,4 +293,6 @@ def guidance_kwargs(env_guidance: float = 1.0, anchor: str = "adapters", anchor_
         out["env_guidance_fallback"] = env_guidance_fallback
     if ballistic:
         out["ballistic"] = ballistic
+    if edit_t is not None:
+        out["edit_t"] = edit_t
     return out

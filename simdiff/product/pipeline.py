@@ -21,7 +21,7 @@ from simdiff import __version__
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 from simdiff.product.outputs import env_label, render_video, write_metadata, write_motion
-from simdiff.product.request import GenerationRequest
+from simdiff.product.request import DEFAULT_EDIT_T, GenerationRequest
 from simdiff.product.simulate import SimulatedMotion, load_simulator, simulate_finish, write_simulated
 from simdiff.sim.env import Environment
 
@@ -129,6 +129,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
                     **({"anchor": request.anchor} if request.anchor != "adapters" else {}),
                     **({"anchor_alpha": request.anchor_alpha} if request.anchor_alpha else {}),
                     **({"anchor_t_max": request.anchor_t_max} if request.anchor_t_max is not None else {}),
+                    **({"edit_t": request.edit_t} if request.edit_t is not None else {}),
                     **({"ballistic": request.ballistic} if request.ballistic else {}),
                 )
                 features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
@@ -267,6 +268,8 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "anchor": request.anchor if simdiff_model else None,
         "anchor_alpha": request.anchor_alpha if simdiff_model else None,
         "anchor_t_max": request.anchor_t_max if simdiff_model else None,
+        "edit_t": (request.edit_t if request.edit_t is not None else DEFAULT_EDIT_T)
+        if simdiff_model and request.anchor == "edit" else None,
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",
         "samples": records,

@@ -48,11 +48,14 @@ class GenerationRequest:
         env_guidance: environment guidance s_e ≥ 0 (1: off; :mod:`simdiff.diffusion.guidance`).
         env_guidance_fallback: s_e ≥ 0 for samples that come out floating or gliding at ``env_guidance``
             (re-sampled with the same seed; None: off; :meth:`simdiff.model.generator.MotionGenerator.generate`).
-        anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference`` (:data:`ANCHORS`).
-        anchor_alpha: with the ``backbone`` or ``reference`` anchor, the adapter strength its text guidance runs at
+        anchor: what the text guidance runs on, ``adapters``, ``backbone``, ``reference`` or ``edit``
+            (:data:`ANCHORS`).
+        anchor_alpha: with the ``backbone``, ``reference`` or ``edit`` anchor, the adapter strength its text guidance runs at
             (0: the backbone alone; :mod:`simdiff.diffusion.guidance`).
         anchor_t_max: with the ``backbone`` or ``reference`` anchor, the last timestep (0..999) it runs at from
             below, the adapters anchor at the earlier steps (None: every step).
+        edit_t: with the ``edit`` anchor, the last timestep (0..999) at which a motion off Earth still follows its
+            Earth motion (None: the model's or the sampler's default).
         ballistic: ballistic-flight strength in [0, 1] (0: off; :mod:`simdiff.motion.ballistic`): flights follow the
             parabola of the sample's gravity.
         formats: output kinds, a subset of :data:`FORMATS`.
@@ -75,6 +78,7 @@ class GenerationRequest:
     anchor: str = "adapters"
     anchor_alpha: float = 0.0
     anchor_t_max: int | None = None
+    edit_t: int | None = None
     ballistic: float = 0.0
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
@@ -215,11 +219,17 @@ def check_finite(name: str, value: float, minimum: float | None = None) -> float
 STORED_NUMBERS: tuple[str, ...] = ("guidance", "alpha", "foot_lock", "env_guidance", "ballistic")
 """The numeric ``sampling.json`` settings."""
 
-ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference")
+ANCHORS: tuple[str, ...] = ("adapters", "backbone", "reference", "edit")
 """``--anchor`` values: :data:`simdiff.diffusion.guidance.ANCHORS` (repeated here, where torch is not imported)."""
 
-ALPHA_ANCHORS: tuple[str, ...] = ("backbone", "reference")
-"""The anchors that take ``--anchor-alpha`` / ``--anchor-t-max`` (:data:`simdiff.diffusion.guidance.ALPHA_ANCHORS`)."""
+ALPHA_ANCHORS: tuple[str, ...] = ("backbone", "reference", "edit")
+"""The anchors that take ``--anchor-alpha`` (:data:`simdiff.diffusion.guidance.ALPHA_ANCHORS`)."""
+
+DEFAULT_EDIT_T: int = 800
+"""The edit anchor's last timestep at Earth unless told (:data:`simdiff.diffusion.guidance.DEFAULT_EDIT_T`)."""
+
+T_MAX_ANCHORS: tuple[str, ...] = ("backbone", "reference")
+"""The anchors that take ``--anchor-t-max`` (:data:`simdiff.diffusion.guidance.T_MAX_ANCHORS`)."""
 
 
 def check_anchor(name: str, value: object) -> str:
@@ -230,12 +240,12 @@ def check_anchor(name: str, value: object) -> str:
 
 
 def check_anchor_alpha(name: str, value: object, anchor: str) -> float:
-    """``value`` as a finite float ≥ 0, and 0 unless ``anchor`` is ``backbone`` or ``reference`` (one-line errors
-    naming ``name``)."""
+    """``value`` as a finite float ≥ 0, and 0 unless ``anchor`` is ``backbone``, ``reference`` or ``edit`` (one-line
+    errors naming ``name``)."""
     number = check_finite(name, value, 0.0)
     if number and anchor not in ALPHA_ANCHORS:
-        raise SimdiffError(f"{name} {number:g} needs the backbone or reference anchor (--anchor backbone or "
-                           f"reference), not {anchor!r}")
+        raise SimdiffError(f"{name} {number:g} needs the backbone, reference or edit anchor (--anchor backbone, "
+                           f"reference or edit), not {anchor!r}")
     return number
 
 
@@ -247,10 +257,31 @@ def check_anchor_t_max(name: str, value: object, anchor: str | None = None) -> i
     if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
             or not 0 <= value <= 999:
         raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value!r}")
-    if anchor is not None and anchor not in ALPHA_ANCHORS:
+    if anchor is not None and anchor not in T_MAX_ANCHORS:
         raise SimdiffError(f"{name} {int(value)} needs the backbone or reference anchor (--anchor backbone or "
                            f"reference), not {anchor!r}")
     return int(value)
+
+
+def check_edit_t(name: str, value: object, anchor: str | None = None) -> int | None:
+    """``value`` as a whole timestep in [0, 999] (None passes), usable with ``anchor`` unless that is None (the
+    ``edit`` anchor); one-line errors naming ``name``."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
+            or not 0 <= value <= 999:
+        raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value!r}")
+    if anchor is not None and anchor != "edit":
+        raise SimdiffError(f"{name} {int(value)} needs the edit anchor (--anchor edit), not {anchor!r}")
+    return int(value)
+
+
+def stored_edit_t(stored: dict[str, float | int | str], anchor: str) -> int | None:
+    """A model's stored ``edit_t`` when ``anchor`` is its stored anchor (the value belongs to that anchor), else None;
+    checked as the option is."""
+    if anchor != stored.get("anchor", "adapters"):
+        return None
+    return check_edit_t("edit_t", stored.get("edit_t"), anchor)
 
 
 def stored_anchor_t_max(stored: dict[str, float | int | str], anchor: str) -> int | None:
@@ -276,12 +307,12 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     Args:
         stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance``,
             ``env_guidance_fallback``,
-            ``anchor``, ``anchor_alpha``, ``anchor_t_max``, ``ballistic`` (see
+            ``anchor``, ``anchor_alpha``, ``anchor_t_max``, ``edit_t``, ``ballistic`` (see
             :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
             ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``, ``anchor_alpha``,
-            ``anchor_t_max``, ``ballistic``). A stored ``anchor_alpha`` or ``anchor_t_max`` belongs to the stored anchor: it is
-            dropped when the user picks another anchor.
+            ``anchor_t_max``, ``edit_t``, ``ballistic``). A stored ``anchor_alpha``, ``anchor_t_max`` or ``edit_t`` belongs
+            to the stored anchor: it is dropped when the user picks another anchor.
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -295,12 +326,13 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
                     else stored_anchor_alpha(stored, anchor))
     anchor_t_max = (check_anchor_t_max("--anchor-t-max", request.anchor_t_max, anchor) if "anchor_t_max" in given
                     else stored_anchor_t_max(stored, anchor))
+    edit_t = (check_edit_t("--edit-t", request.edit_t, anchor) if "edit_t" in given else stored_edit_t(stored, anchor))
     fallback = request.env_guidance_fallback
     if "env_guidance_fallback" not in given and stored.get("env_guidance_fallback") is not None:
         fallback = check_finite("env_guidance_fallback", stored["env_guidance_fallback"], 0.0)
     return replace(
         request, sampler=sampler, steps=steps, anchor=anchor, anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max,
-        env_guidance_fallback=fallback,
+        edit_t=edit_t, env_guidance_fallback=fallback,
         **{name: getattr(request, name) if name in given else stored_setting(stored, name, getattr(request, name))
            for name in STORED_NUMBERS},
     )
@@ -330,6 +362,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                   foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
                   env_guidance_fallback: float | None = None, anchor_alpha: float = 0.0,
                   anchor_t_max: int | None = None, ballistic: float = 0.0, compare: str | None = None,
+                  edit_t: int | None = None,
                   formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
@@ -357,6 +390,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         anchor=check_anchor("--anchor", anchor),
         anchor_alpha=check_finite("--anchor-alpha", anchor_alpha, 0.0),
         anchor_t_max=check_anchor_t_max("--anchor-t-max", anchor_t_max),
+        edit_t=check_edit_t("--edit-t", edit_t),
         ballistic=check_unit("--ballistic", ballistic),
         formats=parse_formats(formats, no_video),
         force=bool(force),

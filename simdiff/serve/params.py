@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass
 from typing import Any, Mapping
 
 from simdiff.errors import SimdiffError
-from simdiff.product.request import MAX_PROMPT_CHARS, check_anchor, check_anchor_t_max, check_text
+from simdiff.product.request import MAX_PROMPT_CHARS, check_anchor, check_anchor_t_max, check_edit_t, check_text
 from simdiff.motion.skeleton import FPS, MAX_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND
 
@@ -59,6 +59,8 @@ class GenerateParams:
             for the model's ``sampling.json`` value when the anchor is the stored one (0 otherwise).
         anchor_t_max: that anchor only at timesteps ≤ this (0..999), or None for the model's ``sampling.json``
             value when the anchor is the stored one (every step otherwise).
+        edit_t: the edit anchor's last timestep at Earth (0..999), or None for the model's ``sampling.json`` value when
+            the anchor is the stored one (the sampler's default otherwise).
         ballistic: ballistic-flight strength in [0, 1] (:mod:`simdiff.motion.ballistic`), or None for the model's
             ``sampling.json`` value (0, off, without one).
     """
@@ -79,6 +81,7 @@ class GenerateParams:
     env_guidance_fallback: float | None = None
     anchor_alpha: float | None = None
     anchor_t_max: int | None = None
+    edit_t: int | None = None
     ballistic: float | None = None
 
     @property
@@ -129,7 +132,7 @@ def parse_generate(body: Any) -> GenerateParams:
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
             simulate, foot_lock, env_guidance, anchor, env_guidance_fallback, anchor_alpha, anchor_t_max,
-            ballistic}``;
+            edit_t, ballistic}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -189,6 +192,7 @@ def parse_generate(body: Any) -> GenerateParams:
         anchor_alpha = _number(body, "anchor_alpha", 0.0)
         _check_range("anchor_alpha", anchor_alpha, 0.0, ALPHA_RANGE[1])
     anchor_t_max = check_anchor_t_max("anchor_t_max", body.get("anchor_t_max"))
+    edit_t = check_edit_t("edit_t", body.get("edit_t"))
     ballistic = body.get("ballistic")
     if ballistic is not None:
         ballistic = _number(body, "ballistic", 0.0)
@@ -196,4 +200,5 @@ def parse_generate(body: Any) -> GenerateParams:
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
                           guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance,
                           anchor=anchor, env_guidance_fallback=fallback, anchor_alpha=anchor_alpha,
-                          anchor_t_max=anchor_t_max, ballistic=ballistic, **wind)
+                          anchor_t_max=anchor_t_max, edit_t=edit_t, ballistic=ballistic,
+                          **wind)

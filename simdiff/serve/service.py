@@ -149,8 +149,8 @@ class MotionService:
         as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import (check_anchor, check_anchor_alpha, check_anchor_t_max, stored_anchor_alpha,
-                                             stored_anchor_t_max, stored_setting)
+        from simdiff.product.request import (check_anchor, check_anchor_alpha, check_anchor_t_max, check_edit_t,
+                                             stored_anchor_alpha, stored_anchor_t_max, stored_edit_t, stored_setting)
 
         try:
             stored = sampling_defaults(self.model_dir)
@@ -163,6 +163,7 @@ class MotionService:
                 fallback = stored_setting(stored, "env_guidance_fallback", 1.0)
             anchor_alpha = stored_anchor_alpha(stored, anchor) if params.anchor_alpha is None else 0.0
             t_max = stored_anchor_t_max(stored, anchor) if params.anchor_t_max is None else None
+            edit_t = stored_edit_t(stored, anchor) if params.edit_t is None else None
             ballistic = params.ballistic if params.ballistic is not None else stored_setting(stored, "ballistic", 0.0)
         except SimdiffError as exc:
             if strict:
@@ -171,16 +172,18 @@ class MotionService:
             push = 1.0 if params.env_guidance is None else params.env_guidance
             anchor = params.anchor or "adapters"
             fallback = params.env_guidance_fallback
-            anchor_alpha, t_max = 0.0, None
+            anchor_alpha, t_max, edit_t = 0.0, None, None
             ballistic = params.ballistic or 0.0
         # the request's own values against the anchor: its error (400), not the model's
         if params.anchor_alpha is not None:
             anchor_alpha = check_anchor_alpha("anchor_alpha", params.anchor_alpha, anchor)
         if params.anchor_t_max is not None:
             t_max = check_anchor_t_max("anchor_t_max", params.anchor_t_max, anchor)
+        if params.edit_t is not None:
+            edit_t = check_edit_t("edit_t", params.edit_t, anchor)
         return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor,
                        env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha), anchor_t_max=t_max,
-                       ballistic=float(ballistic))
+                       edit_t=edit_t, ballistic=float(ballistic))
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -258,7 +261,8 @@ class MotionService:
                                      **({"env_guidance": params.env_guidance, "anchor": params.anchor,
                                          "env_guidance_fallback": params.env_guidance_fallback,
                                          "anchor_alpha": params.anchor_alpha or 0.0,
-                                         "anchor_t_max": params.anchor_t_max} if uses_env else {}))
+                                         "anchor_t_max": params.anchor_t_max,
+                                         "edit_t": params.edit_t} if uses_env else {}))
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count

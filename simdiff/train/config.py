@@ -82,6 +82,11 @@ class TrainConfig:
             paired too) or ``"overlap"`` (kept whole, cropped from their first frames and compared over the frames
             they share, so a longer flight and its landing stay in the target);
             :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`.
+        cross_twins: share p in [0, 1] of paired twins (needs ``env_pairs`` > 0) whose x_t is built from the *other*
+            twin's x₀ (same t and ε) while the target stays their own: "replay my twin's motion under my φ". The plain
+            loss lets the network read a jump's height off x_t below t ≈ 900 whatever φ says (session 69's probe), so
+            φ alone decides it in the noisiest steps; crossed twins make φ act where x_t already shows the motion,
+            in proportion to it (an edit of the twin, as the simulator's replay is). 0 = off.
     """
 
     mode: str = "backbone"
@@ -103,6 +108,7 @@ class TrainConfig:
     twin_frames: str = "equal"
     drift_pairs: str = "all"
     pair_twins: str = "all"
+    cross_twins: float = 0.0
 
 
 @dataclass

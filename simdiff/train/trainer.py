@@ -103,6 +103,10 @@ class Trainer:
             raise SimdiffError(f"drift_pairs must be 'all' or 'wind', got {tc.drift_pairs!r}")
         if tc.pair_twins not in DRIFT_PAIRS:
             raise SimdiffError(f"pair_twins must be 'all' or 'wind', got {tc.pair_twins!r}")
+        if not (isinstance(tc.cross_twins, (int, float)) and 0.0 <= tc.cross_twins <= 1.0):
+            raise SimdiffError(f"cross_twins must be a share in [0, 1], got {tc.cross_twins}")
+        if tc.cross_twins > 0 and not tc.env_pairs > 0:
+            raise SimdiffError(f"cross_twins = {tc.cross_twins} needs env_pairs > 0 (it crosses twins of paired batches)")
         if tc.env_pairs > 0 and tc.mode != "adapters":
             raise SimdiffError(f"env_pairs = {tc.env_pairs} needs adapters mode (the φ-difference loss trains the adapters)")
         with torch.random.fork_rng(devices=[]):
@@ -269,7 +273,7 @@ class Trainer:
         mask = batch["mask"].to(self.device)
         if "paired" in batch:
             self.network.backbone.eval()  # frozen: no dropout, so twins differ only through φ
-            pred = self._paired_prediction(x0, cond, generator)
+            pred = self._paired_prediction(x0, cond, generator, batch["paired"])
         else:
             pred = diffusion_prediction(self.model, self.scheduler, x0, cond, generator=generator)
         loss = masked_mse(pred, x0, mask)
@@ -299,12 +303,23 @@ class Trainer:
             raise SimdiffError(f"loss became {value} at step {self.step}")
         return value
 
-    def _paired_prediction(self, x0: Tensor, cond: Condition, generator: torch.Generator) -> Tensor:
-        """x̂₀ (B, T, F) with one t and one ε per twin pair (items i and i + B/2)."""
+    def _paired_prediction(self, x0: Tensor, cond: Condition, generator: torch.Generator,
+                           paired: Tensor | None = None) -> Tensor:
+        """x̂₀ (B, T, F) with one t and one ε per twin pair (items i and i + B/2). With ``cross_twins`` p > 0, a share p
+        of the paired twins (``paired`` (B/2,) bool) are noised from each other's x₀ (``TrainConfig.cross_twins``)."""
         h = x0.shape[0] // 2
         t = torch.randint(0, self.scheduler.num_train_timesteps, (h,), generator=generator).repeat(2).to(self.device)
         noise = torch.randn((h, *x0.shape[1:]), generator=generator).repeat(2, 1, 1).to(self.device)
-        return self.model(self.scheduler.add_noise(x0, noise, t), t, cond)
+        source = x0
+        p = self.config.train.cross_twins
+        if p > 0:
+            cross = torch.rand(h, generator=generator) < p
+            if paired is not None:
+                cross &= paired.cpu()
+            cross = cross.to(self.device)[:, None, None]
+            swapped = torch.cat([x0[h:], x0[:h]])
+            source = torch.where(cross.repeat(2, 1, 1), swapped, x0)
+        return self.model(self.scheduler.add_noise(source, noise, t), t, cond)
 
     @staticmethod
     def _pair_loss(pred: Tensor, x0: Tensor, mask: Tensor, paired: Tensor) -> Tensor:

@@ -6,6 +6,7 @@
 #   env FB: --env-guidance-fallback (session 52)
 #   env AA: --anchor-alpha (session 55)
 #   env BALLISTIC: --ballistic (session 67)
+#   env EDIT_T: --edit-t, with ANCHOR=edit (session 70); env ETA: --eta, DDIM eta (session 70)
 #   env ASEEDS: stage A's seeds (default "100 101"; session 56); they split the 16 samples per jump prompt, so more seeds
 #     do not raise n (96 jump pairs, 64 windy walks; session 57); env JS: samples per jump prompt (default 16; session 57)
 #   A: selection seeds 100 101, val n 32, response on   B: val n 128 seeds 0 1, no response
@@ -20,5 +21,5 @@ case $1 in
   *) echo "check.sh: unknown stage '$1' (A, B, T or Tq)" >&2; exit 2;;
 esac
 /usr/bin/time -f "stage$1 $2 %e s" python ${PYWRAP} benchmarks/model_check.py --model $3 --corpus $S/corpus3 --evaluator $S/eval \
-  $args --jump-samples ${JS:-16} --speed-samples 8 --steps ${STEPS:-20} --guidance ${W:-2.5} --alpha ${ALPHA:-0.5} --foot-lock 1 --env-guidance ${4:-2} --anchor ${ANCHOR:-adapters} ${AA:+--anchor-alpha $AA} ${FB:+--env-guidance-fallback $FB} ${BALLISTIC:+--ballistic $BALLISTIC} ${ALSO:+--also-evaluator $ALSO} --threads 2 \
+  $args --jump-samples ${JS:-16} --speed-samples 8 --steps ${STEPS:-20} --guidance ${W:-2.5} --alpha ${ALPHA:-0.5} --foot-lock 1 --env-guidance ${4:-2} --anchor ${ANCHOR:-adapters} ${AA:+--anchor-alpha $AA} ${FB:+--env-guidance-fallback $FB} ${BALLISTIC:+--ballistic $BALLISTIC} ${EDIT_T:+--edit-t $EDIT_T} ${ETA:+--eta $ETA} ${ALSO:+--also-evaluator $ALSO} --threads 2 \
   --out $S/eval11/${1:0:1}_$2 -q

@@ -36,7 +36,9 @@ def joints(gen: MotionGenerator, prompt: str, n: int, seed: int, env, s: dict) -
     out = gen.generate([prompt] * n, 120, seed=seed, steps=s["steps"], guidance=s["guidance"], alpha=s["alpha"],
                        foot_lock=s["foot_lock"], env=list(env), env_guidance=s["env_guidance"],
                        anchor=s.get("anchor", "adapters"), anchor_alpha=s.get("anchor_alpha", 0.0),  # session 66
-                       ballistic=s.get("ballistic", 0.0))  # session 67
+                       ballistic=s.get("ballistic", 0.0),  # session 67
+                       **({"edit_t": s["edit_t"]} if "edit_t" in s else {}),  # session 70
+                       eta=s.get("eta", 0.0))  # session 70
     return features_to_joints(out.features.double()).numpy()
 
 

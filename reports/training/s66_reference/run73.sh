@@ -5,12 +5,15 @@
 # Session 67: MODELS (folder holding ${N}_model, default /work/scratch/s66), R (where the verdict lines go, default
 # this folder) and STAGES (their order, default "gate C' A B C+ T") for later rules; the defaults are rule 73's run.
 # BALLISTIC (the model's ballistic strength, default off) goes to every draw; BDRAW: stage B's draw (see stage_B).
+# Session 70: ANC (the anchor, default reference), ALPHA (default 0.5), EDIT_T (the edit anchor's edit t) and ETA (DDIM
+# eta) for rules 81-82; FB empty: no fallback.
 set -u
-RULE=${RULE:-73} N=${N:-G63r} SE=${SE:-3} FB=${FB:-2} AS=${AS:-140}
+RULE=${RULE:-73} N=${N:-G63r} SE=${SE:-3} FB=${FB-2} AS=${AS:-140}
 cd /work/main; . .venv/bin/activate
 V=reports/training/s66_reference; R=${R:-$V}; S=/work/scratch/s39; MODELS=${MODELS:-/work/scratch/s66}; M=$MODELS/${N}_model
 OUT=$R/rule${RULE}_stages.txt; R57=reports/training/s57_pooled_a
-export BALLISTIC=${BALLISTIC:-} SIMDIFF_SCRATCH=$S STEPS=50 ANCHOR=reference AA=0 ANCHOR_ALPHA=0 PROBE_ANCHOR=reference PROBE_ANCHOR_ALPHA=0
+export BALLISTIC=${BALLISTIC:-} SIMDIFF_SCRATCH=$S STEPS=50 ANCHOR=${ANC:-reference} AA=0 ANCHOR_ALPHA=0 PROBE_ANCHOR=${ANC:-reference} PROBE_ANCHOR_ALPHA=0
+export ALPHA=${ALPHA:-0.5} EDIT_T=${EDIT_T:-} ETA=${ETA:-}
 stamp() { echo "[$(date -u +%H:%M)] $*" >&2; }
 guard() {  # $1 phi, $2 seeds, $3 folder
   [ -f $3/$1/check.json ] || SEEDS="$2" /usr/bin/time -f "stage $3 %e s" python reports/training/s37_env_guidance/guard.py \

@@ -1,5 +1,5 @@
 """Screen (no simulator, no verdict): what the ballistic flight projection does to a model's jumps.
-python ballistic_screen.py MODEL [--seed S] [--n N] [--env-guidance SE] [--dump FILE]
+python ballistic_screen.py MODEL [--seed S] [--n N] [--env-guidance SE] [--eta ETA] [--dump FILE]
 
 The six jump prompts of the model check x N samples, 120 frames, under Earth and g -1.6 with the same noise (seeds
 S + prompt index), the model's sampling.json settings (anchor included; fallback not applied). For the raw samples
@@ -41,6 +41,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=7700)
     ap.add_argument("--n", type=int, default=8)
     ap.add_argument("--env-guidance", type=float, default=None)
+    ap.add_argument("--eta", type=float, default=0.0, help="DDIM eta (session 70; 0: deterministic, as shipped)")
     ap.add_argument("--dump", default=None, help="write every sample's flight stats here (JSON)")
     a = ap.parse_args()
     torch.set_num_threads(2)
@@ -51,13 +52,15 @@ def main() -> None:
     out: dict[str, dict[str, list]] = {k: {"earth": [], "moon": []} for k in ("raw", "ballistic")}
     for i, p in enumerate(JUMP_PROMPTS):
         for key, g in (("earth", -9.81), ("moon", -1.6)):
-            f = gen.generate([p] * a.n, 120, seed=a.seed + i, steps=s["steps"], guidance=s["guidance"],
+            f = gen.generate([p] * a.n, 120, seed=a.seed + i, steps=s["steps"], guidance=s["guidance"], eta=a.eta,
                              alpha=s["alpha"], foot_lock=s["foot_lock"], env=[g, 0.0, 0.0],
                              env_guidance=s["env_guidance"], anchor=s.get("anchor", "adapters"),
-                             anchor_alpha=s.get("anchor_alpha", 0.0)).features.double()
+                             anchor_alpha=s.get("anchor_alpha", 0.0),
+                             **({"edit_t": s["edit_t"]} if "edit_t" in s else {})).features.double()
             for kind, feats in (("raw", f), ("ballistic", ballistic_flights(f, g))):
                 out[kind][key] += [flight_stats(j) for j in features_to_joints(feats).numpy()]
-    res = {"model": a.model, "s_e": s["env_guidance"], "seed": a.seed, "seconds": round(time.time() - t0)}
+    res = {"model": a.model, "s_e": s["env_guidance"], "seed": a.seed, "seconds": round(time.time() - t0),
+           **({"anchor": "edit", "edit_t": s["edit_t"]} if "edit_t" in s else {}), **({"eta": a.eta} if a.eta else {})}
     res.update({k: stats(v["earth"], v["moon"]) for k, v in out.items()})
     print(json.dumps(res), flush=True)
     if a.dump:

@@ -91,14 +91,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="what the text guidance runs on: the network with its adapters (adapters), or the backbone "
                           "alone, the adapters adding only their answer to φ against Earth without wind (backbone), "
                           "or the network under Earth without wind at --anchor-alpha, the adapters anchor's whole "
-                          "answer to φ added (reference); default adapters, or the model's sampling.json")
+                          "answer to φ added (reference), or that network until --edit-t, then the adapters under φ "
+                          "(edit); default adapters, or the model's sampling.json")
     smp.add_argument("--anchor-alpha", type=float, metavar="A",
-                     help="with --anchor backbone or reference: run its text guidance with the adapters at strength "
+                     help="with --anchor backbone, reference or edit: run its text guidance with the adapters at strength "
                           "A, so motions under Earth without wind are those of --alpha A while the answer to φ is "
                           "--alpha's (default 0, or the model's sampling.json)")
     smp.add_argument("--anchor-t-max", type=int, metavar="T",
                      help="with --anchor backbone or reference: use it only at the denoising steps whose timestep is "
                           "at most T (0-999), the adapters anchor at the earlier ones (default every step, or the "
+                          "model's sampling.json)")
+    smp.add_argument("--edit-t", type=int, metavar="T",
+                     help="with --anchor edit: a motion off Earth follows its Earth motion (same seed) down to "
+                          "timestep T (0-999), then continues under its gravity and wind (default 800, or the "
                           "model's sampling.json)")
     smp.add_argument("--ballistic", type=float, metavar="S",
                      help="ballistic flight strength in [0, 1]: while no foot is on the ground the body's height "
@@ -144,7 +149,8 @@ def run(args: argparse.Namespace) -> int:
         env_guidance=1.0 if args.env_guidance is None else args.env_guidance, anchor=args.anchor or "adapters",
         env_guidance_fallback=args.env_guidance_fallback,
         anchor_alpha=0.0 if args.anchor_alpha is None else args.anchor_alpha,
-        anchor_t_max=args.anchor_t_max, ballistic=0.0 if args.ballistic is None else args.ballistic,
+        anchor_t_max=args.anchor_t_max, edit_t=args.edit_t,
+        ballistic=0.0 if args.ballistic is None else args.ballistic,
         compare=args.compare, formats=args.format,
         no_video=args.no_video, force=args.force,
     )
@@ -177,7 +183,8 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
     read_recipe(folder)  # likewise extrapolation.json
     given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance",
-                               "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max", "ballistic")
+                               "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max", "edit_t",
+                               "ballistic")
              if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")

@@ -94,6 +94,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--pair-twins", choices=["all", "wind"],
                    help="which twins the per-frame paired loss (--env-pairs) compares: all (default) or only those "
                         "whose phi differ in wind; see TrainConfig.pair_twins")
+    a.add_argument("--cross-twins", type=float, metavar="P",
+                   help="share of paired twins (needs --env-pairs) noised from each other's motion, the target "
+                        "staying their own: phi then edits the motion x_t shows; see TrainConfig.cross_twins")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -207,6 +210,8 @@ def _run_config(args: argparse.Namespace):
         tc.drift_pairs = args.drift_pairs
     if getattr(args, "pair_twins", None) is not None:
         tc.pair_twins = args.pair_twins
+    if getattr(args, "cross_twins", None) is not None:
+        tc.cross_twins = args.cross_twins
     from simdiff.data.augment.anchored import TARGETS
     from simdiff.data.augment.dataset import TWIN_FRAMES
     from simdiff.train.config import DRIFT_PAIRS

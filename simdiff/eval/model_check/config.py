@@ -90,10 +90,12 @@ class CheckConfig:
         steps: DDIM steps; guidance: CFG scale; alpha: adapter strength of SimDiff models; foot_lock: the
             generator's foot-lock strength (0: off, :mod:`simdiff.motion.foot_lock`); env_guidance: environment
             guidance s_e (1: off, :mod:`simdiff.diffusion.guidance`; changes only motions generated off Earth);
-            anchor: what the text guidance runs on, ``adapters``, ``backbone`` or ``reference``
+            anchor: what the text guidance runs on, ``adapters``, ``backbone``, ``reference`` or ``edit``
             (:mod:`simdiff.diffusion.guidance`);
             anchor_alpha: the backbone or reference anchor's adapter strength (0: the backbone alone);
             anchor_t_max: that anchor only at timesteps ≤ this, the adapters anchor above (None: every step);
+            edit_t: with the ``edit`` anchor, its last timestep at Earth (None: its default);
+            eta: the DDIM sampler's η in [0, 1] (0: deterministic, the default; 1: about DDPM's noise);
             env_guidance_fallback: s_e for the prompt samples that float or glide at ``env_guidance`` (re-sampled;
             None: off). The test split is generated at Earth without wind, where any s_e gives the same motion.
             ballistic: strength in [0, 1] of the generator's ballistic flight (:mod:`simdiff.motion.ballistic`; 0: off),
@@ -118,6 +120,8 @@ class CheckConfig:
     env_guidance_fallback: float | None = None
     anchor_alpha: float = 0.0
     anchor_t_max: int | None = None
+    edit_t: int | None = None
+    eta: float = 0.0
     ballistic: float = 0.0
     more_evaluators: list[str] = field(default_factory=list)
     device: str = "cpu"
@@ -142,18 +146,22 @@ class CheckConfig:
                 raise SimdiffError(f"{name} must be at least {low}, got {value}")
         if not 0.0 <= self.foot_lock <= 1.0:
             raise SimdiffError(f"--foot-lock must be in [0, 1], got {self.foot_lock}")
+        if not 0.0 <= self.eta <= 1.0:
+            raise SimdiffError(f"--eta must be in [0, 1], got {self.eta}")
         if not 0.0 <= self.ballistic <= 1.0:
             raise SimdiffError(f"--ballistic must be in [0, 1], got {self.ballistic}")
         if not 0.0 <= self.env_guidance < float("inf"):
             raise SimdiffError(f"--env-guidance must be a finite number ≥ 0, got {self.env_guidance}")
         if self.env_guidance_fallback is not None and not 0.0 <= self.env_guidance_fallback < float("inf"):
             raise SimdiffError(f"--env-guidance-fallback must be a finite number ≥ 0, got {self.env_guidance_fallback}")
-        from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha, check_anchor_t_max
+        from simdiff.diffusion.guidance import ANCHORS, check_anchor_alpha, check_anchor_t_max, check_edit_t
 
         if self.anchor not in ANCHORS:
             raise SimdiffError(f"--anchor must be one of {', '.join(ANCHORS)}, got {self.anchor!r}")
         self.anchor_alpha = check_anchor_alpha(self.anchor_alpha, self.anchor)
         self.anchor_t_max = check_anchor_t_max(self.anchor_t_max, self.anchor)
+        if self.edit_t is not None:
+            self.edit_t = check_edit_t(self.edit_t, self.anchor)
         if self.prompts.length > 196:
             raise SimdiffError(f"--length must be at most 196 frames, got {self.prompts.length}")
         model, corpus, evaluator = Path(self.model), Path(self.corpus), Path(self.evaluator)

@@ -230,6 +230,8 @@ def markdown(report: dict[str, Any]) -> str:
              + (f"; guidance anchor {c['anchor']}" if c.get("anchor", "adapters") != "adapters" else "")
              + (f" at α {c['anchor_alpha']}" if c.get("anchor_alpha") else "")
              + (f" at t ≤ {c['anchor_t_max']}" if c.get("anchor_t_max") is not None else "")
+             + (f", φ from t ≤ {c['edit_t']}" if c.get("edit_t") is not None else "")
+             + (f"; DDIM η {c['eta']}" if c.get("eta") else "")
              + (f"; ballistic flight {c['ballistic']}" if c.get("ballistic") else "")
              + ("; **quick preset (smoke run, not a claim)**" if c["quick"] else "") + ".",
              f"Command: `{p['command']}`; commit {p['git_commit']}{' (dirty tree)' if p['git_dirty'] else ''}; "

@@ -146,6 +146,8 @@ class ModelCheck:
                 "alpha": c.alpha, "device": c.device, **lock, **({"anchor": c.anchor} if c.anchor != "adapters" else {}),
                 **({"anchor_alpha": c.anchor_alpha} if c.anchor_alpha else {}),
                 **({"anchor_t_max": c.anchor_t_max} if c.anchor_t_max is not None else {}),
+                **({"edit_t": c.edit_t} if c.edit_t is not None else {}),
+                **({"eta": c.eta} if c.eta else {}),
                 **({"ballistic": c.ballistic} if c.ballistic else {})}
 
     def part(self, name: str, inputs: dict[str, Any], measure: Callable[[], dict[str, Any]]) -> dict[str, Any]:
@@ -180,7 +182,7 @@ class ModelCheck:
                                                  foot_lock=c.foot_lock, env_guidance=c.env_guidance, anchor=c.anchor,
                                                  env_guidance_fallback=c.env_guidance_fallback,
                                                  anchor_alpha=c.anchor_alpha, anchor_t_max=c.anchor_t_max,
-                                                 ballistic=c.ballistic)
+                                                 ballistic=c.ballistic, edit_t=c.edit_t, eta=c.eta)
         return self._sets[key][0]
 
     def fell_back(self, name: str, phis: Sequence[Sequence[float]]) -> dict[str, Any]:
@@ -213,7 +215,7 @@ class ModelCheck:
             fn = generator_fn(self.generator, env=None if env is None else list(env), alpha=c.alpha, sampler="ddim",
                               steps=c.steps, guidance=c.guidance, foot_lock=c.foot_lock,
                               env_guidance=c.env_guidance, anchor=c.anchor, anchor_alpha=c.anchor_alpha,
-                              anchor_t_max=c.anchor_t_max, ballistic=c.ballistic)
+                              anchor_t_max=c.anchor_t_max, ballistic=c.ballistic, edit_t=c.edit_t, eta=c.eta)
             if c.more_evaluators:
                 fn = _memoised(fn)
             result = score(c.evaluator, dataset, fn)

@@ -44,12 +44,15 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
                        env_guidance: float = 1.0, anchor: str = "adapters",
                        env_guidance_fallback: float | None = None,
                        anchor_alpha: float = 0.0, anchor_t_max: int | None = None,
-                       ballistic: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                       ballistic: float = 0.0, edit_t: int | None = None,
+                       eta: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Generate every batch; returns joints (N, length, 22, 3) float32 (metres, Y-up, 20 fps) and (N,) bool: the
     samples re-sampled at ``env_guidance_fallback`` (the generator's ``Generation.fell_back``; all False without one).
 
     ``env`` is φ = (g_z, w_x, w_y) for a continuous SimDiff model, None for a backbone (``env_guidance`` then
-    and ``anchor`` must stay at their defaults). ``ballistic``: the generator's ballistic flight strength (0: off).
+    and ``anchor`` must stay at their defaults). ``ballistic``: the generator's ballistic flight strength (0: off);
+    ``edit_t``: the edit anchor's last timestep at Earth (None: its default); ``eta``: the DDIM sampler's η (0:
+    deterministic).
     """
     from tqdm import tqdm
 
@@ -57,7 +60,10 @@ def generate_set_flags(generator: Any, batches: Sequence[PromptBatch], length: i
     from simdiff.motion.features import features_to_joints
 
     kwargs: dict[str, Any] = {"env": list(env), "alpha": alpha} if env is not None else {}
-    kwargs.update(guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, env_guidance_fallback, ballistic))
+    kwargs.update(guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, env_guidance_fallback, ballistic,
+                                  edit_t))
+    if eta:
+        kwargs["eta"] = eta
     out, flags = [], []
     for b in tqdm(batches, desc="prompts", disable=not progress, dynamic_ncols=True, leave=False):
         gen = generator.generate([b.prompt] * b.count, length, sampler="ddim", steps=steps, guidance=guidance,
