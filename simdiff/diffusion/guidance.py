@@ -62,13 +62,19 @@ DEFAULT_EDIT_T: int = 800
 the one with the larger answer to low gravity; neither passed that screen)."""
 
 
+def _whole_timestep(name: str, value: int | float) -> int:
+    """``value`` as an int in [0, 999], else a one-line :class:`SimdiffError` naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) or not 0 <= value <= 999:
+        raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value}")
+    return int(value)
+
+
 def check_anchor_t_max(value: int | None, anchor: str) -> int | None:
     """``value`` as an int in [0, 999] that ``anchor`` can use (None: every step, any anchor), else one
     :class:`SimdiffError` line naming it."""
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) or not 0 <= value <= 999:
-        raise SimdiffError(f"anchor t max must be a whole timestep in 0..999, got {value}")
+    value = _whole_timestep("anchor t max", value)
     if anchor not in T_MAX_ANCHORS:
         raise SimdiffError(f"anchor t max {int(value)} needs the backbone or reference anchor (--anchor backbone or "
                            f"reference), not {anchor!r}")
@@ -80,8 +86,7 @@ def check_edit_t(value: int | None, anchor: str) -> int | None:
     the other anchors, which take none (a value given with them is one :class:`SimdiffError` line naming it)."""
     if value is None:
         return DEFAULT_EDIT_T if anchor == "edit" else None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value) or not 0 <= value <= 999:
-        raise SimdiffError(f"edit t must be a whole timestep in 0..999, got {value}")
+    value = _whole_timestep("edit t", value)
     if anchor != "edit":
         raise SimdiffError(f"edit t {int(value)} needs the edit anchor (--anchor edit), not {anchor!r}")
     return int(value)

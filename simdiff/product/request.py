@@ -249,14 +249,20 @@ def check_anchor_alpha(name: str, value: object, anchor: str) -> float:
     return number
 
 
+def whole_timestep(name: str, value: object) -> int:
+    """``value`` as an int in [0, 999], else a one-line error naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
+            or not 0 <= value <= 999:
+        raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value!r}")
+    return int(value)
+
+
 def check_anchor_t_max(name: str, value: object, anchor: str | None = None) -> int | None:
     """``value`` as a whole timestep in [0, 999] (None passes), usable with ``anchor`` unless that is None (the
     ``backbone`` or ``reference`` anchor); one-line errors naming ``name``."""
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
-            or not 0 <= value <= 999:
-        raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value!r}")
+    value = whole_timestep(name, value)
     if anchor is not None and anchor not in T_MAX_ANCHORS:
         raise SimdiffError(f"{name} {int(value)} needs the backbone or reference anchor (--anchor backbone or "
                            f"reference), not {anchor!r}")
@@ -268,9 +274,7 @@ def check_edit_t(name: str, value: object, anchor: str | None = None) -> int | N
     ``edit`` anchor); one-line errors naming ``name``."""
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
-            or not 0 <= value <= 999:
-        raise SimdiffError(f"{name} must be a whole timestep in 0..999, got {value!r}")
+    value = whole_timestep(name, value)
     if anchor is not None and anchor != "edit":
         raise SimdiffError(f"{name} {int(value)} needs the edit anchor (--anchor edit), not {anchor!r}")
     return int(value)
