@@ -465,3 +465,40 @@ def test_generate_edit_anchor_from_the_option_or_sampling_json(tmp_path: Path, c
     assert main([*argv, "--anchor", "edit", "--edit-t", "1000", "--out", str(tmp_path / "bad2")]) == 2
     err = capsys.readouterr().err
     assert "--edit-t must be a whole timestep in 0..999, got 1000" in err and err.count("\n") == 1
+
+
+def test_generate_eta_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
+    from simdiff.serve.testing import write_tiny_model
+
+    model = write_tiny_model(tmp_path / "eta")
+    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "3", "--model", str(model), "--threads", "1",
+            "--format", "npy", "--no-video", "-q"]
+
+    def run(name: str, *extra: str) -> np.ndarray:
+        assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
+        return np.load(tmp_path / name / "sample0_features.npy")
+
+    def meta(name: str) -> dict:
+        return json.loads((tmp_path / name / "generation.json").read_text())
+
+    plain, zero, noisy = run("plain"), run("zero", "--eta", "0"), run("noisy", "--eta", "1")
+    assert np.array_equal(plain, zero) and meta("plain")["eta"] == 0.0
+    assert not np.allclose(noisy, plain, atol=1e-4) and meta("noisy")["eta"] == 1.0
+    assert np.array_equal(run("again", "--eta", "1"), noisy)  # fresh noise, drawn from the seed
+    (model / "sampling.json").write_text('{"eta": 1.0}')
+    assert np.array_equal(run("stored"), noisy) and meta("stored")["eta"] == 1.0
+    assert np.array_equal(run("told", "--eta", "0"), plain)  # the option wins
+    assert main([*argv, "--sampler", "ddpm", "--out", str(tmp_path / "ddpm")]) == 0
+    assert meta("ddpm")["eta"] is None  # the stored η belongs to DDIM
+    (model / "sampling.json").unlink()
+    for extra, message in ((("--eta", "1.5"), "--eta must be in [0, 1], got 1.5"),
+                           (("--eta", "nan"), "--eta must be a finite number"),
+                           (("--eta", "0.5", "--sampler", "ddpm"), "--eta 0.5 is DDIM's noise scale; it needs "
+                                                                  "--sampler ddim, not 'ddpm'")):
+        assert main([*argv, *extra, "--out", str(tmp_path / "bad")]) == 2
+        err = capsys.readouterr().err
+        assert message in err and err.count("\n") == 1, err
+    (model / "sampling.json").write_text('{"eta": 2}')
+    assert main([*argv, "--out", str(tmp_path / "bad_stored")]) == 2
+    err = capsys.readouterr().err
+    assert "eta must be in [0, 1], got 2" in err and err.count("\n") == 1, err

@@ -421,6 +421,24 @@ def test_generate_edit_t_from_sampling_json_or_the_request(server, model_dir):
         assert status == 400 and message in out["error"], out
 
 
+def test_generate_eta_from_sampling_json_or_the_request(server, model_dir):
+    moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5, "gravity": -1.6}
+    status, plain, _ = call(server, "/api/generate", moon)
+    assert status == 200 and plain["meta"]["params"]["eta"] == 0.0
+    status, noisy, _ = call(server, "/api/generate", {**moon, "eta": 1.0})
+    assert status == 200 and noisy["meta"]["params"]["eta"] == 1.0 and noisy["joints"] != plain["joints"]
+    (model_dir / "sampling.json").write_text('{"eta": 1.0}')
+    try:
+        status, stored, _ = call(server, "/api/generate", moon)
+        assert status == 200 and stored["joints"] == noisy["joints"]
+        assert call(server, "/api/generate", {**moon, "eta": 0})[1]["joints"] == plain["joints"]  # the request wins
+    finally:
+        (model_dir / "sampling.json").unlink()
+    for bad, message in ((1.5, "eta must be in [0, 1], got 1.5"), ("x", "eta must be a finite number")):
+        status, out, _ = call(server, "/api/generate", {**moon, "eta": bad})
+        assert status == 400 and message in out["error"], out
+
+
 def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):
     earth = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5}
     status, plain, _ = call(server, "/api/generate", earth)

@@ -71,7 +71,7 @@ SAMPLING_NAME = "sampling.json"
 SAMPLING_KEYS: dict[str, type] = {"alpha": float, "guidance": float, "steps": int, "sampler": str, "foot_lock": float,
                                   "env_guidance": float, "env_guidance_fallback": float, "anchor": str,
                                   "anchor_alpha": float, "anchor_t_max": int, "edit_t": int,
-                                  "ballistic": float}
+                                  "ballistic": float, "eta": float}
 
 
 def sampling_defaults(model: str | os.PathLike[str] | None = None) -> dict[str, float | int | str]:
@@ -81,9 +81,8 @@ def sampling_defaults(model: str | os.PathLike[str] | None = None) -> dict[str, 
     ``sampler``, ``foot_lock`` (:mod:`simdiff.motion.foot_lock`'s strength), ``env_guidance``
     (:mod:`simdiff.diffusion.guidance`'s s_e), ``env_guidance_fallback`` (the s_e for samples that float or glide),
     ``anchor`` (its text-guidance anchor), ``anchor_alpha`` (the backbone or reference anchor's adapter strength) and
-    ``anchor_t_max`` (that anchor only at timesteps ≤ it), ``edit_t`` (the edit anchor's last timestep at Earth) and
-    ``ballistic`` (:mod:`simdiff.motion.ballistic`'s
-    strength), e.g.
+    ``anchor_t_max`` (that anchor only at timesteps ≤ it), ``edit_t`` (the edit anchor's last timestep at Earth),
+    ``ballistic`` (:mod:`simdiff.motion.ballistic`'s strength) and ``eta`` (DDIM's η in [0, 1]), e.g.
     ``{"alpha": 0.8}``;
     values the user gives on the command line win.
 

@@ -122,6 +122,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
                 out = generator.generate(
                     [request.text], request.frames, env=None if env is None else env.as_tuple(),
                     alpha=request.alpha, sampler=request.sampler, steps=request.steps, guidance=request.guidance,
+                    **({"eta": request.eta} if request.eta else {}),
                     seed=request.seed + k, text_embeddings=text, progress=progress, foot_lock=request.foot_lock,
                     **({"env_guidance": request.env_guidance} if request.env_guidance != 1.0 else {}),
                     **({"env_guidance_fallback": request.env_guidance_fallback}
@@ -257,6 +258,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "num_samples": request.num_samples,
         "sampler": request.sampler,
         "steps": request.steps,
+        "eta": request.eta if request.sampler == "ddim" else None,
         "guidance": request.guidance,
         "alpha": request.alpha if simdiff_model else None,
         "alpha_source": alpha_source if simdiff_model else None,

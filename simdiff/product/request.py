@@ -42,6 +42,7 @@ class GenerationRequest:
         num_samples: samples per environment.
         sampler: ``ddim`` or ``ddpm``.
         steps: diffusion steps.
+        eta: DDIM's η in [0, 1] (0: deterministic; 1: fresh noise at every step, as DDPM); 0 with DDPM.
         guidance: classifier-free guidance scale (1 = off).
         alpha: adapter strength α (0 = backbone only).
         foot_lock: foot-lock strength in [0, 1] (0: off; :mod:`simdiff.motion.foot_lock`).
@@ -70,6 +71,7 @@ class GenerationRequest:
     num_samples: int = 1
     sampler: str = "ddim"
     steps: int = 50
+    eta: float = 0.0
     guidance: float = 2.5
     alpha: float = 1.0
     foot_lock: float = 0.0
@@ -232,6 +234,22 @@ T_MAX_ANCHORS: tuple[str, ...] = ("backbone", "reference")
 """The anchors that take ``--anchor-t-max`` (:data:`simdiff.diffusion.guidance.T_MAX_ANCHORS`)."""
 
 
+def check_eta(name: str, value: object, sampler: str) -> float:
+    """``value`` as a float in [0, 1], and 0 unless ``sampler`` is ``ddim`` (one-line errors naming ``name``)."""
+    number = check_unit(name, value)
+    if number and sampler != "ddim":
+        raise SimdiffError(f"{name} {number:g} is DDIM's noise scale; it needs --sampler ddim, not {sampler!r}")
+    return number
+
+
+def stored_eta(stored: dict[str, float | int | str], sampler: str) -> float:
+    """A model's stored ``eta`` when ``sampler`` is its stored sampler (the value belongs to DDIM), else 0; checked
+    as the option is."""
+    if sampler != stored.get("sampler", "ddim"):
+        return 0.0
+    return check_eta("eta", stored.get("eta", 0.0), sampler)
+
+
 def check_anchor(name: str, value: object) -> str:
     """``value`` if it is one of :data:`ANCHORS`, else a one-line error naming ``name``."""
     if value not in ANCHORS:
@@ -311,12 +329,13 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     Args:
         stored: any of ``sampler``, ``steps``, ``guidance``, ``alpha``, ``foot_lock``, ``env_guidance``,
             ``env_guidance_fallback``,
-            ``anchor``, ``anchor_alpha``, ``anchor_t_max``, ``edit_t``, ``ballistic`` (see
+            ``anchor``, ``anchor_alpha``, ``anchor_t_max``, ``edit_t``, ``ballistic``, ``eta`` (see
             :func:`simdiff.model.default.sampling_defaults`).
         given: option names the user set explicitly (``sampler``, ``steps``, ``guidance``, ``alpha``,
             ``foot_lock``, ``env_guidance``, ``env_guidance_fallback``, ``anchor``, ``anchor_alpha``,
-            ``anchor_t_max``, ``edit_t``, ``ballistic``). A stored ``anchor_alpha``, ``anchor_t_max`` or ``edit_t`` belongs
-            to the stored anchor: it is dropped when the user picks another anchor.
+            ``anchor_t_max``, ``edit_t``, ``ballistic``, ``eta``). A stored ``anchor_alpha``, ``anchor_t_max`` or
+            ``edit_t`` belongs to the stored anchor, a stored ``eta`` to the stored sampler: it is dropped when the user
+            picks another anchor (sampler).
     """
     sampler = request.sampler if "sampler" in given else str(stored.get("sampler", request.sampler))
     if "steps" in given:
@@ -331,11 +350,13 @@ def with_model_defaults(request: GenerationRequest, stored: dict[str, float | in
     anchor_t_max = (check_anchor_t_max("--anchor-t-max", request.anchor_t_max, anchor) if "anchor_t_max" in given
                     else stored_anchor_t_max(stored, anchor))
     edit_t = (check_edit_t("--edit-t", request.edit_t, anchor) if "edit_t" in given else stored_edit_t(stored, anchor))
+    eta = check_eta("--eta", request.eta, sampler) if "eta" in given else stored_eta(stored, sampler)
     fallback = request.env_guidance_fallback
     if "env_guidance_fallback" not in given and stored.get("env_guidance_fallback") is not None:
         fallback = check_finite("env_guidance_fallback", stored["env_guidance_fallback"], 0.0)
     return replace(
-        request, sampler=sampler, steps=steps, anchor=anchor, anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max,
+        request, sampler=sampler, steps=steps, eta=eta, anchor=anchor, anchor_alpha=anchor_alpha,
+        anchor_t_max=anchor_t_max,
         edit_t=edit_t, env_guidance_fallback=fallback,
         **{name: getattr(request, name) if name in given else stored_setting(stored, name, getattr(request, name))
            for name in STORED_NUMBERS},
@@ -366,7 +387,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                   foot_lock: float = 0.0, env_guidance: float = 1.0, anchor: str = "adapters",
                   env_guidance_fallback: float | None = None, anchor_alpha: float = 0.0,
                   anchor_t_max: int | None = None, ballistic: float = 0.0, compare: str | None = None,
-                  edit_t: int | None = None,
+                  edit_t: int | None = None, eta: float = 0.0,
                   formats: str | None = None,
                   no_video: bool = False, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
@@ -385,6 +406,7 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         num_samples=int(num_samples),
         sampler=sampler,
         steps=steps_for(sampler, steps),
+        eta=check_eta("--eta", eta, sampler),
         guidance=check_finite("--guidance", guidance, 0.0),
         alpha=check_finite("--alpha", alpha),
         foot_lock=check_unit("--foot-lock", foot_lock),

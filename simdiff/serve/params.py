@@ -63,6 +63,8 @@ class GenerateParams:
             the anchor is the stored one (the sampler's default otherwise).
         ballistic: ballistic-flight strength in [0, 1] (:mod:`simdiff.motion.ballistic`), or None for the model's
             ``sampling.json`` value (0, off, without one).
+        eta: DDIM's η in [0, 1] (0 deterministic, 1 fresh noise at every step), or None for the model's
+            ``sampling.json`` value (0 without one).
     """
 
     text: str
@@ -83,6 +85,7 @@ class GenerateParams:
     anchor_t_max: int | None = None
     edit_t: int | None = None
     ballistic: float | None = None
+    eta: float | None = None
 
     @property
     def frames(self) -> int:
@@ -132,7 +135,7 @@ def parse_generate(body: Any) -> GenerateParams:
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, alpha, seconds, seed, steps, guidance,
             simulate, foot_lock, env_guidance, anchor, env_guidance_fallback, anchor_alpha, anchor_t_max,
-            edit_t, ballistic}``;
+            edit_t, ballistic, eta}``;
             everything but ``text`` is optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -197,8 +200,12 @@ def parse_generate(body: Any) -> GenerateParams:
     if ballistic is not None:
         ballistic = _number(body, "ballistic", 0.0)
         _check_range("ballistic", ballistic, 0.0, 1.0)
+    eta = body.get("eta")
+    if eta is not None:
+        eta = _number(body, "eta", 0.0)
+        _check_range("eta", eta, 0.0, 1.0)
     return GenerateParams(text=text, gravity=gravity, alpha=alpha, seconds=seconds, seed=seed, steps=steps,
                           guidance=guidance, simulate=simulate, foot_lock=foot_lock, env_guidance=env_guidance,
                           anchor=anchor, env_guidance_fallback=fallback, anchor_alpha=anchor_alpha,
-                          anchor_t_max=anchor_t_max, edit_t=edit_t, ballistic=ballistic,
+                          anchor_t_max=anchor_t_max, edit_t=edit_t, ballistic=ballistic, eta=eta,
                           **wind)

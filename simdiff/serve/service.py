@@ -146,11 +146,12 @@ class MotionService:
 
     def _resolved(self, params: GenerateParams, strict: bool) -> GenerateParams:
         """``params`` with the fields left None (α, foot lock, env guidance) taken from the model's ``sampling.json``,
-        as ``simdiff generate`` does (α 1, no foot lock and no env guidance without one). A bad file is the model's error when
+        as ``simdiff generate`` does (α 1, no foot lock, no env guidance and η 0 without one). A bad file is the model's error when
         ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
         from simdiff.product.request import (check_anchor, check_anchor_alpha, check_anchor_t_max, check_edit_t,
-                                             stored_anchor_alpha, stored_anchor_t_max, stored_edit_t, stored_setting)
+                                             stored_anchor_alpha, stored_anchor_t_max, stored_edit_t, stored_eta,
+                                             stored_setting)
 
         try:
             stored = sampling_defaults(self.model_dir)
@@ -165,6 +166,7 @@ class MotionService:
             t_max = stored_anchor_t_max(stored, anchor) if params.anchor_t_max is None else None
             edit_t = stored_edit_t(stored, anchor) if params.edit_t is None else None
             ballistic = params.ballistic if params.ballistic is not None else stored_setting(stored, "ballistic", 0.0)
+            eta = params.eta if params.eta is not None else stored_eta(stored, "ddim")  # the viewer samples with DDIM
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
@@ -174,6 +176,7 @@ class MotionService:
             fallback = params.env_guidance_fallback
             anchor_alpha, t_max, edit_t = 0.0, None, None
             ballistic = params.ballistic or 0.0
+            eta = params.eta or 0.0
         # the request's own values against the anchor: its error (400), not the model's
         if params.anchor_alpha is not None:
             anchor_alpha = check_anchor_alpha("anchor_alpha", params.anchor_alpha, anchor)
@@ -183,7 +186,7 @@ class MotionService:
             edit_t = check_edit_t("edit_t", params.edit_t, anchor)
         return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor,
                        env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha), anchor_t_max=t_max,
-                       edit_t=edit_t, ballistic=float(ballistic))
+                       edit_t=edit_t, ballistic=float(ballistic), eta=float(eta))
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
@@ -257,6 +260,7 @@ class MotionService:
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
                                      alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
                                      guidance=params.guidance, seed=params.seed, progress=self._progress,
+                                     eta=params.eta or 0.0,
                                      foot_lock=params.foot_lock, ballistic=params.ballistic or 0.0,
                                      **({"env_guidance": params.env_guidance, "anchor": params.anchor,
                                          "env_guidance_fallback": params.env_guidance_fallback,

@@ -72,6 +72,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--num-samples", type=int, default=1, metavar="K", help="samples to generate (default 1)")
     smp.add_argument("--sampler", choices=["ddim", "ddpm"], help="diffusion sampler (default ddim)")
     smp.add_argument("--steps", type=int, metavar="N", help="diffusion steps (default 50 for ddim, 1000 for ddpm)")
+    smp.add_argument("--eta", type=float, metavar="E",
+                     help="DDIM's noise scale in [0, 1]: 0 deterministic, 1 fresh noise at every step (default 0, or "
+                          "the model's sampling.json)")
     smp.add_argument("--guidance", type=float, metavar="W", help="classifier-free guidance scale, 1 = off (default 2.5)")
     smp.add_argument("--alpha", type=float, metavar="A",
                      help="strength of the environment adapters, 0 = ignore φ (default 1, or the model's sampling.json)")
@@ -149,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
         env_guidance=1.0 if args.env_guidance is None else args.env_guidance, anchor=args.anchor or "adapters",
         env_guidance_fallback=args.env_guidance_fallback,
         anchor_alpha=0.0 if args.anchor_alpha is None else args.anchor_alpha,
-        anchor_t_max=args.anchor_t_max, edit_t=args.edit_t,
+        anchor_t_max=args.anchor_t_max, edit_t=args.edit_t, eta=0.0 if args.eta is None else args.eta,
         ballistic=0.0 if args.ballistic is None else args.ballistic,
         compare=args.compare, formats=args.format,
         no_video=args.no_video, force=args.force,
@@ -184,7 +187,7 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
     read_recipe(folder)  # likewise extrapolation.json
     given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance",
                                "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max", "edit_t",
-                               "ballistic")
+                               "ballistic", "eta")
              if getattr(args, name) is not None}
     request = with_model_defaults(request, stored, given)
     alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")
