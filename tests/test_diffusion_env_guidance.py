@@ -282,19 +282,35 @@ def test_edit_anchor_follows_earth_above_edit_t_then_the_adapters_at_phi(env_sca
     edit = GuidedDenoiser(sd, 2.5, env_scale=env_scale, anchor="edit", anchor_alpha=0.25, edit_t=600)
     at_ref = GuidedDenoiser(sd, 2.5)  # the reference anchor's text guidance, used at φ_ref and α a
     adapters = GuidedDenoiser(sd, 2.5, env_scale=env_scale)
+    reference = GuidedDenoiser(sd, 2.5, env_scale=env_scale, anchor="reference", anchor_alpha=0.25)
     with torch.no_grad():
         for step in (999, 601):
             t = torch.full((3,), step)
-            assert torch.equal(edit(x, t, c), at_ref(x, t, earth(with_env(c, ENVS, alpha=0.25)))), step
+            out, base = edit(x, t, c), at_ref(x, t, earth(with_env(c, ENVS, alpha=0.25)))
+            assert torch.allclose(out[:2], base[:2], atol=1e-5), step  # low g above edit t: at Earth
+            assert torch.allclose(out[2], reference(x, t, c)[2], atol=1e-5), step  # wind alone: the reference anchor
+            assert (out[2] - base[2]).abs().max() > 1e-3
         for step in (600, 20):
             t = torch.full((3,), step)
             out, base, phi = edit(x, t, c), at_ref(x, t, earth(with_env(c, ENVS, alpha=0.25))), adapters(x, t, c)
             assert torch.allclose(out[1], base[1], atol=1e-5), step  # the Earth row stays on the reference anchor
-            assert torch.allclose(out[[0, 2]], phi[[0, 2]], atol=1e-5), step  # the others: the adapters anchor at φ
+            assert torch.allclose(out[0], phi[0], atol=1e-5), step  # gravity off Earth's: the adapters anchor at φ
+            assert torch.allclose(out[2], reference(x, t, c)[2], atol=1e-5), step
             assert (out[0] - base[0]).abs().max() > 1e-3
 
 
-def test_edit_anchor_costs_one_2b_forward_per_step() -> None:
+def test_edit_anchor_edits_a_row_with_both_gravity_and_wind() -> None:
+    sd = simdiff_net()
+    both = torch.tensor([[-1.6, 0.0, 10.0], [-9.81, 0.0, -10.0], [-9.81, 0.0, 0.0]])
+    c = with_env(cond(), both)
+    x, t = torch.randn(3, 8, 263, generator=torch.Generator().manual_seed(7)), torch.full((3,), 100)
+    with torch.no_grad():
+        out = GuidedDenoiser(sd, 2.5, anchor="edit", edit_t=500)(x, t, c)
+        assert torch.allclose(out[0], GuidedDenoiser(sd, 2.5)(x, t, c)[0], atol=1e-5)
+        assert torch.allclose(out[1:], GuidedDenoiser(sd, 2.5, anchor="reference")(x, t, c)[1:], atol=1e-5)
+
+
+def test_edit_anchor_costs_one_2b_forward_per_step_and_the_wind_rows_reference_pass() -> None:
     sd, sizes = simdiff_net(), []
 
     def counting(x: torch.Tensor, t: torch.Tensor, c: Condition) -> torch.Tensor:
@@ -305,7 +321,9 @@ def test_edit_anchor_costs_one_2b_forward_per_step() -> None:
     with torch.no_grad():
         GuidedDenoiser(counting, 2.5, anchor="edit", edit_t=500)(x, torch.full((3,), 900), cond())
         GuidedDenoiser(counting, 2.5, anchor="edit", edit_t=500)(x, torch.full((3,), 300), cond())
-    assert sizes == [6, 2, 4]  # early: one batch at φ_ref; late: the Earth row and the two rows off it
+    # early: one batch at φ_ref and the wind row's φ / φ_ref pair; late: the same over the Earth and wind rows, then the
+    # low-g row at its φ
+    assert sizes == [6, 4, 4, 4, 2]
 
 
 def test_edit_t_is_checked_in_one_line() -> None:

@@ -17,12 +17,15 @@
   exactly the adapters anchor at α = a; elsewhere the change of φ moves the motion exactly as far as the adapters
   anchor at α would, text guidance included (session 55: the backbone anchor's push, outside the text guidance,
   cost text fidelity under low gravity). Costs one 2B forward plus one 4K forward over the K rows off φ_ref.
-* ``"edit"``: every row follows the reference anchor at φ_ref (``anchor_alpha`` a: exactly the backbone at a = 0) at
-  the steps whose timestep is above ``edit_t`` T_e; at and below T_e the rows off φ_ref run the adapters anchor at their
-  φ (x̃₀ = G_α(c, φ), environment guidance included). A sample off Earth is then its Earth sample of the same noise
+* ``"edit"``: the rows whose gravity is off φ_ref's follow the reference anchor at φ_ref (``anchor_alpha`` a: exactly
+  the backbone at a = 0) at the steps whose timestep is above ``edit_t`` T_e, and run the adapters anchor at their φ at
+  and below it (x̃₀ = G_α(c, φ), environment guidance included). Such a sample is its Earth sample of the same noise
   until T_e, re-played under φ from there: what adapters trained on crossed twins (``TrainConfig.cross_twins``: the
-  other twin's x_t, one's own target) learn to do. Earth rows are exactly the reference anchor's. Costs one 2B forward
-  per step (plus one K forward over the K rows off φ_ref at T_e and below when s_e ≠ 1).
+  other twin's x_t, one's own target) learn to do. Every other row is exactly the reference anchor's: Earth's, and
+  under Earth's gravity with wind the reference anchor's answer to the wind at every step (since session 71: the
+  adapters anchor alone at α 1 pushed session 70's walks 1–2 m towards −y whatever the wind, while the reference
+  anchor's answer to wind cancels what the adapters do at φ_ref). Costs one 2B forward per step, plus one 4W forward
+  over the W wind-only rows, plus one K forward over the K edited rows at T_e and below when s_e ≠ 1.
 * ``anchor_t_max`` T: the backbone or reference anchor runs only at the steps whose timestep is ≤ T, the adapters
   anchor at the earlier ones (session 55: what the text asks for is settled by the early, noisy steps, the adapters'
   answer to Earth, a matter of detail, by the late ones).
@@ -199,26 +202,31 @@ class GuidedDenoiser:
         return guided
 
     def _edit_anchor(self, x: Tensor, timesteps: Tensor, cond: Condition) -> Tensor:
-        """G_a(c, φ_ref) for every row above ``edit_t`` and for the rows at φ_ref; the adapters anchor's x̃₀ at φ for
-        the others at and below it (see the module)."""
-        rows, ref = self._plan(cond, "edit")
+        """The reference anchor (its answer to φ at α) for every row but those whose gravity is off φ_ref's at and
+        below ``edit_t``: the adapters anchor's x̃₀ at φ there (see the module)."""
+        rows, _ = self._plan(cond, "edit")
         assert cond.env is not None  # _plan checked it
         assert self.edit_t is not None
         phi = torch.tensor(self.reference_env, dtype=cond.env.dtype, device=cond.env.device)
-        at_ref = replace(cond, alpha=self.anchor_alpha, env=phi.expand_as(cond.env).clone())
-        if rows is None or ref is None or int(timesteps.max()) > self.edit_t:
-            return self._text_guided(x, timesteps, at_ref)[1]
-        earth = torch.ones(x.shape[0], dtype=torch.bool, device=x.device)
-        earth[rows] = False
+        edited = cond.env[:, 0] != phi[0]
+        if rows is None or int(timesteps.max()) > self.edit_t:
+            edited = torch.zeros_like(edited)
+        keep = (~edited).nonzero().flatten()
         guided = torch.empty_like(x)
-        if bool(earth.any()):
-            keep = earth.nonzero().flatten()
-            guided[keep] = self._text_guided(x[keep], timesteps[keep], at_ref.select(keep))[1]
-        xr, tr = x[rows], timesteps[rows]
-        cond_out, g = self._text_guided(xr, tr, cond.select(rows))
-        if self.env_scale != 1.0:
-            g = g + (self.env_scale - 1.0) * (cond_out - self.denoiser(xr, tr, ref))
-        guided[rows] = g
+        if keep.numel():  # Earth and wind alone: the reference anchor, its answer to the wind included
+            sub = cond.select(keep)
+            wind = (sub.env != phi).any(dim=-1) & (sub.env[:, 0] == phi[0])  # type: ignore[index]
+            w = wind.nonzero().flatten()
+            w_ref = replace(sub.select(w), env=phi.expand(len(w), 3).clone()) if w.numel() else None
+            guided[keep] = self._reference_anchor(x[keep], timesteps[keep], sub, w if w.numel() else None, w_ref)
+        if bool(edited.any()):
+            e = edited.nonzero().flatten()
+            xr, tr, ce = x[e], timesteps[e], cond.select(e)
+            cond_out, g = self._text_guided(xr, tr, ce)
+            if self.env_scale != 1.0:
+                at_ref = replace(ce, env=phi.expand(len(e), 3).clone())
+                g = g + (self.env_scale - 1.0) * (cond_out - self.denoiser(xr, tr, at_ref))
+            guided[e] = g
         return guided
 
     def _plan(self, cond: Condition, anchor: str) -> tuple[Tensor | None, Condition | None]:
