@@ -146,8 +146,8 @@ class MotionService:
 
     def _resolved(self, params: GenerateParams, strict: bool) -> GenerateParams:
         """``params`` with the fields left None (α, foot lock, env guidance) taken from the model's ``sampling.json``,
-        as ``simdiff generate`` does (α 1, no foot lock, no env guidance and η 0 without one). A bad file is the model's error when
-        ``strict``, else ignored (the page's defaults still load)."""
+        as ``simdiff generate`` does (α 1, no foot lock, no env guidance and η 0 without one). A bad file is the model's
+        error when ``strict``, else ignored (the page's defaults still load)."""
         from simdiff.model.default import sampling_defaults
         from simdiff.product.request import (check_anchor, check_anchor_alpha, check_anchor_t_max, check_edit_t,
                                              stored_anchor_alpha, stored_anchor_t_max, stored_edit_t, stored_eta,
