@@ -8,8 +8,9 @@ prompts x N samples under Earth and g -1.6; medians of the generated change of a
 (sampling.json, its anchor and anchor_alpha included since session 66, ballistic since 67; fallback not applied;
 --env-guidance overrides s_e), 120 frames, seeds S + prompt index.
 Ordinary motions under low gravity (--moon N, session 61): the two walk and two run prompts x N under Earth and g -1.6
-with the same noise; mean floating (mm, the model check's metric) at g -1.6 and at Earth, and the median ratio of root
-speeds (g -1.6 over Earth), seeds S + 200 + prompt index: a 1-minute screen for what stage C' (val captions at
+with the same noise; mean floating (mm, the model check's metric) at g -1.6 and at Earth, the median ratio of root
+speeds (g -1.6 over Earth) and (since session 71) the samples that glide at g -1.6 (the model check's rule), seeds S + 200
++ prompt index: a 1-minute screen for what stage C' (val captions at
 g -1.6) penalises."""
 from __future__ import annotations
 
@@ -27,7 +28,7 @@ from simdiff.eval.response import quantities
 from simdiff.model.generator import MotionGenerator
 from simdiff.motion.features import features_to_joints
 from simdiff.motion.flight import flight_stats
-from simdiff.motion.metrics import per_sample_physics_metrics
+from simdiff.motion.metrics import glides, per_sample_physics_metrics
 
 WINDS = [(-9.81, 10.0, 0.0), (-9.81, -10.0, 0.0), (-9.81, 0.0, 10.0), (-9.81, 0.0, -10.0)]
 
@@ -63,13 +64,14 @@ def probe(model: str, walks: int, jumps: int, seed: int, env_guidance: float | N
             apex.append(fa["apex_gain_m"] - fb["apex_gain_m"])
             flight.append(fa["flight_s"] - fb["flight_s"])
     floats: dict[str, list[float]] = {"moon": [], "earth": []}
-    ratio = []
+    ratio, glide = [], 0
     for i, p in enumerate((*SPEED_PROMPTS["walk"], *SPEED_PROMPTS["run"]) if moon_n else ()):
         earth = joints(gen, p, moon_n, seed + 200 + i, (-9.81, 0.0, 0.0), s)
         low = joints(gen, p, moon_n, seed + 200 + i, (-1.6, 0.0, 0.0), s)
         floats["earth"] += list(per_sample_physics_metrics(earth)["floating"])
         floats["moon"] += list(per_sample_physics_metrics(low)["floating"])
         ratio += [root_speed(a) / max(root_speed(b), 1e-6) for a, b in zip(low, earth)]
+        glide += int(glides(low).sum())  # session 71: rule 83's runs glided under g -1.6 past this screen
     res = {"model": model, "seconds": round(time.time() - t0),
            "wind": {k: {"downwind": int(sum(d > 0 for d in v)), "n": len(v), "median_m": float(np.median(v))}
                     for k, v in wind.items() if v}}
@@ -79,7 +81,8 @@ def probe(model: str, walks: int, jumps: int, seed: int, env_guidance: float | N
                           "rise_both": int(sum(a > 0 and f > 0 for a, f in zip(apex, flight)))}
     if ratio:
         res["moon"] = {"n": len(ratio), "floating_mm": float(np.mean(floats["moon"])),
-                       "earth_floating_mm": float(np.mean(floats["earth"])), "speed_ratio_median": float(np.median(ratio))}
+                       "earth_floating_mm": float(np.mean(floats["earth"])), "speed_ratio_median": float(np.median(ratio)),
+                       "glides_low_g": glide}
     return res
 
 
