@@ -63,8 +63,8 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--eta", type=float, default=0.0, metavar="ETA",
                    help="DDIM eta in [0, 1] (0: deterministic, the default; 1: fresh noise at every step)")
     p.add_argument("--edit-t", type=int, default=None, metavar="T",
-                   help="with --anchor edit: motions off Earth follow their Earth motion down to timestep T "
-                        "(default 800)")
+                   help="with --anchor edit: motions under another gravity follow their Earth motion down to "
+                        "timestep T (default 800)")
     p.add_argument("--ballistic", type=float, default=0.0, metavar="S",
                    help="ballistic flight strength in [0, 1] (0: off): flights follow the parabola of the sample's "
                         "gravity")

@@ -145,9 +145,10 @@ class MotionGenerator:
                 without wind are the backbone's (:mod:`simdiff.diffusion.guidance`); continuous SimDiff models only.
                 ``"reference"``: the text guidance runs under Earth without wind with the adapters at
                 ``anchor_alpha`` and the adapters anchor's own answer to φ (text guidance and s_e included) is added.
-                ``"edit"``: every motion is its Earth-without-wind motion (the reference anchor) until the step
-                ``edit_t``, then the motions off it continue under their φ with the adapters anchor.
-            anchor_alpha: with ``anchor="backbone"`` or ``"reference"``, the adapter strength its text guidance runs
+                ``"edit"``: a motion under another gravity than Earth's is its Earth-without-wind motion (the
+                reference anchor) until the step ``edit_t``, then continues under its φ with the adapters anchor;
+                every other motion is the reference anchor's (wind alone included).
+            anchor_alpha: with ``anchor="backbone"``, ``"reference"`` or ``"edit"``, the adapter strength its text guidance runs
                 at (0: the backbone alone; e.g. 0.25: motions under Earth without wind are those of α 0.25, the
                 answer to φ is α's).
             anchor_t_max: with ``anchor="backbone"`` or ``"reference"``, that anchor only at the denoising steps
@@ -155,8 +156,8 @@ class MotionGenerator:
             ballistic: strength in [0, 1] of :func:`simdiff.motion.ballistic.ballistic_flights` applied after the foot
                 cleanup (0: off): every flight's pelvis height follows the parabola of the sample's gravity (φ's g_z;
                 Earth for a backbone-only model), the whole body moved with it; not for categorical SimDiff models.
-            edit_t: with ``anchor="edit"``, the last timestep (0..999) at which motions off Earth still follow their
-                Earth motion (None: :data:`simdiff.diffusion.guidance.DEFAULT_EDIT_T`).
+            edit_t: with ``anchor="edit"``, the last timestep (0..999) at which motions under another gravity
+                still follow their Earth motion (None: :data:`simdiff.diffusion.guidance.DEFAULT_EDIT_T`).
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
         if b == 0:

@@ -55,8 +55,8 @@ class GenerationRequest:
             (0: the backbone alone; :mod:`simdiff.diffusion.guidance`).
         anchor_t_max: with the ``backbone`` or ``reference`` anchor, the last timestep (0..999) it runs at from
             below, the adapters anchor at the earlier steps (None: every step).
-        edit_t: with the ``edit`` anchor, the last timestep (0..999) at which a motion off Earth still follows its
-            Earth motion (None: the model's or the sampler's default).
+        edit_t: with the ``edit`` anchor, the last timestep (0..999) at which a motion under another gravity
+            still follows its Earth motion (None: the model's or the sampler's default).
         ballistic: ballistic-flight strength in [0, 1] (0: off; :mod:`simdiff.motion.ballistic`): flights follow the
             parabola of the sample's gravity.
         formats: output kinds, a subset of :data:`FORMATS`.

@@ -94,8 +94,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="what the text guidance runs on: the network with its adapters (adapters), or the backbone "
                           "alone, the adapters adding only their answer to φ against Earth without wind (backbone), "
                           "or the network under Earth without wind at --anchor-alpha, the adapters anchor's whole "
-                          "answer to φ added (reference), or that network until --edit-t, then the adapters under φ "
-                          "(edit); default adapters, or the model's sampling.json")
+                          "answer to φ added (reference), or, under another gravity, that network until --edit-t, "
+                          "then the adapters under φ (edit); default adapters, or the model's sampling.json")
     smp.add_argument("--anchor-alpha", type=float, metavar="A",
                      help="with --anchor backbone, reference or edit: run its text guidance with the adapters at strength "
                           "A, so motions under Earth without wind are those of --alpha A while the answer to φ is "
@@ -105,8 +105,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           "at most T (0-999), the adapters anchor at the earlier ones (default every step, or the "
                           "model's sampling.json)")
     smp.add_argument("--edit-t", type=int, metavar="T",
-                     help="with --anchor edit: a motion off Earth follows its Earth motion (same seed) down to "
-                          "timestep T (0-999), then continues under its gravity and wind (default 800, or the "
+                     help="with --anchor edit: a motion under another gravity follows its Earth motion (same "
+                          "seed) down to timestep T (0-999), then continues under its gravity and wind (default 800, or the "
                           "model's sampling.json)")
     smp.add_argument("--ballistic", type=float, metavar="S",
                      help="ballistic flight strength in [0, 1]: while no foot is on the ground the body's height "
