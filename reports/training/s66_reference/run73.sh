@@ -6,7 +6,8 @@
 # this folder) and STAGES (their order, default "gate C' A B C+ T") for later rules; the defaults are rule 73's run.
 # BALLISTIC (the model's ballistic strength, default off) goes to every draw; BDRAW: stage B's draw (see stage_B).
 # Session 70: ANC (the anchor, default reference), ALPHA (default 0.5), EDIT_T (the edit anchor's edit t) and ETA (DDIM
-# eta) for rules 81-82; FB empty: no fallback.
+# eta) for rules 81-82; FB empty: no fallback. Session 72: GATE (the gate's verdict script, default gate68.py) and
+# GATE_ARGS (its arguments after the probe log and the rule) for rule 84.
 set -u
 RULE=${RULE:-73} N=${N:-G63r} SE=${SE:-3} FB=${FB-2} AS=${AS:-140}
 cd /work/main; . .venv/bin/activate
@@ -22,7 +23,7 @@ guard() {  # $1 phi, $2 seeds, $3 folder
 stage_gate() {
   PROBE=$MODELS/${N}_probe.log
   [ -s $PROBE ] || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $M > $PROBE 2>&1
-  python reports/training/s61_distill/gate68.py "$PROBE" $RULE | tee -a $OUT | grep -q "gate PASS"
+  python ${GATE:-reports/training/s61_distill/gate68.py} "$PROBE" $RULE ${GATE_ARGS:-} | tee -a $OUT | grep -q "gate PASS"
 }
 stage_Cp() {  # C'
   guard -1.6,0,0 "1 2" $S/eval11/C12_$N
