@@ -16,6 +16,7 @@ import numpy as np
 import torch
 
 from simdiff.eval.model_check.config import SPEED_PROMPTS
+from simdiff.eval.model_check.detect import root_speed
 from simdiff.model.generator import MotionGenerator
 from simdiff.motion.features import features_to_joints
 from simdiff.motion.metrics import glides, never_touches
@@ -52,7 +53,7 @@ def main() -> None:
             joints.append(features_to_joints(f.double()).numpy())
         j = np.concatenate(joints)
         lift = np.ptp(j[:, :, FEET, 1], axis=1).max(axis=1)
-        speed = np.linalg.norm(np.diff(j[:, :, 0, [0, 2]], axis=1), axis=-1).mean(axis=1) * 20
+        speed = np.array([root_speed(x) for x in j])
         out[key] = {"n": len(j), "glides": int(glides(j).sum()), "never_touch": int(never_touches(j).sum()),
                     "foot_lift_median_m": round(float(np.median(lift)), 3),
                     "pelvis_speed_median": round(float(np.median(speed)), 3),

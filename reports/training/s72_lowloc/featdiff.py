@@ -12,9 +12,8 @@ import torch
 
 from simdiff.eval.model_check.config import SPEED_PROMPTS
 from simdiff.model.generator import MotionGenerator
-
-GROUPS = {"root_ang_vel": slice(0, 1), "root_lin_vel": slice(1, 3), "root_y": slice(3, 4), "ric": slice(4, 67),
-          "rot": slice(67, 193), "local_vel": slice(193, 259), "contact": slice(259, 263)}
+from simdiff.motion.features import SLICES
+from simdiff.motion.skeleton import FOOT_LEFT, FOOT_RIGHT
 
 
 def main() -> None:
@@ -27,12 +26,13 @@ def main() -> None:
                               foot_lock=foot_lock, env=[g, 0.0, 0.0], env_guidance=1.0, anchor="edit",
                               anchor_alpha=0.0, edit_t=edit_t).features.numpy()
     a, b = out[-9.81], out[-1.6]
-    for k, sl in GROUPS.items():
+    for k, sl in SLICES.items():
         print(f"{k}: earth mean {a[..., sl].mean():.3f} std {a[..., sl].std():.3f} | low g mean {b[..., sl].mean():.3f} "
               f"std {b[..., sl].std():.3f} | rms diff {np.sqrt(((a[..., sl] - b[..., sl]) ** 2).mean()):.3f}")
-    print("contact per foot joint: earth", a[..., 259:].mean((0, 1)).round(2), "low g", b[..., 259:].mean((0, 1)).round(2))
-    for j in (7, 8, 10, 11):  # ric holds joints 1..21; y of joint j at 4 + 3 (j - 1) + 1
-        y = 4 + 3 * (j - 1) + 1
+    c = SLICES["contacts"]
+    print("contact per foot joint: earth", a[..., c].mean((0, 1)).round(2), "low g", b[..., c].mean((0, 1)).round(2))
+    for j in sorted((*FOOT_LEFT, *FOOT_RIGHT)):  # ric holds joints 1..21; y of joint j at its start + 3 (j - 1) + 1
+        y = SLICES["ric"].start + 3 * (j - 1) + 1
         print(f"joint {j} height range earth {np.ptp(a[..., y], 1).mean():.3f} low g {np.ptp(b[..., y], 1).mean():.3f}, "
               f"mean {a[..., y].mean():.3f} / {b[..., y].mean():.3f}")
     print(f"root y {a[..., 3].mean():.3f} / {b[..., 3].mean():.3f}")

@@ -9,12 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-FEET = [7, 10, 8, 11]
+from simdiff.eval.model_check.detect import root_speed as speed
+from simdiff.motion.skeleton import FOOT_LEFT, FOOT_RIGHT
 
-
-def speed(j: np.ndarray) -> float:
-    """Mean horizontal root speed, m/s, of joints (frames x 22 x 3) at 20 fps."""
-    return float(np.linalg.norm(np.diff(j[:, 0, [0, 2]], axis=0), axis=-1).mean() * 20)
+FEET = [*FOOT_LEFT, *FOOT_RIGHT]
 
 
 def main() -> None:
