@@ -258,3 +258,10 @@ def test_cli_passes_twin_frames_to_the_run(uneven: tuple[Path, Path], tmp_path: 
              if p["what"] == "adapters"]
     assert notes and all(n.endswith("per-frame paired loss on wind twins only (--pair-twins wind)") for n in notes)
     assert json.loads((tmp_path / "ad4" / "train_config.json").read_text())["train"]["drift_pairs"] == "wind"
+    assert main(args + ["--cross-twins", "0.5", "--cross-match", "jump|hop", "--out", str(tmp_path / "ad7")]) == 0
+    train = json.loads((tmp_path / "ad7" / "train_config.json").read_text())["train"]
+    assert (train["cross_twins"], train["cross_match"]) == (0.5, "jump|hop")
+    capsys.readouterr()
+    assert main(args + ["--cross-twins", "0.5", "--cross-match", "jump(", "--out", str(tmp_path / "ad8")]) == 2
+    err = capsys.readouterr().err
+    assert "cross_match 'jump(' is not a regular expression" in err and err.count("\n") == 1

@@ -337,6 +337,41 @@ def test_cross_twins_noise_each_twin_from_the_other(tmp_path: Path) -> None:
         assert torch.equal(seen[1][row], source[row]), row  # p 1: paired twins swapped, the unpaired row kept
 
 
+def test_cross_match_crosses_only_the_pairs_whose_caption_matches(tmp_path: Path) -> None:
+    bb = _backbone(tmp_path)
+    seen: list[torch.Tensor] = []
+    x0 = torch.randn(6, 8, 263, generator=torch.Generator().manual_seed(1))
+    paired = torch.tensor([True, True, True])
+    captions = ["a person JUMPS up", "a person walks", "someone hops", "a person JUMPS up", "a person walks",
+                "someone hops"]
+    for match in ("", "jump|hop"):
+        cfg = run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=1.0, cross_match=match,
+                         batch_size=6, seed=4)
+        trainer = Trainer(tmp_path / f"m{len(match)}", cfg, ShiftTwins(), text_encoder=HashText(), init_model=bb)
+        trainer.model = lambda x, t, c: seen.append(x) or x  # type: ignore[assignment]
+        trainer._paired_prediction(x0, None, torch.Generator().manual_seed(0), paired,  # type: ignore[arg-type]
+                                   captions)
+    g = torch.Generator().manual_seed(0)
+    t = torch.randint(0, trainer.scheduler.num_train_timesteps, (3,), generator=g).repeat(2)
+    noise = torch.randn((3, 8, 263), generator=g).repeat(2, 1, 1)
+    own = trainer.scheduler.add_noise(x0, noise, t)
+    crossed = trainer.scheduler.add_noise(torch.cat([x0[3:], x0[:3]]), noise, t)
+    assert torch.equal(seen[0], crossed)  # no pattern: every pair crossed at p 1
+    for row, source in ((0, crossed), (1, own), (2, crossed), (3, crossed), (4, own), (5, crossed)):
+        assert torch.equal(seen[1][row], source[row]), row  # the walk pair keeps its own x_t
+    for bad, msg in (("jump(", r"cross_match 'jump\(' is not a regular expression"),):
+        with pytest.raises(SimdiffError, match=msg):
+            Trainer(tmp_path / "bad", run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=0.5,
+                                                 cross_match=bad), ShiftTwins(), text_encoder=HashText(), init_model=bb)
+    with pytest.raises(SimdiffError, match="cross_match 'jump' needs cross_twins > 0"):
+        Trainer(tmp_path / "bad2", run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_match="jump"),
+                ShiftTwins(), text_encoder=HashText(), init_model=bb)
+    cfg = run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=0.5, cross_match="clip 1",
+                     batch_size=6, seed=4)
+    losses = Trainer(tmp_path / "train", cfg, ShiftTwins(), text_encoder=HashText(), init_model=bb).train(progress=False)
+    assert all(np.isfinite(losses))
+
+
 def test_cross_twins_train_and_are_checked(tmp_path: Path) -> None:
     bb = _backbone(tmp_path)
     losses = {}

@@ -89,6 +89,9 @@ class TrainConfig:
             (an edit of the twin, as the simulator's replay is; sample with the edit anchor,
             :mod:`simdiff.diffusion.guidance`). 0 = off. Session 70: 600 CPU steps at p 0.5 taught the single
             denoising step half of the simulator's low-g lift; ``reports/training/s70_cross/``.
+        cross_match: a regular expression (case-insensitive, searched in the caption) limiting ``cross_twins`` to the
+            twin pairs whose caption matches, e.g. ``"jump|hop|leap"``: only those pairs are crossed, the rest keep
+            their own x_t. "" (default) = every paired twin may be crossed.
     """
 
     mode: str = "backbone"
@@ -111,6 +114,7 @@ class TrainConfig:
     drift_pairs: str = "all"
     pair_twins: str = "all"
     cross_twins: float = 0.0
+    cross_match: str = ""
 
 
 @dataclass

@@ -13,9 +13,10 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 import time
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 import torch
@@ -107,6 +108,14 @@ class Trainer:
             raise SimdiffError(f"cross_twins must be a share in [0, 1], got {tc.cross_twins}")
         if tc.cross_twins > 0 and not tc.env_pairs > 0:
             raise SimdiffError(f"cross_twins = {tc.cross_twins} needs env_pairs > 0 (it crosses twins of paired batches)")
+        if not isinstance(tc.cross_match, str):
+            raise SimdiffError(f"cross_match must be a regular expression string, got {tc.cross_match!r}")
+        try:
+            self._cross_match = re.compile(tc.cross_match, re.IGNORECASE) if tc.cross_match else None
+        except re.error as exc:
+            raise SimdiffError(f"cross_match {tc.cross_match!r} is not a regular expression: {exc}") from None
+        if self._cross_match is not None and not tc.cross_twins > 0:
+            raise SimdiffError(f"cross_match {tc.cross_match!r} needs cross_twins > 0 (it limits which twins are crossed)")
         if tc.env_pairs > 0 and tc.mode != "adapters":
             raise SimdiffError(f"env_pairs = {tc.env_pairs} needs adapters mode (the φ-difference loss trains the adapters)")
         with torch.random.fork_rng(devices=[]):
@@ -273,7 +282,7 @@ class Trainer:
         mask = batch["mask"].to(self.device)
         if "paired" in batch:
             self.network.backbone.eval()  # frozen: no dropout, so twins differ only through φ
-            pred = self._paired_prediction(x0, cond, generator, batch["paired"])
+            pred = self._paired_prediction(x0, cond, generator, batch["paired"], batch["captions"])
         else:
             pred = diffusion_prediction(self.model, self.scheduler, x0, cond, generator=generator)
         loss = masked_mse(pred, x0, mask)
@@ -304,9 +313,10 @@ class Trainer:
         return value
 
     def _paired_prediction(self, x0: Tensor, cond: Condition, generator: torch.Generator,
-                           paired: Tensor | None = None) -> Tensor:
+                           paired: Tensor | None = None, captions: Sequence[str] | None = None) -> Tensor:
         """x̂₀ (B, T, F) with one t and one ε per twin pair (items i and i + B/2). With ``cross_twins`` p > 0, a share p
-        of the paired twins (``paired`` (B/2,) bool) are noised from each other's x₀ (``TrainConfig.cross_twins``)."""
+        of the paired twins (``paired`` (B/2,) bool) are noised from each other's x₀ (``TrainConfig.cross_twins``);
+        with ``cross_match``, only pairs whose first twin's caption (``captions``, B) matches it."""
         h = x0.shape[0] // 2
         t = torch.randint(0, self.scheduler.num_train_timesteps, (h,), generator=generator).repeat(2).to(self.device)
         noise = torch.randn((h, *x0.shape[1:]), generator=generator).repeat(2, 1, 1).to(self.device)
@@ -316,6 +326,10 @@ class Trainer:
             cross = torch.rand(h, generator=generator) < p
             if paired is not None:
                 cross &= paired.cpu()
+            if self._cross_match is not None:
+                if captions is None:
+                    raise SimdiffError("cross_match needs the batch's captions")
+                cross &= torch.tensor([bool(self._cross_match.search(c)) for c in captions[:h]])
             cross = cross.to(self.device)[:, None, None]
             swapped = torch.cat([x0[h:], x0[:h]])
             source = torch.where(cross.repeat(2, 1, 1), swapped, x0)

@@ -97,6 +97,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--cross-twins", type=float, metavar="P",
                    help="share of paired twins (needs --env-pairs) noised from each other's motion, the target "
                         "staying their own: phi then edits the motion x_t shows; see TrainConfig.cross_twins")
+    a.add_argument("--cross-match", metavar="REGEX",
+                   help="cross only the twin pairs whose caption matches this regular expression (case-insensitive), "
+                        "e.g. 'jump|hop|leap'; needs --cross-twins; see TrainConfig.cross_match")
     a.set_defaults(func=run, mode="adapters")
     e = group.add_parser("export-backbone", help="write a SimDiff model's frozen backbone as a backbone-only model",
                          description="Write the backbone of a SimDiff model folder (weights bit-identical, "
@@ -212,6 +215,8 @@ def _run_config(args: argparse.Namespace):
         tc.pair_twins = args.pair_twins
     if getattr(args, "cross_twins", None) is not None:
         tc.cross_twins = args.cross_twins
+    if getattr(args, "cross_match", None) is not None:
+        tc.cross_match = args.cross_match
     from simdiff.data.augment.anchored import TARGETS
     from simdiff.data.augment.dataset import TWIN_FRAMES
     from simdiff.train.config import DRIFT_PAIRS
