@@ -18,7 +18,7 @@ c = CheckConfig(model=model, corpus=f"{E}/corpus3", evaluator=f"{E}/eval", out=o
                 alpha=float(os.environ.get("ALPHA", "0.5")), foot_lock=1.0, env_guidance=se,  # ALPHA: session 54
                 anchor=os.environ.get("ANCHOR", "adapters"),  # session 47
                 anchor_alpha=float(os.environ.get("ANCHOR_ALPHA", "0")),  # session 55
-                ballistic=float(os.environ.get("BALLISTIC", "0")),  # session 67
+                ballistic=float(os.environ.get("BALLISTIC") or 0),  # session 67
                 edit_t=int(os.environ["EDIT_T"]) if os.environ.get("EDIT_T") else None,  # session 70
                 eta=float(os.environ.get("ETA") or 0),  # session 70
                 split=SplitOptions(split="val", n=128), prompts=PromptOptions(jump_samples=16, speed_samples=8),

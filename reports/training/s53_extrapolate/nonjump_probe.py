@@ -27,7 +27,7 @@ def probe(models: list[str], prompts: list[str], n: int, seed0: int) -> None:
                                alpha=float(os.environ.get("PROBE_ALPHA", "0.5")), env=[-9.81, 0.0, 0.0],
                                anchor=os.environ.get("PROBE_ANCHOR", "adapters"),
                                anchor_alpha=float(os.environ.get("PROBE_ANCHOR_ALPHA", "0")),
-                               ballistic=float(os.environ.get("BALLISTIC", "0")))  # session 67
+                               ballistic=float(os.environ.get("BALLISTIC") or 0))  # session 67
             j = features_to_joints(out.features.double()).numpy()
             rows.append(sum(jump_stats(x)["jump"] for x in j))
         print(model, f"jumping {sum(rows)}/{n * len(prompts)}", rows, f"{time.time() - start:.0f}s", flush=True)
