@@ -1,5 +1,5 @@
 """Rules 85 and 86's choice of sampling from glides.log and sizes.log (rule85.txt, rule86.txt).
-python select85.py FOLDER [--glides-ok MODEL] [--prefix P]: with --glides-ok, exit 0 when MODEL's last glide line
+python select85.py FOLDER [--glides-ok MODEL] [--prefix P | --only P]: with --glides-ok, exit 0 when MODEL's last glide line
 passes (<= 1 of 16 runs gliding at g -1.6, none never touching). Else prints each screened model folder's (those whose
 path starts with P) sizes and margin and the choice line ('choice: s_e X margin M' or, with --prefix, 'choice: FOLDER
 margin M'; 'choice: none')."""
@@ -30,13 +30,14 @@ ap = argparse.ArgumentParser()
 ap.add_argument("folder", type=Path)
 ap.add_argument("--glides-ok")
 ap.add_argument("--prefix", default="")
+ap.add_argument("--only", default="", help="screen only the model folders starting with this, labelled by s_e")
 a = ap.parse_args()
 glides, sizes = lines(a.folder / "glides.log"), lines(a.folder / "sizes.log")
 if a.glides_ok:
     sys.exit(0 if a.glides_ok in glides and glides_ok(glides[a.glides_ok]) else 1)
 best = None
 for model, g in glides.items():
-    if not model.startswith(a.prefix):
+    if not model.startswith(a.prefix) or not model.startswith(a.only):
         continue
     se = g["sampling"]["env_guidance"]
     if a.prefix:
