@@ -359,10 +359,9 @@ def test_cross_match_crosses_only_the_pairs_whose_caption_matches(tmp_path: Path
     assert torch.equal(seen[0], crossed)  # no pattern: every pair crossed at p 1
     for row, source in ((0, crossed), (1, own), (2, crossed), (3, crossed), (4, own), (5, crossed)):
         assert torch.equal(seen[1][row], source[row]), row  # the walk pair keeps its own x_t
-    for bad, msg in (("jump(", r"cross_match 'jump\(' is not a regular expression"),):
-        with pytest.raises(SimdiffError, match=msg):
-            Trainer(tmp_path / "bad", run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=0.5,
-                                                 cross_match=bad), ShiftTwins(), text_encoder=HashText(), init_model=bb)
+    with pytest.raises(SimdiffError, match=r"cross_match 'jump\(' is not a regular expression"):
+        Trainer(tmp_path / "bad", run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_twins=0.5,
+                                             cross_match="jump("), ShiftTwins(), text_encoder=HashText(), init_model=bb)
     with pytest.raises(SimdiffError, match="cross_match 'jump' needs cross_twins > 0"):
         Trainer(tmp_path / "bad2", run_config(2, mode="adapters", sim=True, env_pairs=1.0, cross_match="jump"),
                 ShiftTwins(), text_encoder=HashText(), init_model=bb)
