@@ -9,13 +9,14 @@
 #   env EDIT_T: --edit-t, with ANCHOR=edit (session 70); env ETA: --eta, DDIM eta (session 70)
 #   env ASEEDS: stage A's seeds (default "100 101"; session 56); they split the 16 samples per jump prompt, so more seeds
 #     do not raise n (96 jump pairs, 64 windy walks; session 57); env JS: samples per jump prompt (default 16; session 57)
+#   env BSEEDS: stage B's seeds (default "0 1"; session 74)
 #   A: selection seeds 100 101, val n 32, response on   B: val n 128 seeds 0 1, no response
 #   T: test n 256 seeds 0-4, response on                 Tq: the same without the response
 cd /work/main; . .venv/bin/activate
 S=/work/scratch/s39
 case $1 in
   A) args="--split val --n 32 --seeds ${ASEEDS:-100 101} --workers 2";;
-  B) args="--split val --n 128 --seeds 0 1 --no-response";;
+  B) args="--split val --n 128 --seeds ${BSEEDS:-0 1} --no-response";;
   T) args="--split test --n 256 --seeds 0 1 2 3 4 --workers 2";;
   Tq) args="--split test --n 256 --seeds 0 1 2 3 4 --no-response";;
   *) echo "check.sh: unknown stage '$1' (A, B, T or Tq)" >&2; exit 2;;
