@@ -50,6 +50,17 @@ def test_paired_conditions_narrowed_to_weak_gravity_keep_the_default_draw() -> N
         paired_conditions("16_05", 2, gravity_range=(-1.0, -5.0))
 
 
+def test_paired_conditions_at_one_gravity() -> None:
+    """LO == HI: every gravity draw is that value (rule 87's val replays at g -1.6); more draws than factors would
+    simulate a clip twice under the same gravity, which is a one-line error naming the value."""
+    moon = paired_conditions("16_05", 1, 0, factors=("gravity",), gravity_range=(-1.6, -1.6))
+    assert [(c.factor, c.env.as_tuple()) for c in moon] == [("earth", (-9.81, 0.0, 0.0)), ("gravity", (-1.6, 0.0, 0.0))]
+    three = paired_conditions("16_05", 3, 0, gravity_range=(-1.6, -1.6))
+    assert [c.env.as_tuple()[0] for c in three if c.factor == "gravity"] == [-1.6]
+    with pytest.raises(SimdiffError, match=r"gravity-range -1.6 -1.6 is one gravity: with --conditions 2 over 1"):
+        paired_conditions("16_05", 2, 0, factors=("gravity",), gravity_range=(-1.6, -1.6))
+
+
 def test_augment_cli_narrows_the_draw_and_refuses_it_outside_paired_mode(tmp_path: Path, capsys) -> None:
     import json
 

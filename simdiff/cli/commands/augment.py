@@ -67,7 +67,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--factors", nargs="+", metavar="FACTOR",
                    help="paired: draw only these factors (gravity, wind_x, wind_y; default all three, cycled)")
     p.add_argument("--gravity-range", nargs=2, type=float, metavar=("LO", "HI"),
-                   help="paired: draw g_z uniformly in [LO, HI] m/s^2 (default -20 -1), e.g. -5 -1 for weak gravity")
+                   help="paired: draw g_z uniformly in [LO, HI] m/s^2 (default -20 -1), e.g. -5 -1 for weak gravity; "
+                        "LO = HI: that one gravity (with --conditions at most the number of factors)")
     p.add_argument("--limit", type=int, help="augment only the first N clips of the split")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(func=run)

@@ -102,11 +102,12 @@ def check_factors(factors: Sequence[str]) -> tuple[str, ...]:
 
 
 def check_gravity_range(gravity_range: Sequence[float]) -> tuple[float, float]:
-    """``(lo, hi)`` m/s² within :data:`GRAVITY_RANGE` with lo < hi, else a one-line error naming it."""
+    """``(lo, hi)`` m/s² within :data:`GRAVITY_RANGE` with lo <= hi (lo == hi: that one gravity), else a one-line
+    error naming it."""
     lo, hi = (float(v) for v in gravity_range)
     glo, ghi = GRAVITY_RANGE
-    if not (np.isfinite(lo) and np.isfinite(hi)) or not glo <= lo < hi <= ghi:
-        raise SimdiffError(f"--gravity-range {lo:g} {hi:g}: need {glo:g} <= LO < HI <= {ghi:g} (m/s^2, negative = down)")
+    if not (np.isfinite(lo) and np.isfinite(hi)) or not glo <= lo <= hi <= ghi:
+        raise SimdiffError(f"--gravity-range {lo:g} {hi:g}: need {glo:g} <= LO <= HI <= {ghi:g} (m/s^2, negative = down)")
     return lo, hi
 
 
@@ -119,7 +120,8 @@ def paired_conditions(clip: str, k: int = DEFAULT_PAIRED_K, seed: int = 0, facto
         k: conditions besides Earth.
         seed: run seed.
         factors: the factors drawn, cycled from a per-clip random start (default all three).
-        gravity_range: ``(lo, hi)`` of the uniform g_z draw, m/s² (default the validated range).
+        gravity_range: ``(lo, hi)`` of the uniform g_z draw, m/s² (default the validated range; lo == hi: that
+            gravity, then at most one draw per factor).
     Returns:
         ``[Earth (index 0), draw 1, …, draw k]``, values rounded to 1e-4.
     """
@@ -127,6 +129,10 @@ def paired_conditions(clip: str, k: int = DEFAULT_PAIRED_K, seed: int = 0, facto
         raise SimdiffError(f"--conditions must be at least 1 in paired mode, got {k}")
     factors = check_factors(factors)
     gravity_range = check_gravity_range(gravity_range)
+    if gravity_range[0] == gravity_range[1] and "gravity" in factors and k > len(factors):
+        raise SimdiffError(f"--gravity-range {gravity_range[0]:g} {gravity_range[1]:g} is one gravity: with --conditions "
+                           f"{k} over {len(factors)} factor(s) a clip would be simulated under it more than once; use "
+                           f"--conditions {len(factors)} or a range")
     rng = np.random.default_rng([seed, 0xA13, zlib.crc32(clip.encode("utf-8"))])
     start = int(rng.integers(3))
     out = [AugmentEnv(0, "earth", Environment(EARTH_GRAVITY, 0.0, 0.0))]

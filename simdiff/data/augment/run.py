@@ -130,6 +130,8 @@ class AugmentConfig:
         # one canonical form (FACTORS order, floats), so a resumed run's settings compare equal
         self.factors = check_factors(self.factors)
         self.gravity_range = check_gravity_range(self.gravity_range)
+        if self.mode == "paired":  # a one-gravity range with too many draws fails here, before any file is written
+            paired_conditions("check", self.n_conditions, self.seed, self.factors, self.gravity_range)
 
     @property
     def n_conditions(self) -> int:
