@@ -59,6 +59,12 @@ def test_paired_conditions_at_one_gravity() -> None:
     assert [c.env.as_tuple()[0] for c in three if c.factor == "gravity"] == [-1.6]
     with pytest.raises(SimdiffError, match=r"gravity-range -1.6 -1.6 is one gravity: with --conditions 2 over 1"):
         paired_conditions("16_05", 2, 0, factors=("gravity",), gravity_range=(-1.6, -1.6))
+    from simdiff.data.augment import AugmentConfig
+
+    with pytest.raises(SimdiffError, match="is one gravity"):  # the run's config refuses it before writing anything
+        AugmentConfig(mode="paired", conditions=2, factors=("gravity",), gravity_range=(-1.6, -1.6))
+    assert AugmentConfig(mode="paired", conditions=1, factors=("gravity",), gravity_range=(-1.6, -1.6)).gravity_range \
+        == (-1.6, -1.6)
 
 
 def test_augment_cli_narrows_the_draw_and_refuses_it_outside_paired_mode(tmp_path: Path, capsys) -> None:
