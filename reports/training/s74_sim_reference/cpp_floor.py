@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from clip_embed import embed_motions, embed_texts, first_caption, load_clip
 
 from simdiff.eval.evaluator import OurEvaluator
 from simdiff.eval.metrics import fid, matching_metrics
@@ -29,16 +30,10 @@ ev = OurEvaluator.load(a.evaluator)
 
 def embed(root: Path, keys: list[str]) -> tuple[np.ndarray, np.ndarray]:
     """(motion embeddings, caption embeddings) of keys, motions cut/padded to 196 frames."""
-    feats, caps, lens = [], [], []
-    for k in keys:
-        x = np.load(root / "new_joint_vecs" / f"{k}.npy")[:196].astype(np.float32)
-        feats.append(np.pad(x, ((0, 196 - len(x)), (0, 0))))
-        lens.append(max(4, len(x) // 4 * 4))
-        caps.append((root / "texts" / f"{k}.txt").read_text().splitlines()[0].split("#")[0])
-    x = np.stack(feats)
-    m = np.concatenate([ev.embed_motion(torch.from_numpy(x[i:i + 64]), lens[i:i + 64]) for i in range(0, len(x), 64)])
-    t = np.concatenate([ev.embed_text(caps[i:i + 64]) for i in range(0, len(caps), 64)])
-    return m, t
+    clips = [load_clip(root, k) for k in keys]
+    lens = [max(4, n // 4 * 4) for _, n in clips]
+    captions = [first_caption(root, k) for k in keys]
+    return embed_motions(ev, np.stack([x for x, _ in clips]), lens), embed_texts(ev, captions)
 
 
 pool = sorted((a.ref / "val.txt").read_text().split())

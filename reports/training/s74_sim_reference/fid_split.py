@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from clip_embed import MAX_FRAMES, embed_motions, first_caption, load_clip
 
 from simdiff.eval.evaluator import OurEvaluator
 from simdiff.eval.metrics import fid
@@ -34,19 +35,10 @@ pool = sorted((a.ref / "val.txt").read_text().split())
 ids = sorted(np.random.default_rng(0).choice(pool, min(a.n, len(pool)), replace=False))
 
 
-def clip(root: Path, k: int, n: int) -> np.ndarray:
-    x = np.load(root / "new_joint_vecs" / f"{k}.npy")[:n].astype(np.float32)
-    return np.pad(x, ((0, 196 - len(x)), (0, 0)))
-
-
-def embed(x: np.ndarray, lens: list[int]) -> np.ndarray:
-    return np.concatenate([ev.embed_motion(torch.from_numpy(x[i:i + 64]), lens[i:i + 64]) for i in range(0, len(x), 64)])
-
-
-lens = [max(40, min(196, len(np.load(a.ref / "new_joint_vecs" / f"{k}.npy"))) // 4 * 4) for k in ids]
-caps = [(a.ref / "texts" / f"{k}.txt").read_text().splitlines()[0].split("#")[0] for k in ids]
-rep = embed(np.stack([clip(a.ref, k, n) for k, n in zip(ids, lens)]), lens)
-ear = embed(np.stack([clip(a.earth, k, n) for k, n in zip(ids, lens)]), lens)
+lens = [max(40, min(MAX_FRAMES, len(np.load(a.ref / "new_joint_vecs" / f"{k}.npy"))) // 4 * 4) for k in ids]
+caps = [first_caption(a.ref, k) for k in ids]
+rep = embed_motions(ev, np.stack([load_clip(a.ref, k, n)[0] for k, n in zip(ids, lens)]), lens)
+ear = embed_motions(ev, np.stack([load_clip(a.earth, k, n)[0] for k, n in zip(ids, lens)]), lens)
 is_re = np.array([k in retimed for k in ids])
 d_er = np.linalg.norm(ear - rep, axis=1)
 out = {"n": len(ids), "retimed": int(is_re.sum()), "fid_earth_vs_replays": fid(ear, rep),
@@ -60,12 +52,13 @@ for model in a.models:
                          env_guidance=s["env_guidance"], anchor=s.get("anchor", "adapters"),
                          anchor_alpha=s.get("anchor_alpha", 0.0),
                          **({"edit_t": s["edit_t"]} if "edit_t" in s else {})).features.numpy()
-        feats += [np.pad(x[:n], ((0, 196 - n), (0, 0))) for x, n in zip(f, lens[i:i + 32])]
-    g = embed(np.stack(feats).astype(np.float32), lens)
+        feats += [np.pad(x[:n], ((0, MAX_FRAMES - n), (0, 0))) for x, n in zip(f, lens[i:i + 32])]
+    g = embed_motions(ev, np.stack(feats).astype(np.float32), lens)
     d_gr, d_ge = np.linalg.norm(g - rep, axis=1), np.linalg.norm(g - ear, axis=1)
     row = {"fid_vs_replays": fid(g, rep), "fid_vs_earth": fid(g, ear)}
     for name, m in (("retimed", is_re), ("rest", ~is_re)):
-        row[name] = {"median_d_sample_replay": float(np.median(d_gr[m])), "median_d_sample_earth": float(np.median(d_ge[m])),
+        row[name] = {"median_d_sample_replay": float(np.median(d_gr[m])),
+                     "median_d_sample_earth": float(np.median(d_ge[m])),
                      "nearer_replay": f"{int((d_gr[m] < d_ge[m]).sum())}/{int(m.sum())}"}
     out[Path(model).name] = row
     print(json.dumps({Path(model).name: row}), flush=True)

@@ -3,15 +3,16 @@ J40m's val stage B, 44 of 96, session 62), and the walk guard <= 3 of 64. Exit 0
 python v87.py DIR W"""
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "s66_reference"))
+from v73 import judged, line  # noqa: E402  (rule 73's verdict reading and line format)
+
 JUMPS_SHIPPED_VAL = 44 / 96
 folder, walk = Path(sys.argv[1]), int(sys.argv[2])
-rep = {v["check"]: v for v in json.loads((folder / "check.json").read_text())["verdicts"] if v["passed"] is not None}
-print(folder, "|", "; ".join(f"{k} {v['value']:.4g} {'pass' if v['passed'] else 'FAIL'}" if isinstance(v["value"], float)
-                             else f"{k} {v['value']} {'pass' if v['passed'] else 'FAIL'}" for k, v in rep.items()))
+rep = judged(folder / "check.json")
+print(folder, "|", "; ".join(line(v) for v in rep.values()))
 others = all(v["passed"] for k, v in rep.items() if k != "jumps")
 jumps = rep["jumps"]["value"] >= JUMPS_SHIPPED_VAL - 1e-9
 print(f"others pass: {others}; jumps {rep['jumps']['value']:.3f} >= {JUMPS_SHIPPED_VAL:.3f}: {jumps}; "

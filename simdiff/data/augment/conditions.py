@@ -107,8 +107,19 @@ def check_gravity_range(gravity_range: Sequence[float]) -> tuple[float, float]:
     lo, hi = (float(v) for v in gravity_range)
     glo, ghi = GRAVITY_RANGE
     if not (np.isfinite(lo) and np.isfinite(hi)) or not glo <= lo <= hi <= ghi:
-        raise SimdiffError(f"--gravity-range {lo:g} {hi:g}: need {glo:g} <= LO <= HI <= {ghi:g} (m/s^2, negative = down)")
+        raise SimdiffError(f"--gravity-range {lo:g} {hi:g}: need {glo:g} <= LO <= HI <= {ghi:g} "
+                           "(m/s^2, negative = down)")
     return lo, hi
+
+
+def check_one_gravity(k: int, factors: Sequence[str], gravity_range: Sequence[float]) -> None:
+    """A one-gravity range (lo == hi) with more paired draws ``k`` than ``factors`` would simulate a clip under the same
+    gravity more than once: a one-line error naming it."""
+    lo, hi = gravity_range
+    if lo == hi and "gravity" in factors and k > len(factors):
+        raise SimdiffError(f"--gravity-range {lo:g} {hi:g} is one gravity: with --conditions {k} over {len(factors)} "
+                           f"factor(s) a clip would be simulated under it more than once; use --conditions "
+                           f"{len(factors)} or a range")
 
 
 def paired_conditions(clip: str, k: int = DEFAULT_PAIRED_K, seed: int = 0, factors: Sequence[str] = FACTORS,
@@ -129,10 +140,7 @@ def paired_conditions(clip: str, k: int = DEFAULT_PAIRED_K, seed: int = 0, facto
         raise SimdiffError(f"--conditions must be at least 1 in paired mode, got {k}")
     factors = check_factors(factors)
     gravity_range = check_gravity_range(gravity_range)
-    if gravity_range[0] == gravity_range[1] and "gravity" in factors and k > len(factors):
-        raise SimdiffError(f"--gravity-range {gravity_range[0]:g} {gravity_range[1]:g} is one gravity: with --conditions "
-                           f"{k} over {len(factors)} factor(s) a clip would be simulated under it more than once; use "
-                           f"--conditions {len(factors)} or a range")
+    check_one_gravity(k, factors, gravity_range)
     rng = np.random.default_rng([seed, 0xA13, zlib.crc32(clip.encode("utf-8"))])
     start = int(rng.integers(3))
     out = [AugmentEnv(0, "earth", Environment(EARTH_GRAVITY, 0.0, 0.0))]

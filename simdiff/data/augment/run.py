@@ -54,7 +54,7 @@ import numpy as np
 from simdiff.fsio import read_json as _read_json, write_text
 from simdiff.data.augment.classes import load_motion_types
 from simdiff.data.augment.conditions import (DEFAULT_PAIRED_K, FACTORS, AugmentEnv, check_factors, check_gravity_range,
-                                             make_conditions, paired_conditions)
+                                             check_one_gravity, make_conditions, paired_conditions)
 from simdiff.data.augment.decide import decide
 from simdiff.data.augment.filter import AUTO, FilterConfig
 from simdiff.data.augment.report import build_report, report_markdown
@@ -131,7 +131,7 @@ class AugmentConfig:
         self.factors = check_factors(self.factors)
         self.gravity_range = check_gravity_range(self.gravity_range)
         if self.mode == "paired":  # a one-gravity range with too many draws fails here, before any file is written
-            paired_conditions("check", self.n_conditions, self.seed, self.factors, self.gravity_range)
+            check_one_gravity(self.n_conditions, self.factors, self.gravity_range)
 
     @property
     def n_conditions(self) -> int:
