@@ -7,7 +7,7 @@
 set -u
 cd /work/main; . .venv/bin/activate
 RULE=${RULE:-87} N=${N:-X86} M=${M:-/work/scratch/s73/models/X86_model} CPP_SEEDS=${CPP_SEEDS:-3 4} AS=${AS:-160}
-R=reports/training/s74_sim_reference; V=reports/training/s66_reference; S=/work/scratch/s39; OUT=$R/rule${RULE}_stages.txt
+R=reports/training/s74_sim_reference; V=reports/training/s66_reference; S=/work/scratch/s39; OUT=${STAGES_OUT:-$R/rule${RULE}_stages.txt}
 REF=/work/scratch/s74/ref
 export STEPS=50 W=2.5 ALPHA=0.925 ANCHOR=edit ANCHOR_ALPHA=0 AA=0 EDIT_T=900 ETA=1 BALLISTIC= FB=
 export PROBE_ANCHOR=edit PROBE_ANCHOR_ALPHA=0  # the walk guard as run73.sh ran it for rule 86
