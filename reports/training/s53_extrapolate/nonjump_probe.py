@@ -2,7 +2,7 @@
 settings); counts samples that jump by the checker's rule (flight >= 0.2 s, pelvis >= 15 cm).
 Usage: python nonjump_probe.py MODEL...
 (session 54: env PROBE_ANCHOR, the guidance anchor, default adapters; PROBE_ALPHA, the adapter strength, default 0.5;
-session 55: PROBE_ANCHOR_ALPHA, the anchor's adapter strength, default 0)"""
+session 55: PROBE_ANCHOR_ALPHA, the anchor's adapter strength, default 0; session 76: PROBE_W, the guidance, default 2.5)"""
 import os
 import sys
 import time
@@ -23,7 +23,7 @@ def probe(models: list[str], prompts: list[str], n: int, seed0: int) -> None:
     for model in models:
         gen, start, rows = MotionGenerator.load(model), time.time(), []
         for i, p in enumerate(prompts):
-            out = gen.generate([p] * n, 120, seed=seed0 + i, steps=50, guidance=2.5, foot_lock=1.0,
+            out = gen.generate([p] * n, 120, seed=seed0 + i, steps=50, guidance=float(os.environ.get("PROBE_W", "2.5")), foot_lock=1.0,
                                alpha=float(os.environ.get("PROBE_ALPHA", "0.5")), env=[-9.81, 0.0, 0.0],
                                anchor=os.environ.get("PROBE_ANCHOR", "adapters"),
                                anchor_alpha=float(os.environ.get("PROBE_ANCHOR_ALPHA", "0")),

@@ -4,12 +4,14 @@
 # Needs /work/scratch/s74/val_g16 (the replays, val_g16.sh) and /work/scratch/s73/models/X86_model.
 # Rule 88 (run88.sh) runs the same with RULE=88 N=X88 M=<its folder> CPP_SEEDS="5 6" AS=162 and the gate and stage A
 # first (STAGES="gate A Cpp B Cplus T"); B' seeds stay 2 3 (at Earth X88 samples what X86 samples).
+# Session 76: GUIDANCE (default 2.5), B_SEEDS, B_VERDICT and T_VERDICT (rule 93); the walk guard count is WG (it was W,
+# which then set the guidance of C+ and T to the count: no rule had reached C+ or T through this script).
 set -u
 cd /work/main; . .venv/bin/activate
 RULE=${RULE:-87} N=${N:-X86} M=${M:-/work/scratch/s73/models/X86_model} CPP_SEEDS=${CPP_SEEDS:-3 4} AS=${AS:-160}
 R=reports/training/s74_sim_reference; V=reports/training/s66_reference; S=/work/scratch/s39; OUT=${STAGES_OUT:-$R/rule${RULE}_stages.txt}
 REF=/work/scratch/s74/ref
-export STEPS=50 W=2.5 ALPHA=0.925 ANCHOR=edit ANCHOR_ALPHA=0 AA=0 EDIT_T=900 ETA=1 BALLISTIC= FB=
+export STEPS=50 W=${GUIDANCE:-2.5} ALPHA=0.925 ANCHOR=edit ANCHOR_ALPHA=0 AA=0 EDIT_T=900 ETA=1 BALLISTIC= FB=
 export PROBE_ANCHOR=edit PROBE_ANCHOR_ALPHA=0  # the walk guard as run73.sh ran it for rule 86
 stamp() { echo "[$(date -u +%H:%M)] $*" >&2; }
 guard() {  # $1 phi, $2 seeds, $3 folder, $4 scratch (corpus3/ and eval/)
@@ -32,12 +34,12 @@ stage_Cpp() {
   { echo -n "C'' g -1.6 seeds $CPP_SEEDS vs the simulator's val replays: "; python $V/v73.py text $S/eval11/Cpp_$N/-1.6,0,0; } \
     | tee -a $OUT | grep -q PASS
 }
-stage_B() {
-  B=$S/eval11/B_${N}_s23
-  [ -f $B/check.json ] || BSEEDS="2 3" bash reports/training/s39_drift_gpu/check.sh B ${N}_s23 $M 1
-  W=$(cd reports/training/s53_extrapolate && python walk_probe.py $M | tee /work/scratch/s74/walk$RULE.txt \
-    | sed -n 's/.*jumping \([0-9]*\)\/.*/\1/p')
-  { echo -n "B' Earth seeds 2 3: "; python $R/v87.py $B "$W"; } | tee -a $OUT | grep -q PASS
+stage_B() {  # B_SEEDS (default "2 3"); B_VERDICT (default v87.py) takes the report folder and the walk guard count
+  local bs=${B_SEEDS:-2 3}; B=$S/eval11/B_${N}_s${bs// /}
+  [ -f $B/check.json ] || BSEEDS="$bs" bash reports/training/s39_drift_gpu/check.sh B ${N}_s${bs// /} $M 1
+  WG=$(cd reports/training/s53_extrapolate && python walk_probe.py $M | tee /work/scratch/s74/walk$RULE.txt \
+    | sed -n 's/.*jumping \([0-9]*\)\/.*/\1/p')  # WG, not W: W is the guidance the stages after this one use
+  { echo -n "B' Earth seeds $bs: "; ${B_VERDICT:-python $R/v87.py} $B "$WG"; } | tee -a $OUT | grep -q PASS
 }
 stage_Cplus() {
   guard -9.81,10,0 "0" $S/eval11/Cp_$N $S
@@ -46,7 +48,7 @@ stage_Cplus() {
 stage_T() {
   T=$S/eval11/T_$N
   [ -f $T/check.json ] || bash reports/training/s39_drift_gpu/check.sh T $N $M 1
-  { echo -n "T test seeds 0-4: "; python $V/v73.py test $T; } | tee -a $OUT
+  { echo -n "T test seeds 0-4: "; ${T_VERDICT:-python $V/v73.py test} $T; } | tee -a $OUT
 }
 for st in ${STAGES:-Cpp B Cplus T}; do
   stamp "$st"; "stage_$st" || { echo "rule $RULE: $st failed" | tee -a $OUT; exit 0; }
