@@ -128,6 +128,9 @@ def test_shipped_settings_are_the_measured_ones() -> None:
     assert stored.get("anchor", "adapters") == measured.get("anchor", "adapters")
     assert stored.get("anchor_alpha", 0.0) == measured.get("anchor_alpha", 0.0)
     assert stored.get("anchor_t_max") == measured.get("anchor_t_max")
+    assert stored.get("edit_t") == measured.get("edit_t")  # the edit anchor's start (session 70)
+    assert stored.get("eta", 0.0) == measured.get("eta", 0.0)  # DDIM eta
+    assert stored.get("ballistic", 0.0) == measured.get("ballistic", 0.0)
     from simdiff.motion.foot_lock import CLEANUP_VERSION
 
     assert measured.get("foot_cleanup") == CLEANUP_VERSION  # measured with the foot cleanup users get
