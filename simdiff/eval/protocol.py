@@ -119,7 +119,7 @@ def _physics(features: Tensor, lengths: Tensor) -> dict[str, float]:
     from simdiff.motion.metrics import never_touches, own_floor_metrics, physics_metrics
 
     joints = features_to_joints(features.detach().cpu().double()).numpy()
-    lens = lengths.clamp(min=2, max=joints.shape[1]).numpy()
+    lens = lengths.cpu().clamp(min=2, max=joints.shape[1]).numpy()
     return {**physics_metrics(joints, lens), **own_floor_metrics(joints, lens),
             "never_touch": float(never_touches(joints, lens).mean())}
 

@@ -77,8 +77,8 @@ def evaluate_matching(model: TextMotionEvaluator, dataset: Any, text_encoder: An
         for start in range(0, n - n % bs, bs):
             b = _batch(dataset, list(range(start, start + bs)), rng)
             raw = dataset.normalizer.denormalize(b["motion"])
-            motions.append(model.embed_motion(raw, b["lengths"]).double().numpy())
-            texts.append(model.embed_text_vectors(text_encoder.encode(b["captions"])).double().numpy())
+            motions.append(model.embed_motion(raw, b["lengths"]).double().cpu().numpy())
+            texts.append(model.embed_text_vectors(text_encoder.encode(b["captions"])).double().cpu().numpy())
     stats = matching_metrics(np.concatenate(texts), np.concatenate(motions), batch_size=bs)
     top = stats.r_precision
     return {"top1": float(top[0]), "top2": float(top[1]), "top3": float(top[2]), "mm_dist": stats.mm_dist, "batch": bs}

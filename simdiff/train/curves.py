@@ -84,7 +84,7 @@ def _upsample_batch(raw: torch.Tensor, lengths: torch.Tensor, factor: int) -> tu
     """Low-rate (B, L, 263) raw features → 20 fps (B, L·factor, 263) and their lengths."""
     from simdiff.train.lowfps import upsample_features
 
-    ups = [upsample_features(raw[i, : int(n)].double().numpy(), factor) for i, n in enumerate(lengths)]
+    ups = [upsample_features(raw[i, : int(n)].double().cpu().numpy(), factor) for i, n in enumerate(lengths)]
     out = torch.zeros(len(ups), max(len(u) for u in ups), raw.shape[-1])
     for i, u in enumerate(ups):
         out[i, : len(u)] = torch.from_numpy(np.asarray(u, dtype=np.float32))
@@ -98,8 +98,8 @@ def _sample_metrics(raw: torch.Tensor, batch: dict[str, Any], evaluator: Any, fa
     lengths = batch["lengths"]
     if factor > 1:
         raw, lengths = _upsample_batch(raw, lengths, factor)
-    joints = features_to_joints(raw.detach().double())
-    phys = physics_metrics(joints.numpy(), lengths.clamp(min=2).numpy())
+    joints = features_to_joints(raw.detach().double().cpu())
+    phys = physics_metrics(joints.numpy(), lengths.cpu().clamp(min=2).numpy())
     out: dict[str, Any] = {"sliding": phys["sliding"], "skate_ratio": phys["skate_ratio"], "r_precision_top3": None}
     if evaluator is not None:
         from simdiff.eval.metrics import matching_metrics
@@ -232,7 +232,7 @@ def run_curve(trainer: Any, held: HeldOut, minutes: float, points: int, *, evalu
             path.parent.mkdir(parents=True, exist_ok=True)
             with atomic_path(path) as tmp:
                 with open(tmp, "wb") as fh:
-                    np.save(fh, feats.numpy().astype(np.float32))
+                    np.save(fh, feats.cpu().numpy().astype(np.float32))
             write_text(trainer.run_dir / POINTS_NAME, "".join(json.dumps(r) + "\n" for r in rows))
         log(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
     return rows

@@ -45,7 +45,7 @@ def measure(runner: Runner, spec: ModelSpec | None, env: list[float]) -> dict[st
         alpha = spec.alpha if runner.is_simdiff(spec) else None
         out, seconds = runner.generate(runner.generate_fn(spec, "ddim", alpha, env), items["captions"], items["lengths"],
                                        runner.config.seed * 7 + 1)
-        out = out.to(torch.float64).numpy()
+        out = out.to(torch.float64).cpu().numpy()
         feats = [out[i, :L] for i, L in enumerate(items["lengths"])]
     motions = [extend_last_frame(np.asarray(features_to_joints(f)), f) for f in feats]
     phi = Environment(*env)
