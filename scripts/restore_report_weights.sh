@@ -25,3 +25,4 @@ restore 4ec5b0d 'reports/training/s28_gpu_adapters/env_response/SimDiff_GPU_pair
 restore 4ec5b0d 'reports/training/s28_gpu_adapters/env_response/SimDiff_GPU_pair30__α___0.5.json' 6356d3c7c9238ddc
 restore 0f8ad48 'reports/training/s28_gpu_adapters/env_response_flight/SimDiff_GPU_pair10f__α___0.5.json' 7e131d941b82d79e
 restore 0f8ad48 'reports/training/s28_gpu_adapters/env_response_flight/SimDiff_GPU_pair10f__α___1.json' bb6f3c55e6e15c19
+restore 3f24dad 'reports/training/s76_lambda/X93_model/model.safetensors' 856504f9169ba456
