@@ -4,8 +4,10 @@
 set -u
 cd /work/main; . .venv/bin/activate
 R=reports/training/s76_lambda; X=/work/scratch/s76/models/X93_model
+K=$R/X93_model  # the committed copy (scripts/restore_report_weights.sh brings its weights back from history)
+if [ ! -f $X/model.safetensors ] && [ -f $K/model.safetensors ]; then mkdir -p $X && cp $K/* $X/; fi
 if [ ! -f $X/model.safetensors ]; then  # X90 (rule90.txt's two commands) + guidance 3.0
-  [ -f /work/scratch/s75/models/X90_model/model.safetensors ] || { echo "build X90 first (s75_better/run90.sh's commands)" >&2; exit 1; }
+  [ -f /work/scratch/s75/models/X90_model/model.safetensors ] || { echo "run scripts/restore_report_weights.sh or build X90 first (s75_better/run90.sh's commands)" >&2; exit 1; }
   mkdir -p $X && cp /work/scratch/s75/models/X90_model/* $X/ &&
     python -c "import json,sys; p=sys.argv[1]; s=json.load(open(p)); s['guidance']=3.0; open(p,'w').write(json.dumps(s)+'\n')" $X/sampling.json
 fi
