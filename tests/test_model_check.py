@@ -204,6 +204,36 @@ def test_speed_reference_is_the_corpus_clips_of_about_the_samples_length() -> No
     assert unmatched["types"]["run"]["median_in_iqr"] is False  # against every length the samples are too slow
 
 
+def test_captioned_reference_takes_the_train_clips_captioned_with_the_prompt(tmp_path: Path) -> None:
+    from simdiff.eval.model_check.prompts import captioned_speeds, speed_summary
+    from simdiff.eval.model_check.report import _speed_lines
+
+    (tmp_path / "new_joints").mkdir()
+    rows = [("fast", "train", "run", None, ["A person runs forward.", "someone runs."], 2.6),
+            ("fast2", "train", "run", None, ["a person runs forward"], 3.0),
+            ("mirror", "train", "run", "fast", ["a person runs forward."], 9.0),  # a mirror: its original's speed
+            ("slow", "train", "run", None, ["a person runs forward like an elderly person."], 1.4),
+            ("test", "test", "run", None, ["a person runs forward."], 9.0),  # not train
+            ("walker", "train", "walk", None, ["a person runs forward."], 9.0)]  # another motion type
+    for clip_id, _, _, _, _, speed in rows:
+        np.save(tmp_path / "new_joints" / f"{clip_id}.npy", walk(80, speed=speed).astype(np.float32))
+    (tmp_path / "manifest.json").write_text(json.dumps({"clips": [
+        {"id": i, "split": sp, "motion_type": k, "mirror_of": m, "captions": c} for i, sp, k, m, c, _ in rows]}))
+    kinds = {"run": ["a person runs forward", "a person jogs forward"]}
+    got = captioned_speeds(tmp_path, kinds)
+    assert got["a person jogs forward"] == [] and sorted(got["a person runs forward"]) == pytest.approx([2.6, 3.0], rel=0.02)
+    joints = np.stack([walk(80, speed=1.5), walk(80, speed=2.8)])
+    out = speed_summary(joints, plan_batches(kinds["run"], 1, [0]), kinds, {"run": [1.4, 1.5, 1.6]}, None, None, got)
+    ref = out["types"]["run"]["per_prompt_corpus_captioned"]
+    assert ref["a person runs forward"]["median"] == pytest.approx(2.8, rel=0.02) and ref["a person jogs forward"]["n"] == 0
+    assert out["types"]["run"]["median_in_iqr"] is False  # the verdict's reference is unchanged (1.4-1.6)
+    text = "\n".join(_speed_lines(out))
+    assert "| a person runs forward | 1.50 / 1.50 / 1.50 (n 1) | 2.70 / 2.80 / 2.90 (n 2) |" in text
+    assert "| a person jogs forward |" in text and "| none |" in text
+    assert "per_prompt_corpus_captioned" not in speed_summary(joints, plan_batches(kinds["run"], 1, [0]), kinds,
+                                                               {"run": [1.5]})["types"]["run"]
+
+
 def test_generate_set_flags_keeps_the_generators_fallback_rows_in_order() -> None:
     import torch
 

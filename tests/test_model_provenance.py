@@ -160,6 +160,21 @@ def test_adapters_join_their_backbones_provenance(tmp_path: Path) -> None:
     assert synthetic.trained_on[0].data == "synthetic" and synthetic.weights_licence == "permissive (synthetic data only)"
 
 
+def test_an_entry_listed_again_is_kept_once(tmp_path: Path) -> None:
+    nc, cmu = part("CC-BY-NC-4.0", data="aug", what="adapters"), part("CMU")
+    prov = Provenance([cmu, nc, part("CMU"), nc, part("CMU", data="aug", what="adapters")])
+    assert prov.trained_on == [cmu, nc, part("CMU", data="aug", what="adapters")]  # order of first appearance
+    assert prov.merged(Provenance([nc, cmu])).trained_on == prov.trained_on
+    noted = TrainingData(what="backbone", data="corpus", licences={"CMU": 0.5}, note="a warm start")
+    assert Provenance([cmu, noted]).trained_on == [cmu, noted]  # another note is another run: kept
+    write_provenance(tmp_path, Provenance([cmu]))
+    text = json.loads((tmp_path / PROVENANCE_NAME).read_text())
+    text["trained_on"] *= 3  # a file written before session 77 may repeat entries
+    (tmp_path / PROVENANCE_NAME).write_text(json.dumps(text))
+    back = read_provenance(tmp_path)
+    assert back is not None and back.trained_on == [cmu]
+
+
 def test_shipped_default_model_states_its_licence() -> None:
     from simdiff.model.default import DEFAULT_MODEL_DIR
 

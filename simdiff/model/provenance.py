@@ -113,13 +113,19 @@ def weights_licence(trained_on: Iterable[TrainingData]) -> str:
 class Provenance:
     """What a model was trained on (``trained_on``) and the licence that implies (``weights_licence``).
 
-    ``weights_licence`` is derived from ``trained_on`` by :func:`weights_licence` when left empty.
+    ``weights_licence`` is derived from ``trained_on`` by :func:`weights_licence` when left empty. An entry equal
+    to an earlier one is dropped (a warm start on the same data folder would otherwise list it once per run).
     """
 
     trained_on: list[TrainingData] = field(default_factory=list)
     weights_licence: str = ""
 
     def __post_init__(self) -> None:
+        unique: list[TrainingData] = []
+        for part in self.trained_on:
+            if part not in unique:
+                unique.append(part)
+        self.trained_on = unique
         if not self.weights_licence:
             self.weights_licence = weights_licence(self.trained_on)
 

@@ -9,7 +9,9 @@
   passes when the samples' median lies within those clips' interquartile range. The length matters: mocap runs are
   short because capture volumes are (corpus3's train runs: median 2.90 m/s under 60 frames, 1.45 m/s at 120 frames
   or more, session 65), so a 6 s sample is compared with the corpus's long clips; the all-lengths quartiles are
-  reported beside (no verdict). Beside it (no verdict): how many
+  reported beside (no verdict), and so are, per prompt, the train clips captioned with the prompt itself
+  (:func:`captioned_speeds`, any length; session 77: corpus3's 28 long runs are all elderly or weary runs, while its
+  clips captioned "a person runs forward." run 2.65 m/s). Beside it (no verdict): how many
   walk / run samples jump by the jump rule, against the corpus clips' rate over the samples' length (session 53:
   a model pushed to jump more can start hopping when asked to walk).
 
@@ -98,6 +100,46 @@ def corpus_clips(corpus: str | Path, types: Sequence[str], limit: int = 0, seed:
     Raises:
         SimdiffError: no manifest, or a manifest without motion types.
     """
+    clips = _train_originals(corpus)
+    rng = np.random.default_rng(seed)
+    out: dict[str, list[tuple[float, bool, int]]] = {}
+    for kind in types:
+        ids = sorted(c["id"] for c in clips if c["motion_type"] == kind)
+        if limit and len(ids) > limit:
+            ids = sorted(rng.choice(ids, limit, replace=False).tolist())
+        rows = []
+        for clip_id in ids:
+            joints = _clip_joints(corpus, clip_id)
+            rows.append((root_speed(joints), bool(jump_stats(joints[:frames] if frames else joints)["jump"]),
+                         int(len(joints))))
+        out[kind] = rows
+    return out
+
+
+def _caption_key(text: str) -> str:
+    return text.strip().lower().rstrip(". ")
+
+
+def captioned_speeds(corpus: str | Path, kinds: dict[str, Sequence[str]]) -> dict[str, list[float]]:
+    """Per prompt: mean horizontal root speeds (m/s) of the corpus's train clips (originals) of the prompt's motion
+    type any of whose captions is the prompt itself (case and the final full stop ignored), whatever their length.
+
+    Raises:
+        SimdiffError: as :func:`corpus_clips`.
+    """
+    wanted = {_caption_key(p): (kind, p) for kind, prompts in kinds.items() for p in prompts}
+    out: dict[str, list[float]] = {p: [] for prompts in kinds.values() for p in prompts}
+    for clip in _train_originals(corpus):
+        keys = {_caption_key(c) for c in clip.get("captions", []) if isinstance(c, str)}
+        for key in sorted(keys & wanted.keys()):
+            kind, prompt = wanted[key]
+            if clip["motion_type"] == kind:
+                out[prompt].append(root_speed(_clip_joints(corpus, clip["id"])))
+    return out
+
+
+def _train_originals(corpus: str | Path) -> list[dict[str, Any]]:
+    """The manifest's train clips that are not mirrors, each with a ``motion_type``."""
     path = Path(corpus) / "manifest.json"
     if not path.is_file():
         raise SimdiffError(f"{path}: missing (the speed check needs the corpus manifest with motion_type)")
@@ -107,31 +149,24 @@ def corpus_clips(corpus: str | Path, types: Sequence[str], limit: int = 0, seed:
         raise SimdiffError(f"{path}: not a corpus manifest ({exc})") from None
     if not isinstance(clips, list) or not all(isinstance(c, dict) and "motion_type" in c for c in clips):
         raise SimdiffError(f"{path}: clips without 'motion_type' (build the corpus with `simdiff data build`)")
-    rng = np.random.default_rng(seed)
-    out: dict[str, list[tuple[float, bool, int]]] = {}
-    for kind in types:
-        ids = sorted(c["id"] for c in clips if c.get("split") == "train" and c["motion_type"] == kind
-                     and not c.get("mirror_of"))
-        if limit and len(ids) > limit:
-            ids = sorted(rng.choice(ids, limit, replace=False).tolist())
-        rows = []
-        for clip_id in ids:
-            f = Path(corpus) / "new_joints" / f"{clip_id}.npy"
-            if not f.is_file():
-                raise SimdiffError(f"{f}: missing (listed in manifest.json)")
-            joints = np.load(f)
-            rows.append((root_speed(joints), bool(jump_stats(joints[:frames] if frames else joints)["jump"]),
-                         int(len(joints))))
-        out[kind] = rows
-    return out
+    return [c for c in clips if c.get("split") == "train" and not c.get("mirror_of")]
+
+
+def _clip_joints(corpus: str | Path, clip_id: str) -> np.ndarray:
+    f = Path(corpus) / "new_joints" / f"{clip_id}.npy"
+    if not f.is_file():
+        raise SimdiffError(f"{f}: missing (listed in manifest.json)")
+    return np.load(f)
 
 
 def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dict[str, Sequence[str]],
                   corpus: dict[str, list[float]], corpus_jumps: dict[str, list[bool]] | None = None,
-                  corpus_frames: dict[str, list[int]] | None = None) -> dict[str, Any]:
+                  corpus_frames: dict[str, list[int]] | None = None,
+                  captioned: dict[str, list[float]] | None = None) -> dict[str, Any]:
     """Per motion type: quartiles of the samples' speeds (and per prompt) against the corpus clips' (only those of
     about the samples' length, :func:`length_matched`, when ``corpus_frames`` gives the clips' lengths); how many
-    samples jump (a walk or run that jumps is not what was asked; the corpus clips' rate beside it when given)."""
+    samples jump (a walk or run that jumps is not what was asked; the corpus clips' rate beside it when given);
+    per prompt, the quartiles of ``captioned`` (:func:`captioned_speeds`) when given (no verdict)."""
     owners = _per_sample(batches)
     length = int(joints.shape[1])
     speeds = [root_speed(j) for j in joints]
@@ -154,6 +189,8 @@ def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dic
             "prompts": list(prompts), "samples": gen, "corpus_train": ref,
             **({} if lengths is None else {"corpus_train_all_lengths": quartiles(every)}),
             "per_prompt": {p: quartiles([v for v, b in zip(speeds, owners) if b.prompt == p]) for p in prompts},
+            **({} if captioned is None else
+               {"per_prompt_corpus_captioned": {p: quartiles(list(captioned.get(p, []))) for p in prompts}}),
             "never_touch": int(sum(f for f, b in zip(floating, owners) if b.prompt in prompts)),
             "jumping": _jumping([k for k, b in zip(jumping, owners) if b.prompt in prompts],
                                 None if corpus_jumps is None else corpus_jumps.get(kind, [])),

@@ -117,6 +117,12 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
                      f"{'—' if every is None else _q(every)} | "
                      f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} | "
                      f"{_jumping(t.get('jumping'))} |")
+    captioned = [(p, t["per_prompt"][p], q) for t in s["types"].values()
+                 for p, q in (t.get("per_prompt_corpus_captioned") or {}).items()]
+    if captioned:
+        lines += ["", "Per prompt, beside the corpus train clips captioned with the prompt itself, any length "
+                  "(no verdict):", "", "| prompt | samples | clips captioned so |", "|---|---|---|"]
+        lines += [f"| {p} | {_q(mine)} | {_q(ref) if ref['n'] else 'none'} |" for p, mine, ref in captioned]
     return lines
 
 

@@ -245,7 +245,7 @@ class ModelCheck:
                          lambda: jump_summary(self.samples("jumps", batches, EARTH), batches))
 
     def speeds(self) -> dict[str, Any]:
-        from simdiff.eval.model_check.prompts import SPEED_REFERENCE, corpus_clips, speed_summary
+        from simdiff.eval.model_check.prompts import SPEED_REFERENCE, captioned_speeds, corpus_clips, speed_summary
 
         c = self.config
 
@@ -253,13 +253,14 @@ class ModelCheck:
             try:
                 clips = corpus_clips(c.corpus, list(SPEED_PROMPTS), c.prompts.corpus_clips, c.seeds[0],
                                      c.prompts.length)
+                captioned = captioned_speeds(c.corpus, SPEED_PROMPTS)
             except SimdiffError as exc:
                 return {"skipped": str(exc)}
             batches = self.speed_batches()
             return speed_summary(self.samples("speeds", batches, EARTH), batches, SPEED_PROMPTS,
                                  {k: [v for v, _, _ in rows] for k, rows in clips.items()},
                                  {k: [j for _, j, _ in rows] for k, rows in clips.items()},
-                                 {k: [n for _, _, n in rows] for k, rows in clips.items()})
+                                 {k: [n for _, _, n in rows] for k, rows in clips.items()}, captioned)
 
         return self.part("speeds", {"prompts": SPEED_PROMPTS, "options": c.prompts.__dict__, **JUMPING_RULE,
                                     **SPEED_REFERENCE,
