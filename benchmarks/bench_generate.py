@@ -147,6 +147,15 @@ def summarise(runs: list[dict]) -> dict:
     }
 
 
+def _sampler_label(model: Path) -> str:
+    """What the command samples with: the model's ``sampling.json`` (simdiff generate's defaults) or the CLI's."""
+    path = Path(model) / "sampling.json"
+    stored = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    sampler = stored.get("sampler", "ddim")
+    return (f"{sampler}-{stored.get('steps', 50)}, guidance {stored.get('guidance', 2.5):g} (batched CFG), "
+            f"sampling.json: {json.dumps(stored, sort_keys=True) if stored else 'none'}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--model", type=Path, help="model folder (default: shipped model, else a random --preset one)")
@@ -201,7 +210,7 @@ def main() -> None:
                             + (["--env-guidance", f"{values[0]:g}"] if values[0] is not None else [])),
         "model": {"kind": kind, "path": str(model), "latent_dim": config["backbone"]["latent_dim"],
                   "num_layers": config["backbone"]["num_layers"], "simdiff": config["sim"] is not None},
-        "sampler": "ddim-50, guidance 2.5 (batched CFG)",
+        "sampler": _sampler_label(model),
         "threads": args.threads or "default (idle cores)",
         "threads_used": runs[0]["threads"],
         "machine": {"cpus": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version(),
