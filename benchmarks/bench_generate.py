@@ -149,8 +149,9 @@ def summarise(runs: list[dict]) -> dict:
 
 def _sampler_label(model: Path) -> str:
     """What the command samples with: the model's ``sampling.json`` (simdiff generate's defaults) or the CLI's."""
-    path = Path(model) / "sampling.json"
-    stored = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    from simdiff.model.default import sampling_defaults
+
+    stored = sampling_defaults(model)
     sampler = stored.get("sampler", "ddim")
     return (f"{sampler}-{stored.get('steps', 50)}, guidance {stored.get('guidance', 2.5):g} (batched CFG), "
             f"sampling.json: {json.dumps(stored, sort_keys=True) if stored else 'none'}")

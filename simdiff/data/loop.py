@@ -69,10 +69,10 @@ def _local(joints: np.ndarray) -> np.ndarray:
     return np.stack([c * x + s * z, rel[..., 1], -s * x + c * z], axis=-1)
 
 
-def _speed(joints: np.ndarray, start: int, stop: int) -> float:
-    """Mean horizontal root speed (m/s at 20 fps) from frame ``start`` to ``stop``."""
-    step = np.diff(joints[start : stop + 1, 0][:, [0, 2]], axis=0)
-    return float(np.linalg.norm(step, axis=-1).sum() / max(stop - start, 1) * FPS)
+def _path(joints: np.ndarray) -> np.ndarray:
+    """(T,) horizontal distance the root has travelled by each frame (m; 0 at frame 0)."""
+    step = np.linalg.norm(np.diff(joints[:, 0][:, [0, 2]], axis=0), axis=-1)
+    return np.concatenate([[0.0], np.cumsum(step)])
 
 
 def find_period(joints: np.ndarray, min_period: int = MIN_PERIOD, match: int = MATCH_FRAMES,
@@ -91,21 +91,22 @@ def find_period(joints: np.ndarray, min_period: int = MIN_PERIOD, match: int = M
     if len(x) - tail < min_period:
         raise SimdiffError(f"{len(x)} frames: too short to find a period of at least {min_period} frames")
     local = _local(x)
-    whole = _speed(x, 0, len(x) - 1)
+    path = _path(x)
+    whole = path[-1] / (len(x) - 1) * FPS
     if whole < MIN_SPEED:
         raise SimdiffError(f"the clip moves {whole:.2f} m/s (< {MIN_SPEED} m/s): nothing to loop")
-    best: Period | None = None
-    for start in range(0, len(x) - tail - min_period + 1):
-        for k in range(min_period, len(x) - tail - start + 1):
-            if abs(_speed(x, start, start + k) - whole) > tolerance * whole:
-                continue
-            error = float(np.linalg.norm(local[start + k : start + k + match] - local[start : start + match],
-                                         axis=-1).mean())
-            if best is None or error < best.error:
-                best = Period(start, k, error)
-    if best is None:
+    lags = np.arange(min_period, len(x) - tail + 1)
+    errors = np.full((len(x) - tail - min_period + 1, len(lags)), np.inf)  # [start, lag index]
+    for i, k in enumerate(lags):
+        starts = np.arange(len(x) - tail - k + 1)
+        speed = (path[starts + k] - path[starts]) / k * FPS
+        per_frame = np.linalg.norm(local[k:] - local[:-k], axis=-1).mean(axis=1)  # (T - k,) mean over joints
+        window = np.lib.stride_tricks.sliding_window_view(per_frame, match)[: len(starts)].mean(axis=1)
+        errors[starts, i] = np.where(np.abs(speed - whole) <= tolerance * whole, window, np.inf)
+    start, i = np.unravel_index(int(np.argmin(errors)), errors.shape)  # first minimum: earliest start, then lag
+    if not np.isfinite(errors[start, i]):
         raise SimdiffError(f"no period of {len(x)} frames moves within {tolerance:.0%} of the clip's {whole:.2f} m/s")
-    return best
+    return Period(int(start), int(lags[i]), float(errors[start, i]))
 
 
 def loop_joints(joints: np.ndarray, frames: int, period: int, blend: int = BLEND_FRAMES, start: int = 0) -> np.ndarray:
@@ -125,20 +126,14 @@ def loop_joints(joints: np.ndarray, frames: int, period: int, blend: int = BLEND
     ground = np.array([1.0, 0.0, 1.0])
     origin, target = x[0, 0] * ground, x[period, 0] * ground
 
-    def moved(p: np.ndarray, n: int) -> np.ndarray:
-        for _ in range(n):
-            p = (p - origin) @ turn.T + target
-        return p
-
-    copies = -(-frames // period) + 1
-    out = np.concatenate([moved(x[:period], n) for n in range(copies)])[:frames]
-    for n in range(1, copies):
-        start = n * period
-        for j in range(blend):
-            if start + j >= frames:
-                break
+    copies = [x[: period + blend]]  # copy n: frames [0, period + blend) moved n times (its tail: the continuation)
+    while len(copies) * period < frames:
+        copies.append((copies[-1] - origin) @ turn.T + target)
+    out = np.concatenate([c[:period] for c in copies])[:frames]
+    for n in range(1, len(copies)):
+        for j in range(min(blend, frames - n * period)):
             w = (j + 1) / (blend + 1)
-            out[start + j] = (1 - w) * moved(x[period + j], n - 1) + w * out[start + j]
+            out[n * period + j] = (1 - w) * copies[n - 1][period + j] + w * out[n * period + j]
     return out.astype(np.float32)
 
 
