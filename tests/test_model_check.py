@@ -16,7 +16,7 @@ from simdiff.eval.model_check import CheckConfig, ModelCheck, quick_preset, verd
 from simdiff.eval.model_check.detect import jump_stats, root_speed, standing_level, wilson
 from simdiff.eval.model_check.response import gravity_response, wind_response
 from simdiff.eval.model_check.samples import plan_batches
-from simdiff.eval.model_check.verdict import RULES, figures
+from simdiff.eval.model_check.verdict import CAPTIONED_MIN, RULES, figures
 from simdiff.motion.synthetic import jump, walk
 from simdiff.train.testing import HashTextEncoder
 
@@ -126,6 +126,27 @@ def test_verdict_rules_on_known_numbers() -> None:
     missing = {**good, "gt_fid": None, "gravity_ratio_apex": float("nan")}
     by = {v["check"]: v for v in verdicts(missing)}
     assert by["fid"]["passed"] is None and by["gravity_size"]["passed"] is None  # n/a, never a pass
+
+
+def test_speed_verdicts_judge_each_prompt_by_its_captioned_clips() -> None:
+    """Each prompt with >= CAPTIONED_MIN clips captioned with it is held to their [Q1, Q3]; one with fewer to its type's
+    length-matched clips; reports without per-prompt rows judge the type's median as before (session 78)."""
+    base = {"run_median": 1.5, "run_corpus_q1": 1.45, "run_corpus_q3": 1.72}
+    old = {v["check"]: v for v in verdicts(base)}["run_speed"]
+    assert old["passed"] is True and old["threshold"] == [1.45, 1.72]
+    rows = [["a person runs forward", 1.54, 2.52, 2.89, 50], ["a person jogs forward", 1.37, 1.88, 2.16, 6]]
+    slow = {v["check"]: v for v in verdicts({**base, "run_captioned": rows})}["run_speed"]
+    assert slow["passed"] is False and slow["value"] == [1.54, 1.37]
+    assert slow["threshold"] == [[2.52, 2.89], [1.88, 2.16]] and "outside" in slow["detail"]
+    fast = [["a person runs forward", 2.6, 2.52, 2.89, 50], ["a person jogs forward", 2.0, 1.88, 2.16, 6]]
+    assert {v["check"]: v for v in verdicts({**base, "run_captioned": fast})}["run_speed"]["passed"] is True
+    one_bad = [fast[0], ["a person jogs forward", 2.2, 1.88, 2.16, 6]]
+    assert {v["check"]: v for v in verdicts({**base, "run_captioned": one_bad})}["run_speed"]["passed"] is False
+    few = [fast[0], ["a person jogs forward", 1.6, 1.88, 2.16, CAPTIONED_MIN - 1]]  # too few clips: length-matched
+    v = {v["check"]: v for v in verdicts({**base, "run_captioned": few})}["run_speed"]
+    assert v["passed"] is True and v["threshold"][1] == [1.45, 1.72] and "about the samples' length" in v["detail"]
+    missing = [["a person runs forward", None, 2.52, 2.89, 50]]
+    assert {v["check"]: v for v in verdicts({**base, "run_captioned": missing})}["run_speed"]["passed"] is None
 
 
 def test_sliding_is_na_when_the_samples_hover() -> None:

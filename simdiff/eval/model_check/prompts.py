@@ -3,17 +3,17 @@
 * Jumps (:func:`jump_summary`): per prompt and over all, the fraction of samples that jump
   (:func:`simdiff.eval.model_check.detect.jump_stats`) with a Wilson 95 % interval over samples
   (samples of one prompt are not fully independent; the per-prompt rows show the spread).
-* Speeds (:func:`speed_summary`): quartiles of the samples' mean horizontal root speed per motion
-  type against the quartiles of the corpus's *train* clips of that ``motion_type`` and of about the samples'
-  length (:func:`length_matched`; ``manifest.json``; mirrors left out: they have their original's speed). A type
-  passes when the samples' median lies within those clips' interquartile range. The length matters: mocap runs are
-  short because capture volumes are (corpus3's train runs: median 2.90 m/s under 60 frames, 1.45 m/s at 120 frames
-  or more, session 65), so a 6 s sample is compared with the corpus's long clips; the all-lengths quartiles are
-  reported beside (no verdict), and so are, per prompt, the train clips captioned with the prompt itself
-  (:func:`captioned_speeds`, any length; session 77: corpus3's 28 long runs are all elderly or weary runs, while its
-  clips captioned "a person runs forward." run 2.65 m/s). Beside it (no verdict): how many
-  walk / run samples jump by the jump rule, against the corpus clips' rate over the samples' length (session 53:
-  a model pushed to jump more can start hopping when asked to walk).
+* Speeds (:func:`speed_summary`): quartiles of the samples' mean horizontal root speed per motion type and per
+  prompt; per prompt, the quartiles of the corpus's *train* clips captioned with the prompt itself
+  (:func:`captioned_speeds`, any length, originals only); per type, those of the train clips of that ``motion_type``
+  and of about the samples' length (:func:`length_matched`; ``manifest.json``; mirrors left out: they have their
+  original's speed) and of all lengths (no verdict). The verdicts (:mod:`~simdiff.eval.model_check.verdict`, session
+  78) hold each prompt's sample median to its captioned clips' interquartile range, or to the length-matched one when
+  fewer than five clips carry the caption. Why not length first, as in sessions 65-77: mocap runs are short because
+  capture volumes are, and corpus3's 28 runs of about 6 s are all elderly or weary runs, while its clips captioned
+  "a person runs forward." run 2.65 m/s (session 77). Beside them (no verdict): how many walk / run samples jump by
+  the jump rule, against the corpus clips' rate over the samples' length (session 53: a model pushed to jump more
+  can start hopping when asked to walk).
 
 Both count the samples that never touch the floor (``never_touch``,
 :func:`simdiff.motion.metrics.never_touches`); such a sample is not a jump.
@@ -31,6 +31,7 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.eval.model_check.detect import MIN_FLIGHT_S, MIN_RISE_M, jump_stats, quartiles, root_speed, wilson
 from simdiff.eval.model_check.samples import PromptBatch
+from simdiff.eval.model_check.verdict import CAPTIONED_MIN
 from simdiff.motion.metrics import FLOOR_CLEARANCE, never_touches
 
 STANDING_LEVEL: str = ("median pelvis height over the frames outside every flight (feet on the ground by the "
@@ -176,9 +177,12 @@ def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dic
                            "rule": "pass when the samples' median lies in the corpus train clips' [Q1, Q3]",
                            "types": {}}
     if corpus_frames is not None:
-        out["rule"] = (f"pass when the samples' median lies in [Q1, Q3] of the corpus train clips within "
+        out["rule"] = (f"the type's median in [Q1, Q3] of the corpus train clips within "
                        f"[{length / LENGTH_WINDOW:.0f}, {length * LENGTH_WINDOW:.0f}] frames (samples: {length}; "
                        f"the {MIN_MATCHED} closest in length when fewer)")
+    if captioned is not None:
+        out["rule"] = ("each prompt's sample median in [Q1, Q3] of the corpus train clips captioned with it (at least "
+                       f"{CAPTIONED_MIN}; else " + out["rule"].removeprefix("the type's median ") + ")")
     for kind, prompts in kinds.items():
         mine = [v for v, b in zip(speeds, owners) if b.prompt in prompts]
         every = list(corpus.get(kind, []))

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from simdiff.eval.model_check.verdict import CAPTIONED_MIN
+
 
 def _f(v: Any, digits: int = 3) -> str:
     if v is None:
@@ -108,7 +110,7 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
     if "skipped" in s:
         return [f"Not measured: {s['skipped']}."]
     lines = [f"Speed: {s['speed']}; {s['rule']}. Quartiles Q1 / median / Q3.", "",
-             "| type | prompts | samples | corpus train clips | all lengths (no verdict) | median in IQR | "
+             "| type | prompts | samples | corpus train clips of about that length | all lengths (no verdict) | median in IQR | "
              "never touch floor | jumping (corpus) |",
              "|---|---|---|---|---|---|---|---|"]
     for kind, t in s["types"].items():
@@ -121,7 +123,9 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
                  for p, q in (t.get("per_prompt_corpus_captioned") or {}).items()]
     if captioned:
         lines += ["", "Per prompt, beside the corpus train clips captioned with the prompt itself, any length "
-                  "(no verdict):", "", "| prompt | samples | clips captioned so |", "|---|---|---|"]
+                  "(the speed verdicts' reference when every prompt of the type has at least "
+                  f"{CAPTIONED_MIN} such clips; else the length-matched clips above are):", "",
+                  "| prompt | samples | clips captioned so |", "|---|---|---|"]
         lines += [f"| {p} | {_q(mine)} | {_q(ref) if ref['n'] else 'none'} |" for p, mine, ref in captioned]
     return lines
 
