@@ -123,8 +123,8 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
                  for p, q in (t.get("per_prompt_corpus_captioned") or {}).items()]
     if captioned:
         lines += ["", "Per prompt, beside the corpus train clips captioned with the prompt itself, any length "
-                  "(the speed verdicts' reference when every prompt of the type has at least "
-                  f"{CAPTIONED_MIN} such clips; else the length-matched clips above are):", "",
+                  "(the speed verdicts hold each prompt with at least "
+                  f"{CAPTIONED_MIN} such clips to them, the others to the length-matched clips above):", "",
                   "| prompt | samples | clips captioned so |", "|---|---|---|"]
         lines += [f"| {p} | {_q(mine)} | {_q(ref) if ref['n'] else 'none'} |" for p, mine, ref in captioned]
     return lines

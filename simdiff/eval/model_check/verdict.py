@@ -94,7 +94,9 @@ def _speed(f: dict[str, Any], kind: str) -> dict[str, Any]:
         band = [_num(c1), _num(c3)] if own else [q1, q3]
         m = _num(med)
         ok = None if m is None or None in band else band[0] <= m <= band[1]
-        meds.append(m), bands.append(band), judged.append(ok)
+        meds.append(m)
+        bands.append(band)
+        judged.append(ok)
         ref = f"{int(n)} clips captioned so" if own else "clips of about the samples' length"
         notes.append(f"{prompt}: {_fmt(m)} vs [{_fmt(band[0])}, {_fmt(band[1])}] of {ref}: "
                      f"{ {True: 'inside', False: 'outside', None: 'n/a'}[ok]}")
