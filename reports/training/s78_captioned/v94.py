@@ -18,6 +18,9 @@ from simdiff.eval.model_check.config import SPEED_PROMPTS
 from simdiff.eval.model_check.prompts import captioned_speeds, quartiles
 from simdiff.eval.model_check.verdict import figures, verdicts
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "s66_reference"))
+import v73  # noqa: E402  (rule 73's text and earth clauses)
+
 SHIPPED = Path(__file__).resolve().parents[1] / "s76_lambda" / "test" / "X93" / "check.json"
 CORPUS = Path(os.environ.get("SIMDIFF_SCRATCH", "/work/scratch/s39")) / "corpus3"
 
@@ -45,28 +48,21 @@ def line(v: dict) -> str:
 
 
 def main(kind: str, folder: str, extra: str | None = None) -> bool:
+    """text and earth: rule 73's clauses (v73.py) on today's verdicts; test: rule 94's own clause."""
+    v73.judged, v73.line = judged, line
+    if kind != "test":
+        return v73.main(kind, folder, extra)
     rep = judged(Path(folder) / "check.json")
     print(folder, "|", "; ".join(line(v) for v in rep.values()))
-    for k in ("walk_speed", "run_speed"):
-        if k in rep:
-            print(f"  {k}: {rep[k]['detail']}")
-    if kind == "text":
-        ok = all(rep[k]["passed"] for k in ("r_precision_top3", "fid"))
-    elif kind == "earth":
-        walk = int(extra)
-        ok = all(v["passed"] for v in rep.values()) and walk <= 3
-        print(f"walk guard {walk} of 64 (bar 3)")
-    elif kind == "test":
-        ok = all(v["passed"] for v in rep.values())
-        if not ok:
-            old = judged(SHIPPED)
-            kept = all(rep[k]["passed"] for k, v in old.items() if v["passed"] and k in rep)
-            gained = rep["run_speed"]["passed"] and not old["run_speed"]["passed"]
-            print(f"not every verdict passes; X93's test passes kept: {kept}; run_speed gained: {gained}")
-            ok = kept and gained
-        print("SHIP" if ok else "DO NOT SHIP")
-    else:
-        raise SystemExit(f"v94.py: unknown kind {kind!r} (earth, text or test)")
+    print("\n".join(f"  {k}: {rep[k]['detail']}" for k in ("walk_speed", "run_speed") if k in rep))
+    ok = all(v["passed"] for v in rep.values())
+    if not ok:
+        old = judged(SHIPPED)
+        kept = all(rep[k]["passed"] for k, v in old.items() if v["passed"] and k in rep)
+        gained = rep["run_speed"]["passed"] and not old["run_speed"]["passed"]
+        print(f"not every verdict passes; X93's test passes kept: {kept}; run_speed gained: {gained}")
+        ok = kept and gained
+    print("SHIP" if ok else "DO NOT SHIP")
     print("PASS" if ok else "FAIL")
     return ok
 
