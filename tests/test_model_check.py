@@ -129,8 +129,9 @@ def test_verdict_rules_on_known_numbers() -> None:
 
 
 def test_speed_verdicts_judge_each_prompt_by_its_captioned_clips() -> None:
-    """Each prompt with >= CAPTIONED_MIN clips captioned with it is held to their [Q1, Q3]; one with fewer to its type's
-    length-matched clips; reports without per-prompt rows judge the type's median as before (session 78)."""
+    """Each prompt with >= CAPTIONED_MIN clips captioned with it is held to their [Q1, Q3]; one with fewer to the clips
+    captioned with any of its type's prompts, else to its type's length-matched clips; reports without per-prompt rows
+    judge the type's median as before (session 78)."""
     base = {"run_median": 1.5, "run_corpus_q1": 1.45, "run_corpus_q3": 1.72}
     old = {v["check"]: v for v in verdicts(base)}["run_speed"]
     assert old["passed"] is True and old["threshold"] == [1.45, 1.72]
@@ -145,6 +146,9 @@ def test_speed_verdicts_judge_each_prompt_by_its_captioned_clips() -> None:
     few = [fast[0], ["a person jogs forward", 1.6, 1.88, 2.16, CAPTIONED_MIN - 1]]  # too few clips: length-matched
     v = {v["check"]: v for v in verdicts({**base, "run_captioned": few})}["run_speed"]
     assert v["passed"] is True and v["threshold"][1] == [1.45, 1.72] and "about the samples' length" in v["detail"]
+    pooled = {"run_captioned": few, "run_captioned_pool": [2.4, 2.8, 56]}  # too few: the type's captioned clips first
+    v = {v["check"]: v for v in verdicts({**base, **pooled})}["run_speed"]
+    assert v["passed"] is False and v["threshold"][1] == [2.4, 2.8] and "with a run prompt" in v["detail"]
     missing = [["a person runs forward", None, 2.52, 2.89, 50]]
     assert {v["check"]: v for v in verdicts({**base, "run_captioned": missing})}["run_speed"]["passed"] is None
 
@@ -235,22 +239,27 @@ def test_captioned_reference_takes_the_train_clips_captioned_with_the_prompt(tmp
             ("mirror", "train", "run", "fast", ["a person runs forward."], 9.0),  # a mirror: its original's speed
             ("slow", "train", "run", None, ["a person runs forward like an elderly person."], 1.4),
             ("test", "test", "run", None, ["a person runs forward."], 9.0),  # not train
-            ("walker", "train", "walk", None, ["a person runs forward."], 9.0)]  # another motion type
+            ("walker", "train", "walk", None, ["a person runs forward."], 9.0),  # another motion type
+            ("both", "train", "run", None, ["a person jogs forward.", "a person runs forward"], 2.0)]
     for clip_id, _, _, _, _, speed in rows:
         np.save(tmp_path / "new_joints" / f"{clip_id}.npy", walk(80, speed=speed).astype(np.float32))
     (tmp_path / "manifest.json").write_text(json.dumps({"clips": [
         {"id": i, "split": sp, "motion_type": k, "mirror_of": m, "captions": c} for i, sp, k, m, c, _ in rows]}))
     kinds = {"run": ["a person runs forward", "a person jogs forward"]}
     got = captioned_speeds(tmp_path, kinds)
-    assert got["a person jogs forward"] == [] and sorted(got["a person runs forward"]) == pytest.approx([2.6, 3.0], rel=0.02)
+    assert sorted(got["a person runs forward"]) == pytest.approx([2.0, 2.6, 3.0], rel=0.02)
+    assert got["a person jogs forward"] == pytest.approx([2.0], rel=0.02)
+    assert sorted(got["run:*"]) == pytest.approx([2.0, 2.6, 3.0], rel=0.02)  # a clip with both captions counts once
     joints = np.stack([walk(80, speed=1.5), walk(80, speed=2.8)])
     out = speed_summary(joints, plan_batches(kinds["run"], 1, [0]), kinds, {"run": [1.4, 1.5, 1.6]}, None, None, got)
     ref = out["types"]["run"]["per_prompt_corpus_captioned"]
-    assert ref["a person runs forward"]["median"] == pytest.approx(2.8, rel=0.02) and ref["a person jogs forward"]["n"] == 0
+    assert ref["a person runs forward"]["median"] == pytest.approx(2.6, rel=0.02) and ref["a person jogs forward"]["n"] == 1
+    assert out["types"]["run"]["corpus_captioned_any_prompt"]["n"] == 3
     assert out["types"]["run"]["median_in_iqr"] is False  # the verdict's reference is unchanged (1.4-1.6)
     text = "\n".join(_speed_lines(out))
-    assert "| a person runs forward | 1.50 / 1.50 / 1.50 (n 1) | 2.70 / 2.80 / 2.90 (n 2) |" in text
-    assert "| a person jogs forward |" in text and "| none |" in text
+    assert "| a person runs forward | 1.50 / 1.50 / 1.50 (n 1) | 2.30 / 2.60 / 2.80 (n 3) |" in text
+    assert "| a person jogs forward | 2.80 / 2.80 / 2.80 (n 1) | 2.00 / 2.00 / 2.00 (n 1) |" in text
+    assert "| any run prompt | 1.83 / 2.15 / 2.48 (n 2) | 2.30 / 2.60 / 2.80 (n 3) |" in text
     assert "per_prompt_corpus_captioned" not in speed_summary(joints, plan_batches(kinds["run"], 1, [0]), kinds,
                                                                {"run": [1.5]})["types"]["run"]
 

@@ -35,8 +35,9 @@ def main(folder: str, report: str) -> bool:
             q = cap[p]
             rows.append([p, float(np.median(v)), q["q1"], q["q3"], q["n"]])
             print(f"{p}: n {len(v)} Q1/median/Q3 {np.percentile(v, [25, 50, 75]).round(3).tolist()}")
+        pool = ref["corpus_captioned_any_prompt"]
         f = {f"{kind}_captioned": rows, f"{kind}_corpus_q1": ref["corpus_train"]["q1"],
-             f"{kind}_corpus_q3": ref["corpus_train"]["q3"]}
+             f"{kind}_corpus_q3": ref["corpus_train"]["q3"], f"{kind}_captioned_pool": [pool["q1"], pool["q3"], pool["n"]]}
         v = _speed(f, kind)
         print(f"{kind}: {'PASS' if v['passed'] else 'FAIL'} ({v['detail']})")
         ok = ok and bool(v["passed"])

@@ -1,7 +1,9 @@
 """Rule 94's verdicts from one model-check report, recomputed with today's verdict code
 (simdiff/eval/model_check/verdict.py: walk and run speeds per prompt against the corpus train clips captioned with it,
-session 78). Reports written before session 77 lack those clips' quartiles; they are filled in from the corpus
-(captioned_speeds on corpus3) before the verdicts are recomputed. Exit 0 on a pass.
+session 78). Reports written before session 78 lack some of those clips' quartiles; they are filled in from the corpus
+(captioned_speeds on corpus3) before the verdicts are recomputed. Rule 94 ran with the first session-78 rule (a prompt
+with fewer than 5 captioned clips held to the length-matched clips); rule 95 with the second (to the clips captioned
+with any prompt of its type first); rule94_stages.txt keeps what rule 94's screen printed. Exit 0 on a pass.
 python v94.py earth DIR WG   B: every verdict the report gives passes, and WG (walking samples that jump) <= 3 of 64
 python v94.py text DIR       C+: r_precision_top3 and fid pass
 python v94.py test DIR       T: every verdict passes -> SHIP (and resolve); else SHIP only if every verdict the shipped
@@ -15,7 +17,7 @@ import sys
 from pathlib import Path
 
 from simdiff.eval.model_check.config import SPEED_PROMPTS
-from simdiff.eval.model_check.prompts import captioned_speeds, quartiles
+from simdiff.eval.model_check.prompts import captioned_speeds, pool_key, quartiles
 from simdiff.eval.model_check.verdict import figures, verdicts
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "s66_reference"))
@@ -29,10 +31,11 @@ def filled(path: Path) -> dict:
     """The report at ``path`` with the captioned clips' quartiles filled in where it lacks them."""
     report = json.loads(path.read_text())
     types = (report.get("speeds") or {}).get("types") or {}
-    if any("per_prompt_corpus_captioned" not in t for t in types.values()):
+    if any("corpus_captioned_any_prompt" not in t for t in types.values()):
         captioned = captioned_speeds(CORPUS, SPEED_PROMPTS)
-        for t in types.values():
+        for kind, t in types.items():
             t["per_prompt_corpus_captioned"] = {p: quartiles(captioned.get(p, [])) for p in t["prompts"]}
+            t["corpus_captioned_any_prompt"] = quartiles(captioned.get(pool_key(kind), []))
     return report
 
 

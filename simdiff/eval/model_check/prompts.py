@@ -8,8 +8,9 @@
   (:func:`captioned_speeds`, any length, originals only); per type, those of the train clips of that ``motion_type``
   and of about the samples' length (:func:`length_matched`; ``manifest.json``; mirrors left out: they have their
   original's speed) and of all lengths (no verdict). The verdicts (:mod:`~simdiff.eval.model_check.verdict`, session
-  78) hold each prompt's sample median to its captioned clips' interquartile range, or to the length-matched one when
-  fewer than five clips carry the caption. Why not length first, as in sessions 65-77: mocap runs are short because
+  78) hold each prompt's sample median to its captioned clips' interquartile range; when fewer than five clips carry
+  the caption, to that of the clips carrying any of its type's prompts; when those are fewer too, to the
+  length-matched one. Why not length first, as in sessions 65-77: mocap runs are short because
   capture volumes are, and corpus3's 28 runs of about 6 s are all elderly or weary runs, while its clips captioned
   "a person runs forward." run 2.65 m/s (session 77). Beside them (no verdict): how many walk / run samples jump by
   the jump rule, against the corpus clips' rate over the samples' length (session 53: a model pushed to jump more
@@ -123,20 +124,30 @@ def _caption_key(text: str) -> str:
 
 def captioned_speeds(corpus: str | Path, kinds: dict[str, Sequence[str]]) -> dict[str, list[float]]:
     """Per prompt: mean horizontal root speeds (m/s) of the corpus's train clips (originals) of the prompt's motion
-    type any of whose captions is the prompt itself (case and the final full stop ignored), whatever their length.
+    type any of whose captions is the prompt itself (case and the final full stop ignored), whatever their length;
+    and per motion type (key ``"<type>:*"``), those of the clips captioned with any of the type's prompts, each clip
+    once (the reference of a prompt too few clips carry, :data:`~simdiff.eval.model_check.verdict.CAPTIONED_MIN`).
 
     Raises:
         SimdiffError: as :func:`corpus_clips`.
     """
     wanted = {_caption_key(p): (kind, p) for kind, prompts in kinds.items() for p in prompts}
     out: dict[str, list[float]] = {p: [] for prompts in kinds.values() for p in prompts}
+    out.update({pool_key(kind): [] for kind in kinds})
     for clip in _train_originals(corpus):
         keys = {_caption_key(c) for c in clip.get("captions", []) if isinstance(c, str)}
-        for key in sorted(keys & wanted.keys()):
-            kind, prompt = wanted[key]
-            if clip["motion_type"] == kind:
-                out[prompt].append(root_speed(_clip_joints(corpus, clip["id"])))
+        hits = [wanted[k][1] for k in sorted(keys & wanted.keys()) if wanted[k][0] == clip["motion_type"]]
+        if hits:
+            speed = root_speed(_clip_joints(corpus, clip["id"]))
+            for prompt in hits:
+                out[prompt].append(speed)
+            out[pool_key(clip["motion_type"])].append(speed)
     return out
+
+
+def pool_key(kind: str) -> str:
+    """:func:`captioned_speeds`' key for the clips captioned with any prompt of ``kind``."""
+    return f"{kind}:*"
 
 
 def _train_originals(corpus: str | Path) -> list[dict[str, Any]]:
@@ -182,7 +193,7 @@ def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dic
                        f"the {MIN_MATCHED} closest in length when fewer)")
     if captioned is not None:
         out["rule"] = ("each prompt's sample median in [Q1, Q3] of the corpus train clips captioned with it (at least "
-                       f"{CAPTIONED_MIN}; else " + out["rule"].removeprefix("the type's median ") + ")")
+                       f"{CAPTIONED_MIN}; else with any of its type's prompts; else " + out["rule"].removeprefix("the type's median ") + ")")
     for kind, prompts in kinds.items():
         mine = [v for v, b in zip(speeds, owners) if b.prompt in prompts]
         every = list(corpus.get(kind, []))
@@ -194,7 +205,8 @@ def speed_summary(joints: np.ndarray, batches: Sequence[PromptBatch], kinds: dic
             **({} if lengths is None else {"corpus_train_all_lengths": quartiles(every)}),
             "per_prompt": {p: quartiles([v for v, b in zip(speeds, owners) if b.prompt == p]) for p in prompts},
             **({} if captioned is None else
-               {"per_prompt_corpus_captioned": {p: quartiles(list(captioned.get(p, []))) for p in prompts}}),
+               {"per_prompt_corpus_captioned": {p: quartiles(list(captioned.get(p, []))) for p in prompts},
+                "corpus_captioned_any_prompt": quartiles(list(captioned.get(pool_key(kind), [])))}),
             "never_touch": int(sum(f for f, b in zip(floating, owners) if b.prompt in prompts)),
             "jumping": _jumping([k for k, b in zip(jumping, owners) if b.prompt in prompts],
                                 None if corpus_jumps is None else corpus_jumps.get(kind, [])),

@@ -119,14 +119,18 @@ def _speed_lines(s: dict[str, Any]) -> list[str]:
                      f"{'—' if every is None else _q(every)} | "
                      f"{'yes' if t['median_in_iqr'] else 'no'} | {t.get('never_touch', '—')} | "
                      f"{_jumping(t.get('jumping'))} |")
-    captioned = [(p, t["per_prompt"][p], q) for t in s["types"].values()
-                 for p, q in (t.get("per_prompt_corpus_captioned") or {}).items()]
-    if captioned:
+    if any(t.get("per_prompt_corpus_captioned") for t in s["types"].values()):
         lines += ["", "Per prompt, beside the corpus train clips captioned with the prompt itself, any length "
                   "(the speed verdicts hold each prompt with at least "
-                  f"{CAPTIONED_MIN} such clips to them, the others to the length-matched clips above):", "",
+                  f"{CAPTIONED_MIN} such clips to them, the others to the clips captioned with any prompt of their "
+                  "type, last row of each type, or when those are fewer to the length-matched clips above):", "",
                   "| prompt | samples | clips captioned so |", "|---|---|---|"]
-        lines += [f"| {p} | {_q(mine)} | {_q(ref) if ref['n'] else 'none'} |" for p, mine, ref in captioned]
+        for kind, t in s["types"].items():
+            lines += [f"| {p} | {_q(t['per_prompt'][p])} | {_q(ref) if ref['n'] else 'none'} |"
+                      for p, ref in (t.get("per_prompt_corpus_captioned") or {}).items()]
+            pool = t.get("corpus_captioned_any_prompt")
+            if pool is not None:
+                lines.append(f"| any {kind} prompt | {_q(t['samples'])} | {_q(pool) if pool['n'] else 'none'} |")
     return lines
 
 
