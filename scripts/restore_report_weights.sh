@@ -26,3 +26,4 @@ restore 4ec5b0d 'reports/training/s28_gpu_adapters/env_response/SimDiff_GPU_pair
 restore 0f8ad48 'reports/training/s28_gpu_adapters/env_response_flight/SimDiff_GPU_pair10f__α___0.5.json' 7e131d941b82d79e
 restore 0f8ad48 'reports/training/s28_gpu_adapters/env_response_flight/SimDiff_GPU_pair10f__α___1.json' bb6f3c55e6e15c19
 restore 3f24dad 'reports/training/s76_lambda/X93_model/model.safetensors' 856504f9169ba456
+restore 96adcbf 'reports/training/s78_captioned/X95_model/model.safetensors' 5801f52673e8d161
