@@ -8,6 +8,19 @@ cd /work/main; . .venv/bin/activate
 R=reports/training/s78_captioned; W=/work/scratch/s78; RUN=/work/scratch/s77/train94
 X93=${X93:-reports/training/s76_lambda/X93_model}; OUT=$R/rule95_stages.txt
 stamp() { echo "[$(date -u +%H:%M)] $*" >&2; }
+K=$R/X95_model  # the committed copy of the chosen weights (scripts/restore_report_weights.sh brings them back)
+if grep -q "^X95 = X94_800 (5801f52673e8d161)" $OUT 2>/dev/null; then  # S' ran (session 78): straight to the stages
+  M=$W/models/X94_800
+  if [ ! -f $M/model.safetensors ]; then
+    [ -f $K/model.safetensors ] || bash scripts/restore_report_weights.sh > /dev/null
+    mkdir -p $M && cp $K/* $M/
+  fi
+  sha256sum $M/model.safetensors | grep -q ^5801f52673e8d161 || { echo "X95's weights do not hash to 5801f526..." >&2; exit 1; }
+  RULE=95 N=X95 M=$M AS=170 GUIDANCE=3.0 PROBE_W=3.0 B_SEEDS="8 9" B_VERDICT="python $R/v94.py earth" \
+    T_VERDICT="python $R/v94.py test" STAGES="${STAGES:-A B T Cplus}" STAGES_OUT=$OUT \
+    bash reports/training/s74_sim_reference/run87.sh
+  exit 0
+fi
 until [ -f $W/fine1000/model.safetensors ]; do sleep 20; done
 until [ "$(cat $RUN/checkpoints/latest 2>/dev/null)" = "step_000001200" ] && ! pgrep -f "train backbone --data /work/scratch/s77/c3loop" > /dev/null; do sleep 20; done
 [ -f $W/fine1200/model.safetensors ] || { mkdir -p $W/fine1200.tmp && cp $RUN/model/* $W/fine1200.tmp/ && mv $W/fine1200.tmp $W/fine1200; }
