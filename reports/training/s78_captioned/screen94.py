@@ -5,7 +5,6 @@ type, read from REPORT, a model-check report on corpus3 at 120 frames); jumps of
 from __future__ import annotations
 
 import glob
-import json
 import sys
 from pathlib import Path
 
@@ -13,8 +12,7 @@ import numpy as np
 
 from simdiff.eval.model_check.config import SPEED_PROMPTS
 from simdiff.eval.model_check.detect import jump_stats, root_speed
-from simdiff.eval.model_check.verdict import _speed
-from v94 import filled
+from v94 import filled, speed_verdict
 
 
 def joints(folder: str) -> list[np.ndarray]:
@@ -28,17 +26,12 @@ def main(folder: str, report: str) -> bool:
     types = filled(Path(report))["speeds"]["types"]
     ok = True
     for kind, prompts in SPEED_PROMPTS.items():
-        ref, cap = types[kind], types[kind]["per_prompt_corpus_captioned"]
-        rows = []
+        medians = {}
         for p in prompts:
             v = [root_speed(j) for j in joints(f"{folder}/{p.replace(' ', '_')}")]
-            q = cap[p]
-            rows.append([p, float(np.median(v)), q["q1"], q["q3"], q["n"]])
+            medians[p] = float(np.median(v))
             print(f"{p}: n {len(v)} Q1/median/Q3 {np.percentile(v, [25, 50, 75]).round(3).tolist()}")
-        pool = ref["corpus_captioned_any_prompt"]
-        f = {f"{kind}_captioned": rows, f"{kind}_corpus_q1": ref["corpus_train"]["q1"],
-             f"{kind}_corpus_q3": ref["corpus_train"]["q3"], f"{kind}_captioned_pool": [pool["q1"], pool["q3"], pool["n"]]}
-        v = _speed(f, kind)
+        v = speed_verdict(types, kind, medians)
         print(f"{kind}: {'PASS' if v['passed'] else 'FAIL'} ({v['detail']})")
         ok = ok and bool(v["passed"])
     jumps = joints(f"{folder}/a_person_jumps_forward")

@@ -12,8 +12,7 @@ import numpy as np
 
 from simdiff.eval.model_check.config import SPEED_PROMPTS
 from simdiff.eval.model_check.detect import jump_stats, root_speed
-from simdiff.eval.model_check.verdict import _speed
-from v94 import filled
+from v94 import filled, speed_verdict
 
 SEEDS = (704, 705, 706, 707)
 
@@ -29,15 +28,10 @@ def judge(cand: str, types: dict) -> float | None:
     """The candidate's smallest margin (None when it fails)."""
     margins, ok = [], True
     for kind, prompts in SPEED_PROMPTS.items():
-        t, rows = types[kind], []
-        for p in prompts:
-            v = [root_speed(j) for s in SEEDS for j in joints(f"{cand}/{s}/{p.replace(' ', '_')}/sample*_joints.npy")]
-            q = t["per_prompt_corpus_captioned"][p]
-            rows.append([p, float(np.median(v)), q["q1"], q["q3"], q["n"]])
-        pool = t["corpus_captioned_any_prompt"]
-        f = {f"{kind}_captioned": rows, f"{kind}_corpus_q1": t["corpus_train"]["q1"],
-             f"{kind}_corpus_q3": t["corpus_train"]["q3"], f"{kind}_captioned_pool": [pool["q1"], pool["q3"], pool["n"]]}
-        v = _speed(f, kind)
+        medians = {p: float(np.median([root_speed(j) for s in SEEDS
+                                       for j in joints(f"{cand}/{s}/{p.replace(' ', '_')}/sample*_joints.npy")]))
+                   for p in prompts}
+        v = speed_verdict(types, kind, medians)
         print(f"  {kind}: {'pass' if v['passed'] else 'FAIL'} ({v['detail']})")
         ok = ok and bool(v["passed"])
         margins += [min(m - lo, hi - m) / (hi - lo) for m, (lo, hi) in zip(v["value"], v["threshold"])]

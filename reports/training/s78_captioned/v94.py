@@ -39,6 +39,13 @@ def filled(path: Path) -> dict:
     return report
 
 
+def speed_verdict(types: dict, kind: str, medians: dict[str, float]) -> dict:
+    """Today's ``{kind}_speed`` verdict for sample medians per prompt (m/s), against the references in ``types`` (a
+    filled report's ``speeds.types``), through the model check's own figures / verdicts."""
+    t = {**types[kind], "per_prompt": {p: {"median": m} for p, m in medians.items()}}
+    return next(v for v in verdicts(figures({"speeds": {"types": {kind: t}}})) if v["check"] == f"{kind}_speed")
+
+
 def judged(path: Path) -> dict[str, dict]:
     """check name -> verdict under today's rules, for the verdicts that were judged (passed True or False)."""
     return {v["check"]: v for v in verdicts(figures(filled(path))) if v["passed"] is not None}
