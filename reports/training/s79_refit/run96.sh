@@ -12,7 +12,7 @@ M=$W/models/X96
 if [ ! -f $M/model.safetensors ]; then
   for s in 300 600; do
     P=/work/scratch/s74/X96_${s}_probe.log
-    [ -s $P ] || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $W/snap_$s > $P 2>&1
+    grep -qs "^{" $P || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $W/snap_$s > $P 2>&1
     L=$(python reports/training/s72_lowloc/gate84.py $P 96 0.209)
     echo "step $s ($(sha256sum $W/snap_$s/model.safetensors | cut -c1-16)): $L" | tee -a $OUT
     if echo "$L" | grep -q "gate PASS"; then
