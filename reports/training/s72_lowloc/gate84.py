@@ -7,7 +7,10 @@ count."""
 import json
 import sys
 
-r = [json.loads(line) for line in open(sys.argv[1]) if line.startswith("{")][-1]
+rows = [json.loads(line) for line in open(sys.argv[1]) if line.startswith("{")]
+if not rows:
+    sys.exit(f"{sys.argv[1]}: no result line (a JSON line from env_probe.py): the probe failed or did not finish")
+r = rows[-1]
 bar = float(sys.argv[3])
 wind = sum(v["downwind"] for v in r["wind"].values())
 if "glides_low_g" not in r.get("moon", {}):
