@@ -9,6 +9,20 @@ D=simdiff/assets/default_model
 cp $X/model.safetensors $X/config.json $X/provenance.json $D/
 python -c "import json,sys; open(sys.argv[2],'w').write(json.dumps(json.load(open(sys.argv[1])), indent=2) + '\n')" \
   $X/sampling.json $D/sampling.json
+python - $D/provenance.json <<'PY'  # the trainer merges equal entries, so say what sessions 78 and 79 added
+import json, sys
+p = json.load(open(sys.argv[1]))
+for e in p["trained_on"]:
+    if e["data"] == "c3loop" and not e.get("note"):
+        e["note"] = ("session 78: the session-75 backbone fine-tuned 800 steps of batch 64 on 2 CPU cores (lr 1e-4, "
+                     "EMA 0.995, seed 94) on corpus3's train_jumpx plus 514 run loops (`simdiff data loop`; "
+                     "reports/training/s77_run_speed/train94.sh, rule 95's X95)")
+    elif e["what"] == "adapters" and e.get("note", "").startswith("simulated from corpus") and "session 79" not in e["note"]:
+        e["note"] += ("; session 79: the adapters and Sim Encoder re-fitted 300 steps of batch 64 on 2 CPU cores on the "
+                      "frozen session-78 backbone (seed 96; packs rebuilt with their original commands, split big79; "
+                      "reports/training/s79_refit/)")
+open(sys.argv[1], "w").write(json.dumps(p, indent=2) + "\n")
+PY
 mkdir -p $R/test/X96 && cp $T/check.json $T/check.md $R/test/X96/
 sed -i 's#reports/training/s76_lambda/test/X93/check.json#reports/training/s79_refit/test/X96/check.json#' \
   tests/test_default_model.py
