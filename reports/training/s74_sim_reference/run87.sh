@@ -20,7 +20,7 @@ guard() {  # $1 phi, $2 seeds, $3 folder, $4 scratch (corpus3/ and eval/)
 }
 stage_gate() {  # rule 84's gate (env_probe seeds 7000+, gate84.py with speed bar 0.209)
   PROBE=/work/scratch/s74/${N}_probe.log
-  [ -s $PROBE ] || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $M > $PROBE 2>&1
+  grep -qs "^{" $PROBE || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $M > $PROBE 2>&1
   python reports/training/s72_lowloc/gate84.py "$PROBE" $RULE 0.209 | tee -a $OUT | grep -q "gate PASS"
 }
 stage_A() {  # seeds AS AS+1, 32 samples per jump prompt
