@@ -6,17 +6,19 @@
 # first (STAGES="gate A Cpp B Cplus T"); B' seeds stay 2 3 (at Earth X88 samples what X86 samples).
 # Session 76: GUIDANCE (default 2.5), B_SEEDS, B_VERDICT and T_VERDICT (rule 93); the walk guard count is WG (it was W,
 # which then set the guidance of C+ and T to the count: no rule had reached C+ or T through this script).
+# Session 80: SE (environment guidance, default 1) and EDIT_T (default 900) from the environment (rule 98).
 set -u
 cd /work/main; . .venv/bin/activate
 RULE=${RULE:-87} N=${N:-X86} M=${M:-/work/scratch/s73/models/X86_model} CPP_SEEDS=${CPP_SEEDS:-3 4} AS=${AS:-160}
 R=reports/training/s74_sim_reference; V=reports/training/s66_reference; S=/work/scratch/s39; OUT=${STAGES_OUT:-$R/rule${RULE}_stages.txt}
 REF=/work/scratch/s74/ref
-export STEPS=50 W=${GUIDANCE:-2.5} ALPHA=0.925 ANCHOR=edit ANCHOR_ALPHA=0 AA=0 EDIT_T=900 ETA=1 BALLISTIC= FB=
+export STEPS=50 W=${GUIDANCE:-2.5} ALPHA=0.925 ANCHOR=edit ANCHOR_ALPHA=0 AA=0 EDIT_T=${EDIT_T:-900} ETA=1 BALLISTIC= FB=
+SE=${SE:-1}  # environment guidance s_e of every stage (session 80, rule 98; it was always 1)
 export PROBE_ANCHOR=edit PROBE_ANCHOR_ALPHA=0  # the walk guard as run73.sh ran it for rule 86
 stamp() { echo "[$(date -u +%H:%M)] $*" >&2; }
 guard() {  # $1 phi, $2 seeds, $3 folder, $4 scratch (corpus3/ and eval/)
   [ -f $3/$1/check.json ] || SIMDIFF_SCRATCH=$4 SEEDS="$2" /usr/bin/time -f "stage $3 %e s" \
-    python reports/training/s37_env_guidance/guard.py $1 1 $3/$1 $M >&2 || exit 1
+    python reports/training/s37_env_guidance/guard.py $1 $SE $3/$1 $M >&2 || exit 1
 }
 stage_gate() {  # rule 84's gate (env_probe seeds 7000+, gate84.py with speed bar 0.209)
   PROBE=/work/scratch/s74/${N}_probe.log
@@ -25,7 +27,7 @@ stage_gate() {  # rule 84's gate (env_probe seeds 7000+, gate84.py with speed ba
 }
 stage_A() {  # seeds AS AS+1, 32 samples per jump prompt
   A=$S/eval11/A_${N}_s$AS
-  [ -f $A/check.json ] || JS=32 ASEEDS="$AS $((AS + 1))" bash reports/training/s39_drift_gpu/check.sh A ${N}_s$AS $M 1
+  [ -f $A/check.json ] || JS=32 ASEEDS="$AS $((AS + 1))" bash reports/training/s39_drift_gpu/check.sh A ${N}_s$AS $M $SE
   python reports/training/s57_pooled_a/stage_a55.py $A | tee -a $OUT | grep -q PASS
 }
 stage_Cpp() {
@@ -36,7 +38,7 @@ stage_Cpp() {
 }
 stage_B() {  # B_SEEDS (default "2 3"); B_VERDICT (default v87.py) takes the report folder and the walk guard count
   local bs=${B_SEEDS:-2 3}; B=$S/eval11/B_${N}_s${bs// /}
-  [ -f $B/check.json ] || BSEEDS="$bs" bash reports/training/s39_drift_gpu/check.sh B ${N}_s${bs// /} $M 1
+  [ -f $B/check.json ] || BSEEDS="$bs" bash reports/training/s39_drift_gpu/check.sh B ${N}_s${bs// /} $M $SE
   WG=$(cd reports/training/s53_extrapolate && python walk_probe.py $M | tee /work/scratch/s74/walk$RULE.txt \
     | sed -n 's/.*jumping \([0-9]*\)\/.*/\1/p')  # WG, not W: W is the guidance the stages after this one use
   { echo -n "B' Earth seeds $bs: "; ${B_VERDICT:-python $R/v87.py} $B "$WG"; } | tee -a $OUT | grep -q PASS
@@ -47,7 +49,7 @@ stage_Cplus() {
 }
 stage_T() {
   T=$S/eval11/T_$N
-  [ -f $T/check.json ] || bash reports/training/s39_drift_gpu/check.sh T $N $M 1
+  [ -f $T/check.json ] || bash reports/training/s39_drift_gpu/check.sh T $N $M $SE
   { echo -n "T test seeds 0-4: "; ${T_VERDICT:-python $V/v73.py test} $T; } | tee -a $OUT
 }
 for st in ${STAGES:-Cpp B Cplus T}; do
