@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Rule 96's ship step, run only when v94.py test says SHIP: X96 becomes simdiff/assets/default_model (weights,
 # config, provenance, sampling), its test check goes to test/X96/ and tests/test_default_model.py points at it.
+# Later rules on the same weights set N (name), X (model folder) and R (their report folder); session 80: rule 98.
 set -euo pipefail
 cd /work/main; . .venv/bin/activate
-R=reports/training/s79_refit; V=reports/training/s78_captioned; T=/work/scratch/s39/eval11/T_X96; X=/work/scratch/s79/models/X96
-python $V/v94.py test $T | grep -qx SHIP || { echo "ship96: T does not say SHIP" >&2; exit 1; }
+N=${N:-X96} R=${R:-reports/training/s79_refit} X=${X:-/work/scratch/s79/models/X96}
+V=reports/training/s78_captioned; T=/work/scratch/s39/eval11/T_$N
+python $V/v94.py test $T | grep -qx SHIP || { echo "ship96 ($N): T does not say SHIP" >&2; exit 1; }
 D=simdiff/assets/default_model
 cp $X/model.safetensors $X/config.json $X/provenance.json $D/
 python -c "import json,sys; open(sys.argv[2],'w').write(json.dumps(json.load(open(sys.argv[1])), indent=2) + '\n')" \
@@ -23,7 +25,6 @@ for e in p["trained_on"]:
                       "reports/training/s79_refit/)")
 open(sys.argv[1], "w").write(json.dumps(p, indent=2) + "\n")
 PY
-mkdir -p $R/test/X96 && cp $T/check.json $T/check.md $R/test/X96/
-sed -i 's#reports/training/s76_lambda/test/X93/check.json#reports/training/s79_refit/test/X96/check.json#' \
-  tests/test_default_model.py
+mkdir -p $R/test/$N && cp $T/check.json $T/check.md $R/test/$N/
+sed -i "s#reports/training/s76_lambda/test/X93/check.json#$R/test/$N/check.json#" tests/test_default_model.py
 git status --short
