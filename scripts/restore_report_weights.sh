@@ -27,3 +27,4 @@ restore 0f8ad48 'reports/training/s28_gpu_adapters/env_response_flight/SimDiff_G
 restore 0f8ad48 'reports/training/s28_gpu_adapters/env_response_flight/SimDiff_GPU_pair10f__α___1.json' bb6f3c55e6e15c19
 restore 3f24dad 'reports/training/s76_lambda/X93_model/model.safetensors' 856504f9169ba456
 restore 96adcbf 'reports/training/s78_captioned/X95_model/model.safetensors' 5801f52673e8d161
+restore 7d049c1 'reports/training/s79_refit/X96_model/model.safetensors' bea4733bc95c8950
