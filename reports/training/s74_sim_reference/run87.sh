@@ -21,7 +21,7 @@ guard() {  # $1 phi, $2 seeds, $3 folder, $4 scratch (corpus3/ and eval/)
     python reports/training/s37_env_guidance/guard.py $1 $SE $3/$1 $M >&2 || exit 1
 }
 stage_gate() {  # rule 84's gate (env_probe seeds 7000+, gate84.py with speed bar 0.209)
-  PROBE=/work/scratch/s74/${N}_probe.log
+  PROBE=/work/scratch/s74/${N}_probe.log; mkdir -p /work/scratch/s74  # session 81: a fresh scratch has no s74/
   grep -qs "^{" $PROBE || python reports/training/s60_wind/env_probe.py --walks 8 --jumps 8 --moon 16 $M > $PROBE 2>&1
   python reports/training/s72_lowloc/gate84.py "$PROBE" $RULE 0.209 | tee -a $OUT | grep -q "gate PASS"
 }

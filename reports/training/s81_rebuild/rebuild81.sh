@@ -14,7 +14,7 @@ set -u
 cd /work/main; . .venv/bin/activate
 R=reports/training; S=/work/scratch/s39; C=$S/corpus3
 log() { echo "[$(date -u +%H:%M:%S)] $*"; }
-mkdir -p $S /work/scratch/s79/models /work/scratch/s80
+mkdir -p $S /work/scratch/s79/models /work/scratch/s80 /work/scratch/s74  # s74: run87.sh writes its gate probe there
 if [ ! -s $C/train_walk150.txt ]; then
   log "corpus3 start"
   nice -n 5 simdiff data build --shared ../shared/data --out $C --workers 2 --quiet || exit 1
@@ -26,7 +26,8 @@ fi
 (cd $S && grep " file corpus3/" /work/main/$R/s55_reference/sha256_rebuilt_s55.txt | sed 's/ file /  /' | sha256sum -c --quiet) \
   || { echo "rebuild81: corpus3 does not hash to session 55's files" >&2; exit 1; }
 cmp -s $C/train_walk150.txt $R/s40_walk_wind/train_walk150_split.txt || echo "note: train_walk150 differs from s40's file"
-bash $R/s79_refit/packs.sh || exit 1
+# the packs only feed the re-fit: skipped when X96 is on disk (resume98.sh restores it from history)
+[ -f /work/scratch/s79/models/X96/model.safetensors ] || bash $R/s79_refit/packs.sh || exit 1
 X96=/work/scratch/s79/models/X96
 if [ ! -f $X96/model.safetensors ]; then
   bash scripts/restore_report_weights.sh > /dev/null || exit 1
