@@ -1,7 +1,7 @@
 """Session 82: what "a person runs forward" does under g -1.6 vs Earth, beyond the glide / never-touch counts.
 Per sample (joints .npy, frames x 22 x 3, metres, Y-up, 20 fps): pelvis horizontal speed (m/s), the mean speed of the
-joints relative to the pelvis (m/s; a frozen pose carried along scores near 0), and the share of frames with every
-foot joint (7, 8, 10, 11) above 5 cm of the sample's lowest foot height (in the air).
+joints relative to the pelvis (m/s; a frozen pose carried along scores near 0), and the share of frames in a flight
+(the model check's own rules: `root_speed`, `simdiff.motion.flight.airborne`).
 Usage: python lowrun.py DIR [DIR ...]   (folders of `simdiff generate --format npy`)"""
 from __future__ import annotations
 
@@ -10,17 +10,15 @@ from pathlib import Path
 
 import numpy as np
 
-FEET = [7, 8, 10, 11]
+from simdiff.eval.model_check.detect import root_speed
+from simdiff.motion.flight import airborne
+from simdiff.motion.skeleton import FPS
 
 
 def figures(j: np.ndarray) -> tuple[float, float, float]:
     """(pelvis speed m/s, root-relative joint speed m/s, airborne share) of one sample."""
-    v = np.linalg.norm(np.diff(j[:, 0, [0, 2]], axis=0), axis=1).mean() * 20
-    rel = j - j[:, :1]
-    w = np.linalg.norm(np.diff(rel, axis=0), axis=2).mean() * 20
-    feet = j[:, FEET, 1]
-    air = (feet.min(axis=1) > feet.min() + 0.05).mean()
-    return float(v), float(w), float(air)
+    pose_speed = np.linalg.norm(np.diff(j - j[:, :1], axis=0), axis=2).mean() * FPS
+    return root_speed(j), float(pose_speed), float(airborne(j).mean())
 
 
 for d in sys.argv[1:]:
