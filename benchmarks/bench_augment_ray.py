@@ -73,7 +73,7 @@ def run_one(corpus: Path, out: Path, backend: str, workers: int, shard_size: int
     """One configuration in this process: warm up, then time :func:`augment` (binary mode)."""
     from simdiff.data.augment import AugmentConfig, FilterConfig, augment
     from simdiff.data.augment.projector import SimProjector
-    from simdiff.data.augment.run import load_source_joints
+    from simdiff.data.augment.pairs import load_source_joints
     from simdiff.data.humanml3d import read_split
     from simdiff.sim.env import Environment
 

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_generate.py [--model DIR] [--preset small] [--threads 2] [--length 6]
+    python benchmarks/bench_generate.py [--model DIR] [--preset small] [--length 6]
         [--repeats 3] [--no-video] [--env-guidance S [S ...]] [--json out.json]
 
 Each repeat runs the real command in a fresh interpreter (``python -m simdiff generate ...``) and
@@ -47,7 +47,8 @@ def random_model(folder: Path, preset: str) -> Path:
     import numpy as np
     import torch
 
-    from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network
+    from simdiff.model import ModelConfig, SimConfig, backbone_preset, build_network
+    from simdiff.inference.generator import MotionGenerator
 
     torch.manual_seed(0)
     config = ModelConfig(backbone=backbone_preset(preset), sim=SimConfig())
@@ -58,11 +59,10 @@ def random_model(folder: Path, preset: str) -> Path:
     return folder
 
 
-def command(model: Path, out: Path, threads: int, length: float, no_video: bool,
-            env_guidance: float | None = None) -> list[str]:
+def command(model: Path, out: Path, length: float, no_video: bool, env_guidance: float | None = None) -> list[str]:
     cmd = [sys.executable, "-m", "simdiff", "generate", README_TEXT, *README_ENV, "--model", str(model),
            "--out", str(out), "--length", f"{length:g}", "-q"]
-    return (cmd + (["--threads", str(threads)] if threads else []) + (["--no-video"] if no_video else [])
+    return (cmd + (["--format", "npy,bvh"] if no_video else [])
             + (["--env-guidance", f"{env_guidance:g}"] if env_guidance is not None else []))
 
 
@@ -111,7 +111,7 @@ IMPORT_GROUPS: tuple[tuple[str, str], ...] = (
     ("cli (argparse + command discovery)", "from simdiff.cli.main import build_parser; build_parser()"),
     ("checks (simdiff.product.request)", "import simdiff.product.request"),
     ("torch", "import torch"),
-    ("simdiff.model + diffusion", "import simdiff.model.default, simdiff.model.generator"),
+    ("simdiff.model + diffusion", "import simdiff.inference.default, simdiff.inference.generator"),
     ("text encoder (MiniLM)", "import simdiff.text.minilm"),
     ("simdiff.motion.features (scipy.ndimage)", "import simdiff.motion.features"),
     ("simdiff.motion.io (BVH writer; scipy.signal, .spatial)", "import simdiff.motion.io.bvh_writer"),
@@ -149,23 +149,20 @@ def summarise(runs: list[dict]) -> dict:
 
 def _sampler_label(model: Path) -> str:
     """What the command samples with: the model's ``sampling.json`` (simdiff generate's defaults) or the CLI's."""
-    from simdiff.model.default import sampling_defaults
+    from simdiff.inference.default import sampling_config
 
-    stored = sampling_defaults(model)
-    sampler = stored.get("sampler", "ddim")
-    return (f"{sampler}-{stored.get('steps', 50)}, guidance {stored.get('guidance', 2.5):g} (batched CFG), "
-            f"sampling.json: {json.dumps(stored, sort_keys=True) if stored else 'none'}")
+    config = sampling_config(model)
+    return (f"{config.sampler}-{config.steps}, guidance {config.guidance:g} (batched CFG), "
+            f"sampling: {json.dumps(config.to_dict(), sort_keys=True)}")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--model", type=Path, help="model folder (default: shipped model, else a random --preset one)")
     parser.add_argument("--preset", default="small", help="backbone size of the random model (default small)")
-    parser.add_argument("--threads", type=int, default=2,
-                        help="torch CPU threads in the command (default 2; 0 = the command's own default)")
     parser.add_argument("--length", type=float, default=6.0, help="motion length in seconds (default 6)")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs (default 3)")
-    parser.add_argument("--no-video", action="store_true", help="skip the GIF")
+    parser.add_argument("--no-video", action="store_true", help="skip the GIF (--format npy,bvh)")
     parser.add_argument("--no-importtime", action="store_true", help="skip the -X importtime run")
     parser.add_argument("--env-guidance", type=float, nargs="+", metavar="S",
                         help="time the command with each of these environment-guidance values in turn and report "
@@ -176,7 +173,7 @@ def main() -> None:
         raise SystemExit(f"bench_generate: --repeats must be at least 1, got {args.repeats}")
     values: list[float | None] = list(args.env_guidance) if args.env_guidance else [None]
 
-    from simdiff.model.default import DEFAULT_MODEL_DIR
+    from simdiff.inference.default import DEFAULT_MODEL_DIR
 
     with tempfile.TemporaryDirectory(prefix="bench_generate_") as tmp:
         tmp_dir = Path(tmp)
@@ -192,13 +189,13 @@ def main() -> None:
         for i in range(args.repeats):
             for j, value in enumerate(values):
                 out = tmp_dir / f"out{i}_{j}"
-                run = timed_run(command(model, out, args.threads, args.length, args.no_video, value), out)
+                run = timed_run(command(model, out, args.length, args.no_video, value), out)
                 by_value[j].append(run)
                 label = "" if value is None else f" (env guidance {value:g})"
                 print(f"run {i}{label}: wall {run['wall_s']:.2f} s, cpu {run['cpu_s']:.2f} s", file=sys.stderr)
         runs = by_value[0]
         imports = None if args.no_importtime else import_profile(
-            command(model, tmp_dir / "imp", args.threads, args.length, args.no_video, values[0]))
+            command(model, tmp_dir / "imp", args.length, args.no_video, values[0]))
         imports_cpu = import_cpu()
         load_after = os.getloadavg()
 
@@ -206,13 +203,11 @@ def main() -> None:
     result = {
         "benchmark": "bench_generate",
         "command": " ".join(["simdiff", "generate", repr(README_TEXT), *README_ENV, "--length", f"{args.length:g}"]
-                            + (["--threads", str(args.threads)] if args.threads else [])
-                            + (["--no-video"] if args.no_video else [])
+                            + (["--format", "npy,bvh"] if args.no_video else [])
                             + (["--env-guidance", f"{values[0]:g}"] if values[0] is not None else [])),
         "model": {"kind": kind, "path": str(model), "latent_dim": config["backbone"]["latent_dim"],
                   "num_layers": config["backbone"]["num_layers"], "simdiff": config["sim"] is not None},
         "sampler": _sampler_label(model),
-        "threads": args.threads or "default (idle cores)",
         "threads_used": runs[0]["threads"],
         "machine": {"cpus": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version(),
                     "loadavg_1min_before_after": [round(load_before[0], 2), round(load_after[0], 2)]},

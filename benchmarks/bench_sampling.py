@@ -20,7 +20,8 @@ import time
 
 import torch
 
-from simdiff.diffusion import make_scheduler, sample
+from simdiff.diffusion.config import SamplingConfig
+from simdiff.diffusion.sampling import make_scheduler, sample
 from simdiff.model import Condition, MDMBackbone, backbone_preset
 
 
@@ -36,20 +37,17 @@ def time_sampling(net: MDMBackbone, sampler: str, steps: int, batch: int, frames
     Extrapolated from ``probe`` steps when given; the best of ``repeats`` runs (a shared machine's
     other load only ever adds time).
     """
-    scheduler = make_scheduler(sampler, steps)
-    total = len(scheduler.timesteps)
-    run_steps = total if probe is None else min(probe, total)
-    scheduler.timesteps = scheduler.timesteps[:run_steps]
+    total = len(make_scheduler(sampler, steps).timesteps)
+    run_steps = total if probe is None else min(probe, total)  # every step costs one network pass
     cond = Condition(text=torch.randn(batch, net.config.text_dim, device=device))
     gen = torch.Generator(device=device).manual_seed(0)
-    short = make_scheduler(sampler, steps)
-    short.timesteps = short.timesteps[:2]
-    sample(net, short, cond, frames, generator=gen, batched_cfg=batched_cfg)  # warm-up
+    sample(net, SamplingConfig(sampler=sampler, steps=2), cond, frames, generator=gen, batched_cfg=batched_cfg)  # warm-up
     best = float("inf")
     for _ in range(repeats):
         _sync(device)
         start = time.perf_counter()
-        sample(net, scheduler, cond, frames, generator=gen, batched_cfg=batched_cfg)
+        sample(net, SamplingConfig(sampler=sampler, steps=run_steps), cond, frames, generator=gen,
+               batched_cfg=batched_cfg)
         _sync(device)
         best = min(best, time.perf_counter() - start)
     return best * total / run_steps

@@ -16,7 +16,8 @@ import time
 
 import torch
 
-from simdiff.diffusion import DDPMScheduler, diffusion_loss
+from simdiff.diffusion.ddpm import DDPMScheduler
+from simdiff.diffusion.losses import diffusion_loss
 from simdiff.model import Condition, SimConfig, SimDiffNet, backbone_preset
 from simdiff.model.backbone import MDMBackbone
 

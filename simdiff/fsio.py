@@ -14,11 +14,14 @@ import json
 import os
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterator
+from typing import TYPE_CHECKING, Any, Iterator, Mapping
 
 import numpy as np
 
 from simdiff.errors import SimdiffError
+
+if TYPE_CHECKING:
+    from torch import Tensor
 
 _REASONS: dict[int, str] = {
     errno.ENOSPC: "no space left on device",
@@ -176,3 +179,29 @@ def file_digest(paths: list[Path]) -> str:
             for block in iter(lambda: handle.read(1 << 20), b""):
                 sha.update(block)
     return sha.hexdigest()
+
+
+def canonical_safetensors(blob: bytes) -> bytes:
+    """``blob`` (a serialised safetensors file) with its ``__metadata__`` keys sorted: the library writes that map in
+    a per-process random order, so the same weights hashed differently from run to run. Tensor entries and data are
+    untouched; the header keeps its length (it is the same JSON reordered)."""
+    n = int.from_bytes(blob[:8], "little")
+    header = json.loads(blob[8:8 + n])
+    meta = header.get("__metadata__")
+    if not meta:
+        return blob
+    header["__metadata__"] = dict(sorted(meta.items()))
+    text = json.dumps(header, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+    if len(text) > n:  # never: the same keys and values, reordered (kept safe: then the library's bytes stand)
+        return blob
+    return blob[:8] + text + b" " * (n - len(text)) + blob[8 + n:]
+
+
+def atomic_save_tensors(tensors: Mapping[str, Tensor], path: str | os.PathLike[str],
+                        metadata: dict[str, str] | None = None) -> None:
+    """Write a safetensors file atomically (tensors made contiguous, on CPU); the same tensors and metadata give the
+    same bytes (:func:`canonical_safetensors`). torch is imported here, so that this module stays light."""
+    from safetensors.torch import save
+
+    clean = {k: v.detach().to("cpu").contiguous() for k, v in tensors.items()}
+    write_bytes(path, canonical_safetensors(save(clean, metadata=metadata)))

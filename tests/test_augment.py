@@ -16,12 +16,12 @@ import pytest
 
 from simdiff.data.augment import (AugmentConfig, AugmentedHumanML3D, FilterConfig, augment, keep_pair, make_conditions,
                                   open_training_dataset, random_conditions)
-from simdiff.data.augment.run import load_source_joints
+from simdiff.data.augment.pairs import load_source_joints
 from simdiff.data.augment.filter import rejections, residual_newtons
 from simdiff.errors import SimdiffError
 from simdiff.eval.testing import write_tiny_corpus
 from simdiff.sim.env import Environment
-from simdiff.train.data import collate
+from simdiff.data.batch import collate
 
 
 def fake_info(env: Environment, i: int) -> dict:

@@ -1,4 +1,4 @@
-"""Issue 13: the augment report per content class, the Earth-tracked view and the "done when" checklist.
+"""The augment report per content class, the Earth-tracked view and the quality checks.
 
 Synthetic shard records with known outcomes: every clip is simulated 10 times in every condition
 bin and a known number of those copies is made unfaithful (pose d_L2 over the bound), so the keep
@@ -144,7 +144,7 @@ def test_a_bin_without_pairs_is_no_data_and_not_a_pass() -> None:
     assert items["low_g_flight"]["status"] == "NO DATA"
 
 
-def test_bounds_are_the_issues() -> None:
+def test_bounds_of_the_quality_checks() -> None:
     cfg = DoneWhen()
     assert (cfg.plain_gravity_keep, cfg.flight_gravity_keep, cfg.wind_keep, cfg.earth_keep, cfg.confound_r) == (
         0.5, 0.25, 0.6, 0.66, 0.1)
@@ -176,4 +176,4 @@ def test_cli_refinalises_with_auto_without_simulating_and_reads_the_manifest(
     report = json.loads((out / "report.json").read_text())
     assert report["filter"]["calibration"]["earth_keep_target"] == 0.66
     assert report["by_class"]["all"]["clips"]["acrobatics"] == 1 and report["motion_types"] == "manifest"
-    assert "Issue 13 \"done when\"" in (out / "report.md").read_text()
+    assert "## Quality checks" in (out / "report.md").read_text()

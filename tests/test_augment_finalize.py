@@ -1,4 +1,4 @@
-"""Issue 13: the keep decision at finalize (re-finalize without simulating) and the auto pose threshold."""
+"""The keep decision at finalize (re-finalize without simulating) and the auto pose threshold."""
 
 from __future__ import annotations
 

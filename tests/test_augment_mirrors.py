@@ -1,4 +1,4 @@
-"""Issue 13: ``--share-mirrors`` derives a mirrored clip's pairs from its original's rollouts."""
+"""``--share-mirrors`` derives a mirrored clip's pairs from its original's rollouts."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from simdiff.data.augment import AugmentConfig, augment
-from simdiff.data.augment.run import load_source_joints, rollout_to_layout
+from simdiff.data.augment.pairs import load_source_joints, rollout_to_layout
 from simdiff.data.augment.share import group_mirrors, mirror_env, mirror_sources
 from simdiff.errors import SimdiffError
 from simdiff.eval.testing import write_tiny_corpus

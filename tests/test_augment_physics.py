@@ -1,4 +1,4 @@
-"""Issue 13: paired conditions, the confound check and the physics-signal measurements."""
+"""Paired conditions, the confound check and the physics-signal measurements."""
 
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ def test_paired_conditions_narrowed_to_weak_gravity_keep_the_default_draw() -> N
 
 
 def test_paired_conditions_at_one_gravity() -> None:
-    """LO == HI: every gravity draw is that value (rule 87's val replays at g -1.6); more draws than factors would
+    """LO == HI: every gravity draw is that value (e.g. val replays at g -1.6); more draws than factors would
     simulate a clip twice under the same gravity, which is a one-line error naming the value."""
     moon = paired_conditions("16_05", 1, 0, factors=("gravity",), gravity_range=(-1.6, -1.6))
     assert [(c.factor, c.env.as_tuple()) for c in moon] == [("earth", (-9.81, 0.0, 0.0)), ("gravity", (-1.6, 0.0, 0.0))]
@@ -92,7 +92,7 @@ def test_augment_cli_narrows_the_draw_and_refuses_it_outside_paired_mode(tmp_pat
 
 def test_paired_draws_are_uncorrelated_with_content_but_round_robin_is_not() -> None:
     """Content that repeats with the round-robin cycle (30 conditions, 2 per clip: 15 clips), so
-    that each condition always meets the same kind of clip, as in issue 13: paired passes,
+    that each condition always meets the same kind of clip: paired passes,
     round-robin fails."""
     from simdiff.data.augment.conditions import random_conditions
     from simdiff.data.augment.run import assign_conditions

@@ -1,4 +1,4 @@
-"""Issue 13: ``--resimulate-gravity-below`` re-projects only the pairs whose physics changed, resumably."""
+"""``--resimulate-gravity-below`` re-projects only the pairs whose physics changed, resumably."""
 
 from __future__ import annotations
 

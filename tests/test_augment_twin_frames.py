@@ -77,7 +77,7 @@ def test_prefix_trims_twins_to_their_common_frames_and_pairs_them(uneven: tuple[
         before = plain.sim.items[i]
         assert item.name == before.name and item.start == before.start and item.stop <= before.stop
         np.testing.assert_array_equal(ds.sim.load_motion(item), plain.sim.load_motion(before)[: item.length])
-    # source-anchored targets now anchor the longer replays too, over the common frames
+    # with prefix twins, source-anchored targets anchor the longer replays too, over the common frames
     anchored = AugmentedHumanML3D(aug, targets="source-anchored", twin_frames="prefix")
     assert AugmentedHumanML3D(aug, targets="source-anchored").anchored < anchored.anchored == len(anchored.sim.items)
     for i, item in enumerate(anchored.sim.items):

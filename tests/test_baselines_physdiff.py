@@ -10,7 +10,8 @@ from simdiff.baselines.physdiff import (PhysDiffConfig, ProjectionHook, check_sc
                                         reencode)
 from simdiff.diffusion.sampling import make_scheduler
 from simdiff.errors import SimdiffError
-from simdiff.model import ModelConfig, MotionGenerator, backbone_preset, build_network
+from simdiff.model import ModelConfig, backbone_preset, build_network
+from simdiff.inference.generator import MotionGenerator
 from simdiff.motion.features import extend_last_frame, features_to_joints, process_joints
 from simdiff.motion.synthetic import walk
 from simdiff.train.testing import HashTextEncoder

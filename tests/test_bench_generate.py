@@ -16,7 +16,7 @@ def test_env_guidance_values_are_timed_in_turn(tmp_path: Path) -> None:
     out = tmp_path / "bench.json"
     model = write_tiny_model(tmp_path / "model")  # continuous φ, MiniLM by name (as the shipped model)
     cmd = [sys.executable, str(REPO / "benchmarks" / "bench_generate.py"), "--model", str(model),
-           "--repeats", "1", "--length", "0.5", "--no-video", "--no-importtime", "--threads", "1",
+           "--repeats", "1", "--length", "0.5", "--no-video", "--no-importtime",
            "--env-guidance", "2", "1", "--json", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr

@@ -27,7 +27,7 @@ def test_blender_imports_our_bvh(tmp_path: Path) -> None:
     np.save(tmp_path / "walk.npy", joints)
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     out = subprocess.run(
-        [os.environ["SIMDIFF_BLENDER_PYTHON"], str(REPO / "scripts" / "blender_bvh_check.py"),
+        [os.environ["SIMDIFF_BLENDER_PYTHON"], str(Path(__file__).parent / "blender_bvh_check.py"),
          str(tmp_path / "walk.bvh"), str(tmp_path / "walk.npy")],
         capture_output=True, text=True, env=env, timeout=300, check=True,
     ).stdout

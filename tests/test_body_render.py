@@ -95,7 +95,7 @@ def test_render_mjcf_adds_visuals_only():
 
 
 def test_motion_qpos_joints_and_passthrough():
-    from simdiff.sim.convert import qpos_to_joints
+    from simdiff.sim.retarget import qpos_to_joints
     from simdiff.sim.humanoid import load_model
 
     model = load_model()

@@ -18,12 +18,12 @@ import pytest
 
 from simdiff.cli.main import main
 from simdiff.data.corpus.build import CorpusConfig, build
-from simdiff.data.corpus.item import LICENCE_SETS
+from simdiff.licences import LICENCE_SETS
 from simdiff.data.corpus.registry import discover_all
 from simdiff.data.corpus.splits import assign_stratified
 from simdiff.data.humanml3d import read_captions
 from mocap_fixtures import POS_ROT, bvh_text
-from test_data_cmu_build import _amc, _asf, _bvh, _deepmimic
+from cmu_fixtures import amc_text, asf_text, cmu_bvh_text, deepmimic_text
 
 _BANDAI = [  # name, parent, offset (cm): the Bandai game rig's joint names
     ("joint_Root", None, (0, 0, 0)), ("Hips", "joint_Root", (0, 95, 0)),
@@ -65,10 +65,10 @@ def shared(tmp_path_factory: pytest.TempPathFactory) -> Path:
     cmu = root / "cmu"
     for sub in ("amc", "asf", "bvh", "deepmimic/extra"):
         (cmu / sub).mkdir(parents=True)
-    (cmu / "asf" / "01.asf").write_text(_asf())
-    (cmu / "amc" / "01_01.amc").write_text(_amc(3.0, 60))
-    (cmu / "bvh" / "01_01.bvh").write_text(_bvh(3.0, 60))  # the same trial as BVH
-    (cmu / "deepmimic" / "01_01.txt").write_text(_deepmimic(3.0, 30))  # ... and as DeepMimic
+    (cmu / "asf" / "01.asf").write_text(asf_text())
+    (cmu / "amc" / "01_01.amc").write_text(amc_text(3.0, 60))
+    (cmu / "bvh" / "01_01.bvh").write_text(cmu_bvh_text(3.0, 60))  # the same trial as BVH
+    (cmu / "deepmimic" / "01_01.txt").write_text(deepmimic_text(3.0, 30))  # ... and as DeepMimic
     (cmu / "CMU_data.csv").write_text('"Subject","Trial #","Motion Description","framerate"\n1,1,"walk",60\n'
                                       '2,1,"jump",60\n')
     (cmu / "descriptions.tsv").write_text("01_01\twalk\n02_01\tjump up and down\n")
@@ -76,9 +76,9 @@ def shared(tmp_path_factory: pytest.TempPathFactory) -> Path:
                                                     "kitml": []}) + "\n")
     extra = root / "extra"
     (extra / "cmu-bvh" / "motionbuilder").mkdir(parents=True)
-    (extra / "cmu-bvh" / "motionbuilder" / "02_01.bvh").write_text(_bvh(2.5, 60))
+    (extra / "cmu-bvh" / "motionbuilder" / "02_01.bvh").write_text(cmu_bvh_text(2.5, 60))
     (extra / "cmu-bvh" / "aclstm" / "salsa").mkdir(parents=True)
-    (extra / "cmu-bvh" / "aclstm" / "salsa" / "01.bvh").write_text(_bvh(2.5, 60))
+    (extra / "cmu-bvh" / "aclstm" / "salsa" / "01.bvh").write_text(cmu_bvh_text(2.5, 60))
     data = extra / "bandai-namco" / "dataset" / "Bandai-Namco-Research-Motiondataset-1"
     (data / "cfg").mkdir(parents=True)
     (data / "data").mkdir()
@@ -91,16 +91,16 @@ def shared(tmp_path_factory: pytest.TempPathFactory) -> Path:
             (data / "data" / f"{stem}.json").write_text(json.dumps({"content": c, "style": s}))
     hdm = tmp_path_factory.mktemp("hdm") / "hdm05" / "train" / "4"
     hdm.mkdir(parents=True)
-    (hdm / "HDM_bd.asf").write_text(_asf())
-    (hdm / "HDM_bd_hopBothLegs1hops_001_120.amc").write_text(_amc(1.5, 120))  # 1.5 s: padded to 2 s
+    (hdm / "HDM_bd.asf").write_text(asf_text())
+    (hdm / "HDM_bd_hopBothLegs1hops_001_120.amc").write_text(amc_text(1.5, 120))  # 1.5 s: padded to 2 s
     with tarfile.open(extra / "hdm05.tar.xz", "w:xz") as tar:
         tar.add(hdm.parent.parent, arcname="hdm05")
     motions = extra / "deepmimic-xbpeng" / "data" / "motions"
     motions.mkdir(parents=True)
-    jump = _deepmimic(2.5, 30)
+    jump = deepmimic_text(2.5, 30)
     (motions / "humanoid3d_jump.txt").write_text(jump)
     (cmu / "deepmimic" / "extra" / "humanoid3d_jump.txt").write_text(jump)  # same bytes
-    (motions / "humanoid3d_jump_mirror.txt").write_text(_deepmimic(2.4, 30))  # left out
+    (motions / "humanoid3d_jump_mirror.txt").write_text(deepmimic_text(2.4, 30))  # left out
     return root
 
 

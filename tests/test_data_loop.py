@@ -13,10 +13,14 @@ from simdiff.cli.main import main
 from simdiff.data.clip_files import process_clip, write_clip
 from simdiff.data.loop import find_period, loop_corpus, loop_joints
 from simdiff.errors import SimdiffError
-from simdiff.eval.model_check.detect import root_speed
 from simdiff.motion.kinematics import facing_direction
 from simdiff.motion.skeleton import FACE_JOINTS
 from simdiff.motion.synthetic import walk
+
+
+def root_speed(joints: np.ndarray, fps: float = 20.0) -> float:
+    """Mean horizontal (X–Z) pelvis speed (m/s) of (T, 22, 3) joints."""
+    return float(np.linalg.norm(np.diff(np.asarray(joints)[:, 0, [0, 2]], axis=0), axis=1).mean() * fps)
 
 
 def _max_step(joints: np.ndarray) -> float:

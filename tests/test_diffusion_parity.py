@@ -12,7 +12,8 @@ import torch
 
 diffusers = pytest.importorskip("diffusers")
 
-from simdiff.diffusion import DDIMScheduler, DDPMScheduler  # noqa: E402
+from simdiff.diffusion.ddim import DDIMScheduler  # noqa: E402
+from simdiff.diffusion.ddpm import DDPMScheduler  # noqa: E402
 
 SCHEDULES = {"cosine": "squaredcos_cap_v2", "linear": "linear"}
 

@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 import torch
 
-from simdiff.diffusion import DDIMScheduler, DDPMScheduler, make_scheduler
+from simdiff.diffusion.ddim import DDIMScheduler
+from simdiff.diffusion.ddpm import DDPMScheduler
+from simdiff.diffusion.sampling import make_scheduler
 from simdiff.diffusion.schedule import cosine_betas, ddim_timesteps, even_timesteps
 from simdiff.errors import SimdiffError
 

@@ -134,23 +134,24 @@ def test_shipped_table_configs_carry_claims() -> None:
     assert t1.ddpm_samples >= 32
 
 
-def test_generator_fn_passes_eta_and_refuses_it_with_physdiff() -> None:
-    """The DDIM η reaches the generator only when set (stand-ins need not know it); PhysDiff takes none."""
+def test_generator_fn_passes_its_sampling_config_and_refuses_eta_with_physdiff() -> None:
+    """The one SamplingConfig reaches the generator as it is; PhysDiff takes no DDIM η."""
     import torch
 
+    from simdiff.diffusion.config import SamplingConfig
     from simdiff.eval.protocol import generator_fn
 
-    calls: list[dict] = []
+    calls: list[SamplingConfig] = []
 
     class Stub:
         is_simdiff = False
 
-        def generate(self, captions, lengths, **kwargs):  # noqa: ANN001, ANN003
-            calls.append(kwargs)
+        def generate(self, captions, lengths, config, **kwargs):  # noqa: ANN001, ANN003
+            calls.append(config)
             return type("G", (), {"features": torch.zeros(len(captions), 4, 263)})()
 
     generator_fn(Stub())(["a"], [4], 0)
-    generator_fn(Stub(), eta=1.0)(["a"], [4], 0)
-    assert "eta" not in calls[0] and calls[1]["eta"] == 1.0
-    with pytest.raises(SimdiffError, match="DDIM eta 1.0 is a generator option; the PhysDiff baseline takes none"):
-        generator_fn(Stub(), eta=1.0, physdiff=object())
+    generator_fn(Stub(), SamplingConfig(eta=1.0))(["a"], [4], 0)
+    assert calls == [SamplingConfig(), SamplingConfig(eta=1.0)]
+    with pytest.raises(SimdiffError, match="DDIM eta 1 is a generator option; the PhysDiff baseline takes none"):
+        generator_fn(Stub(), SamplingConfig(eta=1.0), physdiff=object())

@@ -20,7 +20,7 @@ from simdiff.motion.features import (
 )
 from simdiff.motion.skeleton import BONE_LENGTHS, PARENTS
 
-# Acceptance tolerances (issue: root ≤ 1e-6, ric ≤ 1e-5, rot6d ≤ 5e-5, vel ≤ 1e-5, contacts exact).
+# Acceptance tolerances (root ≤ 1e-6, ric ≤ 1e-5, rot6d ≤ 5e-5, vel ≤ 1e-5, contacts exact).
 TOLERANCES = {
     "root_rot_vel": 1e-6,
     "root_lin_vel": 1e-6,

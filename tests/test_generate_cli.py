@@ -13,7 +13,8 @@ import torch
 
 from simdiff.cli.main import main
 from simdiff.motion.foot_lock import clean_feet_numpy
-from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network
+from simdiff.model import ModelConfig, SimConfig, backbone_preset, build_network
+from simdiff.inference.generator import MotionGenerator
 
 
 @pytest.fixture(autouse=True)
@@ -38,8 +39,8 @@ def tiny_model(tmp_path_factory) -> Path:
 def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     (tiny_model / "sampling.json").write_text('{"alpha": 0.5, "foot_lock": 1.0}')
     try:
-        code = main(["generate", "a person jumps forward", "--gravity", "-3.7", "--wind", "2", "0", "--frames", "10",
-                     "--steps", "2", "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1",
+        code = main(["generate", "a person jumps forward", "--gravity", "-3.7", "--wind", "2", "0", "--length", "0.5",
+                     "--steps", "2", "--model", str(tiny_model), "--out", str(tmp_path / "o"),
                      "--format", "npy,bvh,gif", "-q"])
     finally:
         (tiny_model / "sampling.json").unlink()
@@ -52,10 +53,10 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     assert all(Path(p).is_file() for p in printed)
     assert np.load(tmp_path / "o" / "sample0_joints.npy").shape == (10, 22, 3)
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
-    assert (meta["alpha"], meta["alpha_source"], meta["steps"], meta["frames"]) == (0.5, "sampling.json", 2, 10)
+    assert (meta["alpha"], meta["steps"], meta["frames"]) == (0.5, 2, 10)
     assert meta["foot_lock"] == 1.0 and meta["foot_cleanup"] == 3  # lock, swing clearance, floating clip dropped
     assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
-    assert meta["threads"] == 1
+    assert meta["threads"] == torch.get_num_threads()
     assert (meta["model"]["trained_on"], meta["model"]["weights_licence"]) == ("unknown", "unknown")  # no provenance.json
     assert meta["samples"][0]["touches_floor"] is True and abs(meta["samples"][0]["lowest_m"]) < 0.1
 
@@ -66,8 +67,8 @@ def test_generate_reports_the_models_provenance(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "m")
     write_provenance(model, Provenance([TrainingData("backbone", "corpus", ["bandai"], 0.5, {"CC-BY-NC-4.0": 0.5}),
                                         TrainingData("adapters", "aug", ["cmu-amc"], 0.1, {"CMU": 0.1})]))
-    argv = ["generate", "a person waves", "--frames", "8", "--steps", "2", "--model", str(model), "--threads", "1",
-            "--format", "npy", "--no-video", "-q"]
+    argv = ["generate", "a person waves", "--length", "0.4", "--steps", "2", "--model", str(model),
+            "--format", "npy", "-q"]
     assert main([*argv, "--out", str(tmp_path / "o")]) == 0, capsys.readouterr().err
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())["model"]
     assert meta["weights_licence"] == "non-commercial (CC-BY-NC-4.0 motion in the training data)"
@@ -82,9 +83,8 @@ def test_generate_reports_the_models_provenance(tmp_path: Path, capsys) -> None:
 
 def test_backbone_model_warns_once_and_ignores_phi(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "bb", sim=False)
-    code = main(["generate", "a person walks", "--gravity", "-1.6", "--compare", "gravity=-9.81,-1.6", "--frames", "6",
-                 "--steps", "1", "--model", str(model), "--out", str(tmp_path / "o"), "--no-video", "--threads", "1",
-                 "-q"])
+    code = main(["generate", "a person walks", "--gravity", "-1.6", "--compare", "gravity=-9.81,-1.6", "--length", "0.3",
+                 "--steps", "1", "--model", str(model), "--out", str(tmp_path / "o"), "--format", "npy,bvh", "-q"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 0
     assert len(err) == 1 and err[0].startswith("simdiff: warning:") and "--gravity, --compare ignored" in err[0]
@@ -95,10 +95,10 @@ def test_backbone_model_warns_once_and_ignores_phi(tmp_path: Path, capsys) -> No
 def test_default_output_folder_is_named_after_the_prompt(tiny_model: Path, tmp_path: Path, monkeypatch, capsys) -> None:
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("SIMDIFF_MODEL", str(tiny_model))
-    assert main(["generate", "A person: waves!", "--frames", "4", "--steps", "1", "--format", "npy", "--threads", "1",
+    assert main(["generate", "A person: waves!", "--length", "0.2", "--steps", "1", "--format", "npy",
                  "-q"]) == 0
     assert (tmp_path / "out" / "a_person_waves" / "sample0_joints.npy").is_file()
-    assert main(["generate", "A person waves", "--frames", "4", "--steps", "1", "--format", "npy", "--threads", "1",
+    assert main(["generate", "A person waves", "--length", "0.2", "--steps", "1", "--format", "npy",
                  "-q"]) == 0  # a second run never overwrites the first
     assert (tmp_path / "out" / "a_person_waves-2" / "generation.json").is_file()
     assert capsys.readouterr().out.split()[-1] == "out/a_person_waves-2/generation.json"
@@ -110,7 +110,7 @@ def test_default_output_folder_is_named_after_the_prompt(tiny_model: Path, tmp_p
     (["walk", "--gravity", "0"], "gravity must be negative"),
     (["walk", "--gravity", "nan"], "--gravity must be a finite number, got nan"),
     (["walk", "--wind", "12", "0"], "12 N exceeds"),
-    (["walk", "--steps", "0"], "--steps must be 1..1000, got 0"),
+    (["walk", "--steps", "0"], "--steps must be a whole number in 1..1000, got 0"),
     (["walk", "--guidance", "nan"], "--guidance must be a finite number"),
     (["walk", "--compare", "gravity:-1,-2"], "bad --compare 'gravity:-1,-2'"),
     (["walk", "--model", "{tmp}/nowhere"], "nowhere/config.json: model file not found"),
@@ -127,7 +127,7 @@ def test_bad_input_one_line_exit_2(tmp_path: Path, argv: list[str], needle: str,
 
 
 def test_missing_shipped_model_message(tmp_path: Path, monkeypatch) -> None:
-    from simdiff.model import default
+    from simdiff.inference import default
 
     monkeypatch.delenv("SIMDIFF_MODEL", raising=False)
     monkeypatch.setattr(default, "DEFAULT_MODEL_DIR", tmp_path / "default_model")
@@ -137,18 +137,23 @@ def test_missing_shipped_model_message(tmp_path: Path, monkeypatch) -> None:
         default.check_model_dir()
 
 
-def test_help_lists_every_option() -> None:
+def test_help_lists_every_option_with_the_shipped_defaults() -> None:
+    import re
+
     proc = subprocess.run([sys.executable, "-m", "simdiff", "generate", "--help"], capture_output=True, text=True)
     assert proc.returncode == 0
-    for option in ("--gravity", "--wind", "--length", "--frames", "--seed", "--num-samples", "--sampler", "--steps",
-                   "--guidance", "--alpha", "--out", "--model", "--force", "--format", "--compare", "--no-video",
-                   "--quiet", "--threads", "generation.json"):
-        assert option in proc.stdout, option
+    options = ("-h", "--gravity", "--wind", "--compare", "--simulate", "--force", "--length", "--seed",
+               "--num-samples", "--sampler", "--steps", "--eta", "--guidance", "--alpha", "--foot-lock",
+               "--env-guidance", "--edit-t", "--out", "--format", "--quiet", "--model", "--device")
+    usage = proc.stdout.split("\n\n")[0]
+    assert set(re.findall(r"\[(-[-\w]+)", usage)) == set(options) - {"--quiet"} | {"-q"}
+    for default in ("(default 3)", "(default 0.925)", "(default 1.1)", "(default 950)", "(default 1)"):
+        assert default in " ".join(proc.stdout.split()), default
 
 
 def test_generate_simulate_writes_the_simulated_motion_and_tracking(tiny_model: Path, tmp_path: Path, capsys) -> None:
-    code = main(["generate", "a person jumps", "--gravity", "-3.7", "--frames", "8", "--steps", "1", "--simulate",
-                 "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    code = main(["generate", "a person jumps", "--gravity", "-3.7", "--length", "0.4", "--steps", "1", "--simulate",
+                 "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
     captured = capsys.readouterr()
     assert code == 0, captured.err
     assert ("warning: the simulated finish" in captured.err) == (json.loads(
@@ -176,8 +181,8 @@ def test_generate_simulate_in_a_worker_equals_in_process(tiny_model: Path, tmp_p
     out = {}
     for workers in ("1", "0"):
         monkeypatch.setenv("SIMDIFF_FINISH_WORKERS", workers)
-        code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--simulate", "--model",
-                     str(tiny_model), "--out", str(tmp_path / workers), "--threads", "1", "--format", "npy", "-q"])
+        code = main(["generate", "a person walks", "--length", "0.4", "--steps", "1", "--simulate", "--model",
+                     str(tiny_model), "--out", str(tmp_path / workers), "--format", "npy", "-q"])
         assert code == 0, capsys.readouterr().err
         assert json.loads((tmp_path / workers / "generation.json").read_text())["simulate_workers"] == int(workers)
         out[workers] = np.load(tmp_path / workers / "sample0_simulated_joints.npy")
@@ -193,8 +198,8 @@ def test_a_failed_finish_still_writes_the_generated_motion(tiny_model: Path, tmp
 
     monkeypatch.setenv("SIMDIFF_FINISH_WORKERS", "0")
     monkeypatch.setattr("simdiff.product.pipeline.simulate_finish", broken)
-    code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--simulate", "--model",
-                 str(tiny_model), "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    code = main(["generate", "a person walks", "--length", "0.4", "--steps", "1", "--simulate", "--model",
+                 str(tiny_model), "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
     err = capsys.readouterr().err
     assert code != 0 and "the simulator broke (the generated motions and generation.json are written in" in err
     assert len(err.strip().splitlines()) == 1
@@ -215,8 +220,7 @@ def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path:
     tensors["normalizer.mean"][SLICES["contacts"]] = 1.0
     tensors["normalizer.mean"][SLICES["root_lin_vel"]] = 0.02
     save_file(tensors, model / "model.safetensors")
-    argv = ["generate", "a person walks", "--frames", "12", "--steps", "2", "--model", str(model), "--threads",
-            "1", "--format", "npy", "--no-video", "-q"]
+    argv = ["generate", "a person walks", "--length", "0.6", "--steps", "2", "--model", str(model), "--format", "npy", "-q"]
     assert main([*argv, "--out", str(tmp_path / "off")]) == 0, capsys.readouterr().err
     assert main([*argv, "--foot-lock", "1", "--out", str(tmp_path / "on")]) == 0, capsys.readouterr().err
     off, on = (np.load(tmp_path / d / "sample0_features.npy") for d in ("off", "on"))
@@ -230,34 +234,12 @@ def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path:
     assert "--foot-lock must be in [0, 1], got 2" in err and err.count("\n") == 1
 
 
-def test_generate_ballistic_option_is_recorded_stored_and_checked(tiny_model: Path, tmp_path: Path, capsys) -> None:
-    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(tiny_model), "--threads",
-            "1", "--format", "npy", "--no-video", "-q"]
-    assert main([*argv, "--ballistic", "1", "--out", str(tmp_path / "on")]) == 0, capsys.readouterr().err
-    assert json.loads((tmp_path / "on" / "generation.json").read_text())["ballistic"] == 1.0
-    assert main([*argv, "--out", str(tmp_path / "off")]) == 0, capsys.readouterr().err
-    assert json.loads((tmp_path / "off" / "generation.json").read_text())["ballistic"] == 0.0
-    assert main([*argv, "--ballistic", "2", "--out", str(tmp_path / "bad")]) == 2
-    err = capsys.readouterr().err
-    assert "--ballistic must be in [0, 1], got 2" in err and err.count("\n") == 1
-    try:
-        (tiny_model / "sampling.json").write_text('{"ballistic": 1.0}')
-        assert main([*argv, "--out", str(tmp_path / "stored")]) == 0, capsys.readouterr().err
-        assert json.loads((tmp_path / "stored" / "generation.json").read_text())["ballistic"] == 1.0
-        (tiny_model / "sampling.json").write_text('{"ballistic": 3}')
-        assert main([*argv, "--out", str(tmp_path / "bad2")]) == 2
-        err = capsys.readouterr().err
-        assert "ballistic must be in [0, 1], got 3" in err and err.count("\n") == 1
-    finally:
-        (tiny_model / "sampling.json").unlink(missing_ok=True)
-
-
 def test_generate_env_guidance_changes_only_motions_off_earth(tmp_path: Path, capsys) -> None:
     from simdiff.serve.testing import write_tiny_model
 
     model = write_tiny_model(tmp_path / "reacting")  # jittered weights: the adapters answer φ
-    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
-            "--format", "npy", "--no-video", "-q"]
+    argv = ["generate", "a person jumps", "--length", "0.6", "--steps", "2", "--model", str(model),
+            "--format", "npy", "-q"]
 
     def run(name: str, *extra: str) -> np.ndarray:
         assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
@@ -276,80 +258,12 @@ def test_generate_env_guidance_changes_only_motions_off_earth(tmp_path: Path, ca
     assert "--env-guidance must be ≥ 0, got -1" in err and err.count("\n") == 1
 
 
-def test_generate_backbone_anchor_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
-    from simdiff.serve.testing import write_tiny_model
-
-    model = write_tiny_model(tmp_path / "reacting")  # jittered weights: the adapters answer φ
-    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
-            "--format", "npy", "--no-video", "-q", "--alpha", "0.5"]
-
-    def run(name: str, *extra: str) -> np.ndarray:
-        assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
-        return np.load(tmp_path / name / "sample0_features.npy")
-
-    plain, anchored = run("plain"), run("anchored", "--anchor", "backbone")
-    assert np.array_equal(anchored, run("alone", "--alpha", "0"))  # Earth without wind: the backbone alone
-    assert not np.allclose(plain, anchored, atol=1e-4)
-    assert json.loads((tmp_path / "anchored" / "generation.json").read_text())["anchor"] == "backbone"
-    (model / "sampling.json").write_text('{"anchor": "backbone"}')
-    assert np.array_equal(run("stored"), anchored)
-    assert np.array_equal(run("given", "--anchor", "adapters"), plain)
-    (model / "sampling.json").write_text('{"anchor": "sim"}')
-    assert main([*argv, "--out", str(tmp_path / "bad")]) == 2
-    err = capsys.readouterr().err
-    assert "anchor must be one of adapters, backbone, reference, edit, got 'sim'" in err and err.count("\n") == 1
-
-
-def test_generate_anchor_alpha_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
-    from simdiff.serve.testing import write_tiny_model
-
-    model = write_tiny_model(tmp_path / "reacting")
-    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
-            "--format", "npy", "--no-video", "-q", "--alpha", "0.5"]
-
-    def run(name: str, *extra: str) -> np.ndarray:
-        assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
-        return np.load(tmp_path / name / "sample0_features.npy")
-
-    given = run("given", "--anchor", "backbone", "--anchor-alpha", "0.25")
-    assert np.array_equal(given, run("quarter", "--alpha", "0.25"))  # Earth without wind: α 0.25's motion
-    assert not np.allclose(given, run("backbone", "--anchor", "backbone"), atol=1e-4)
-    assert json.loads((tmp_path / "given" / "generation.json").read_text())["anchor_alpha"] == 0.25
-    (model / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": 0.25}')
-    assert np.array_equal(run("stored"), given)
-    assert np.array_equal(run("adapters", "--anchor", "adapters"), run("plain0", "--anchor", "adapters",
-                                                                       "--anchor-alpha", "0"))  # stored value dropped
-    assert main([*argv, "--anchor", "adapters", "--anchor-alpha", "0.25", "--out", str(tmp_path / "bad")]) == 2
-    err = capsys.readouterr().err
-    assert "--anchor-alpha 0.25 needs the backbone, reference or edit anchor" in err and err.count("\n") == 1
-    reference = run("reference", "--anchor", "reference", "--anchor-alpha", "0.25")
-    assert np.array_equal(reference, run("a25", "--alpha", "0.25"))  # Earth without wind: the adapters at 0.25
-    assert json.loads((tmp_path / "reference" / "generation.json").read_text())["anchor"] == "reference"
-    late = run("late", "--anchor", "reference", "--anchor-alpha", "0.25", "--anchor-t-max", "100")  # DDIM 2: t 500, 0
-    assert json.loads((tmp_path / "late" / "generation.json").read_text())["anchor_t_max"] == 100
-    assert not np.allclose(late, reference, atol=1e-4)  # the early steps ran the adapters anchor at α 0.5
-    (model / "sampling.json").write_text('{"anchor": "reference", "anchor_alpha": 0.25, "anchor_t_max": 100}')
-    assert np.array_equal(run("stored_late"), late)
-    assert json.loads((tmp_path / "given" / "generation.json").read_text())["anchor_t_max"] is None
-    (model / "sampling.json").unlink()
-    assert main([*argv, "--anchor-t-max", "500", "--out", str(tmp_path / "bad_t")]) == 2
-    err = capsys.readouterr().err
-    assert "--anchor-t-max 500 needs the backbone or reference anchor" in err and err.count("\n") == 1
-    assert main([*argv, "--anchor", "reference", "--anchor-t-max", "1000", "--out", str(tmp_path / "bad_t2")]) == 2
-    err = capsys.readouterr().err
-    assert "--anchor-t-max must be a whole timestep in 0..999, got 1000" in err and err.count("\n") == 1
-    (model / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": -1}')
-    assert main([*argv, "--out", str(tmp_path / "bad2")]) == 2
-    err = capsys.readouterr().err
-    assert "anchor_alpha must be ≥ 0, got -1" in err and err.count("\n") == 1
-
-
 def test_generate_env_guidance_on_a_backbone_is_one_line(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "backbone", sim=False)
-    code = main(["generate", "a person walks", "--frames", "8", "--steps", "1", "--model", str(model), "--threads", "1",
+    code = main(["generate", "a person walks", "--length", "0.4", "--steps", "1", "--model", str(model),
                  "--env-guidance", "2", "--format", "npy", "--out", str(tmp_path / "o"), "-q"])
     err = capsys.readouterr().err
-    assert code == 2 and "env guidance needs a SimDiff model with a continuous Sim Encoder" in err
+    assert code == 2 and "--env-guidance needs a SimDiff model with a continuous Sim Encoder" in err
     assert err.count("\n") == 1
 
 
@@ -360,8 +274,8 @@ def test_a_sample_that_never_touches_the_floor_is_warned_about(tmp_path: Path, c
     mean[3] = 1.5  # root height
     mean[5:67:3] = 1.2  # every other joint's height: the whole body about a metre up
     MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 0.01)).save(tmp_path / "m")
-    code = main(["generate", "a person runs", "--frames", "8", "--steps", "1", "--model", str(tmp_path / "m"),
-                 "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    code = main(["generate", "a person runs", "--length", "0.4", "--steps", "1", "--model", str(tmp_path / "m"),
+                 "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
     err = capsys.readouterr().err
     assert code == 0
     assert err.startswith("simdiff: warning: sample 0 never comes within 0.10 m of the floor (lowest joint 1.1")
@@ -369,32 +283,11 @@ def test_a_sample_that_never_touches_the_floor_is_warned_about(tmp_path: Path, c
     rec = json.loads((tmp_path / "o" / "generation.json").read_text())["samples"][0]
     assert rec["touches_floor"] is False and 1.1 < rec["lowest_m"] < 1.3 and rec["glides"] is False
     # the foot cleanup (cleanup 3) drops such a sample onto the floor: no warning, lowest joint at y = 0
-    code = main(["generate", "a person runs", "--frames", "8", "--steps", "1", "--model", str(tmp_path / "m"),
-                 "--out", str(tmp_path / "o2"), "--threads", "1", "--format", "npy", "-q", "--foot-lock", "1"])
+    code = main(["generate", "a person runs", "--length", "0.4", "--steps", "1", "--model", str(tmp_path / "m"),
+                 "--out", str(tmp_path / "o2"), "--format", "npy", "-q", "--foot-lock", "1"])
     assert code == 0 and capsys.readouterr().err == ""
     rec = json.loads((tmp_path / "o2" / "generation.json").read_text())["samples"][0]
     assert rec["touches_floor"] is True and rec["lowest_m"] == 0.0
-
-
-def test_env_guidance_fallback_is_recorded_per_sample(tmp_path: Path, capsys) -> None:
-    torch.manual_seed(0)
-    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())
-    mean = torch.zeros(263)
-    mean[3] = 1.5
-    mean[5:67:3] = 1.2  # every raw sample floats: each one is re-sampled at the fallback
-    MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 0.01)).save(tmp_path / "m")
-    args = ["generate", "a person runs", "--frames", "8", "--steps", "1", "--model", str(tmp_path / "m"),
-            "--gravity", "-1.6", "--env-guidance", "4", "--threads", "1", "--format", "npy", "-q"]
-    assert main([*args, "--env-guidance-fallback", "2", "--out", str(tmp_path / "o")]) == 0
-    meta = json.loads((tmp_path / "o" / "generation.json").read_text())
-    assert meta["env_guidance_fallback"] == 2.0 and meta["samples"][0]["fell_back"] is True
-    assert main([*args, "--out", str(tmp_path / "p")]) == 0
-    meta = json.loads((tmp_path / "p" / "generation.json").read_text())
-    assert meta["env_guidance_fallback"] is None and "fell_back" not in meta["samples"][0]
-    capsys.readouterr()
-    assert main([*args, "--env-guidance-fallback", "-1", "--out", str(tmp_path / "q")]) == 2
-    err = capsys.readouterr().err
-    assert "--env-guidance-fallback must be ≥ 0, got -1" in err and err.count("\n") == 1
 
 
 def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
@@ -405,8 +298,8 @@ def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
     mean[3] = 0.9  # root height
     mean[4:67] = torch.tensor([0.0, 0.05, 0.0] * 21)  # every joint 5 cm above the floor, fixed: a statue
     MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 1e-4)).save(tmp_path / "m")
-    code = main(["generate", "a person runs", "--frames", "20", "--steps", "1", "--model", str(tmp_path / "m"),
-                 "--out", str(tmp_path / "o"), "--threads", "1", "--format", "npy", "-q"])
+    code = main(["generate", "a person runs", "--length", "1", "--steps", "1", "--model", str(tmp_path / "m"),
+                 "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
     err = capsys.readouterr().err
     assert code == 0 and err.startswith("simdiff: warning: sample 0 glides: it travels while no foot lifts 0.05 m")
     assert len(err.strip().splitlines()) == 1
@@ -415,8 +308,8 @@ def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
 
 def test_generate_reports_an_extrapolated_backbone(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "m")
-    argv = ["generate", "a person waves", "--frames", "8", "--steps", "2", "--model", str(model), "--threads", "1",
-            "--format", "npy", "--no-video", "-q"]
+    argv = ["generate", "a person waves", "--length", "0.4", "--steps", "2", "--model", str(model),
+            "--format", "npy", "-q"]
     assert main([*argv, "--out", str(tmp_path / "o")]) == 0, capsys.readouterr().err
     assert "extrapolation" not in json.loads((tmp_path / "o" / "generation.json").read_text())["model"]
     (model / "extrapolation.json").write_text(json.dumps({"lambda": 1.5, "parent": "p"}))
@@ -430,12 +323,12 @@ def test_generate_reports_an_extrapolated_backbone(tmp_path: Path, capsys) -> No
     assert not (tmp_path / "bad" / "generation.json").exists()
 
 
-def test_generate_edit_anchor_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
+def test_generate_edit_t_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
     from simdiff.serve.testing import write_tiny_model
 
     model = write_tiny_model(tmp_path / "editing")
-    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "2", "--model", str(model), "--threads", "1",
-            "--format", "npy", "--no-video", "-q", "--alpha", "0.5"]
+    argv = ["generate", "a person jumps", "--length", "0.6", "--steps", "2", "--model", str(model),
+            "--format", "npy", "-q", "--alpha", "0.5"]
 
     def run(name: str, *extra: str) -> np.ndarray:
         assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
@@ -444,35 +337,32 @@ def test_generate_edit_anchor_from_the_option_or_sampling_json(tmp_path: Path, c
     def meta(name: str) -> dict:
         return json.loads((tmp_path / name / "generation.json").read_text())
 
-    earth = run("earth", "--anchor", "edit")
-    assert np.array_equal(earth, run("a0", "--alpha", "0"))  # Earth without wind: the reference anchor at α 0
-    assert meta("earth")["edit_t"] == 800 and meta("a0")["edit_t"] is None
+    earth = run("earth")
+    assert np.array_equal(earth, run("a0", "--alpha", "0"))  # Earth without wind: the backbone alone
+    assert meta("earth")["edit_t"] == 950
     # DDIM 2 runs t 500 and 0: edit t 100 keeps the first step at Earth, edit t 600 runs both under φ
-    late, early = (run(n, "--anchor", "edit", "--edit-t", t, "--gravity", "-1.6") for n, t in (("late", "100"),
-                                                                                               ("early", "600")))
+    late, early = (run(n, "--edit-t", t, "--gravity", "-1.6") for n, t in (("late", "100"), ("early", "600")))
     assert meta("late")["edit_t"] == 100 and not np.allclose(late, early, atol=1e-4)
     assert not np.allclose(late, earth, atol=1e-4)  # the last step ran under φ
-    (model / "sampling.json").write_text('{"anchor": "edit", "edit_t": 100}')
+    (model / "sampling.json").write_text('{"edit_t": 100}')
     assert np.array_equal(run("stored", "--gravity", "-1.6"), late)
     assert meta("stored")["edit_t"] == 100
-    assert meta("stored")["anchor"] == "edit"
-    assert main([*argv, "--anchor", "reference", "--gravity", "-1.6", "--out", str(tmp_path / "ref")]) == 0
-    assert meta("ref")["edit_t"] is None  # the stored edit t belongs to the stored anchor
+    (model / "sampling.json").write_text('{"anchor": "edit"}')
+    assert main([*argv, "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "unknown key 'anchor' = 'edit'" in err and err.count("\n") == 1
     (model / "sampling.json").unlink()
-    assert main([*argv, "--edit-t", "500", "--out", str(tmp_path / "bad")]) == 2
+    assert main([*argv, "--edit-t", "1000", "--out", str(tmp_path / "bad2")]) == 2
     err = capsys.readouterr().err
-    assert "--edit-t 500 needs the edit anchor" in err and err.count("\n") == 1
-    assert main([*argv, "--anchor", "edit", "--edit-t", "1000", "--out", str(tmp_path / "bad2")]) == 2
-    err = capsys.readouterr().err
-    assert "--edit-t must be a whole timestep in 0..999, got 1000" in err and err.count("\n") == 1
+    assert "--edit-t must be a whole number in 0..999, got 1000" in err and err.count("\n") == 1
 
 
 def test_generate_eta_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
     from simdiff.serve.testing import write_tiny_model
 
     model = write_tiny_model(tmp_path / "eta")
-    argv = ["generate", "a person jumps", "--frames", "12", "--steps", "3", "--model", str(model), "--threads", "1",
-            "--format", "npy", "--no-video", "-q"]
+    argv = ["generate", "a person jumps", "--length", "0.6", "--steps", "3", "--model", str(model),
+            "--format", "npy", "-q"]
 
     def run(name: str, *extra: str) -> np.ndarray:
         assert main([*argv, *extra, "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
@@ -489,7 +379,7 @@ def test_generate_eta_from_the_option_or_sampling_json(tmp_path: Path, capsys) -
     assert np.array_equal(run("stored"), noisy) and meta("stored")["eta"] == 1.0
     assert np.array_equal(run("told", "--eta", "0"), plain)  # the option wins
     assert main([*argv, "--sampler", "ddpm", "--out", str(tmp_path / "ddpm")]) == 0
-    assert meta("ddpm")["eta"] is None  # the stored η belongs to DDIM
+    assert meta("ddpm")["eta"] == 0.0  # the stored η belongs to DDIM
     (model / "sampling.json").unlink()
     for extra, message in ((("--eta", "1.5"), "--eta must be in [0, 1], got 1.5"),
                            (("--eta", "nan"), "--eta must be a finite number"),

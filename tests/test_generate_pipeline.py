@@ -9,11 +9,13 @@ import numpy as np
 import pytest
 import torch
 
-from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network
+from simdiff.diffusion.config import SamplingConfig
+from simdiff.model import ModelConfig, SimConfig, backbone_preset, build_network
+from simdiff.inference.generator import MotionGenerator
 from simdiff.motion.features import features_to_joints
 from simdiff.viz.video import write_gif
 from simdiff.product.pipeline import Timer, run_generation, sample_motions
-from simdiff.product.request import build_request
+from simdiff.product.request import GenerationRequest, build_request
 from simdiff.train.testing import HashTextEncoder
 
 
@@ -24,6 +26,11 @@ def one_thread():
     torch.set_num_threads(1)
     yield
     torch.set_num_threads(threads)
+
+
+def req(text: str, steps: int, **kwargs) -> GenerationRequest:
+    """A checked request sampled with ``steps`` DDIM steps (the other settings: SamplingConfig's defaults)."""
+    return build_request(text, sampling=SamplingConfig(steps=steps), **kwargs)
 
 
 def tiny_generator(sim: bool = True, active_adapters: bool = True) -> MotionGenerator:
@@ -41,7 +48,7 @@ def tiny_generator(sim: bool = True, active_adapters: bool = True) -> MotionGene
 
 
 def test_files_shapes_and_metadata(tmp_path: Path) -> None:
-    request = build_request("a person jumps forward", gravity=-3.7, wind=(2.0, 0.0), frames=12, steps=3, seed=4,
+    request = req("a person jumps forward", 3, gravity=-3.7, wind=(2.0, 0.0), length_s=0.6, seed=4,
                             formats="npy,bvh,gif")
     timer = Timer()
     meta, paths = run_generation(tiny_generator(), request, tmp_path, tmp_path, timer, quiet=True)
@@ -70,17 +77,17 @@ def test_files_shapes_and_metadata(tmp_path: Path) -> None:
 
 def test_sample_k_uses_seed_plus_k_and_env_matters() -> None:
     gen = tiny_generator()
-    two = sample_motions(gen, build_request("walk", frames=10, steps=3, seed=5, num_samples=2), Timer(), quiet=True)
-    one = sample_motions(gen, build_request("walk", frames=10, steps=3, seed=6), Timer(), quiet=True)
+    two = sample_motions(gen, req("walk", 3, length_s=0.5, seed=5, num_samples=2), Timer(), quiet=True)
+    one = sample_motions(gen, req("walk", 3, length_s=0.5, seed=6), Timer(), quiet=True)
     assert [s.seed for s in two] == [5, 6]
     np.testing.assert_array_equal(two[1].features, one[0].features)
     assert not np.allclose(two[0].features, two[1].features)
-    moon = sample_motions(gen, build_request("walk", gravity=-1.6, frames=10, steps=3, seed=6), Timer(), quiet=True)
+    moon = sample_motions(gen, req("walk", 3, gravity=-1.6, length_s=0.5, seed=6), Timer(), quiet=True)
     assert np.abs(moon[0].features - one[0].features).max() > 1e-3
 
 
 def test_compare_same_noise_per_environment(tmp_path: Path) -> None:
-    request = build_request("a person jumps", frames=8, steps=2, compare="gravity=-9.81,-1.6", num_samples=1,
+    request = req("a person jumps", 2, length_s=0.4, compare="gravity=-9.81,-1.6", num_samples=1,
                             formats="npy,gif")
     gen = tiny_generator()
     meta, paths = run_generation(gen, request, tmp_path, tmp_path, Timer(), quiet=True)
@@ -96,7 +103,7 @@ def test_compare_same_noise_per_environment(tmp_path: Path) -> None:
     with Image.open(paths[0]) as im:
         assert im.size[0] == width
     # each compared motion equals a plain run under that environment with the same seed
-    earth = sample_motions(gen, build_request("a person jumps", frames=8, steps=2), Timer(), quiet=True)[0]
+    earth = sample_motions(gen, req("a person jumps", 2, length_s=0.4), Timer(), quiet=True)[0]
     np.testing.assert_array_equal(np.load(tmp_path / "gravity-9.81_sample0_features.npy"), earth.features)
     # with zero-initialised (fresh) adapters φ has no effect: same noise gives the same motion
     fresh = tiny_generator(active_adapters=False)
@@ -106,7 +113,7 @@ def test_compare_same_noise_per_environment(tmp_path: Path) -> None:
 
 def test_backbone_model_ignores_environment(tmp_path: Path) -> None:
     gen = tiny_generator(sim=False)
-    request = build_request("walk", gravity=-1.6, frames=6, steps=2, formats="npy").with_envs(
+    request = req("walk", 2, gravity=-1.6, length_s=0.3, formats="npy").with_envs(
         build_request("walk").envs)
     meta, _ = run_generation(gen, request, tmp_path, tmp_path, Timer(), quiet=True)
     assert meta["environment"] is None and meta["alpha"] is None and meta["samples"][0]["environment"] is None
@@ -114,7 +121,7 @@ def test_backbone_model_ignores_environment(tmp_path: Path) -> None:
 
 
 def test_mp4_output(tmp_path: Path) -> None:
-    request = build_request("walk", frames=6, steps=1, formats="mp4")
+    request = req("walk", 1, length_s=0.3, formats="mp4")
     _, paths = run_generation(tiny_generator(), request, tmp_path, tmp_path, Timer(), quiet=True)
     assert [p.name for p in paths] == ["sample0.mp4", "generation.json"]
     assert (tmp_path / "sample0.mp4").stat().st_size > 1000

@@ -7,7 +7,7 @@ import json
 import torch
 from safetensors.torch import load, load_file
 
-from simdiff.model.checkpoint import atomic_save_tensors, canonical_safetensors
+from simdiff.fsio import atomic_save_tensors, canonical_safetensors
 
 
 def _with_metadata_order(keys: list[str]) -> bytes:

@@ -169,14 +169,14 @@ def test_an_entry_listed_again_is_kept_once(tmp_path: Path) -> None:
     assert Provenance([cmu, noted]).trained_on == [cmu, noted]  # another note is another run: kept
     write_provenance(tmp_path, Provenance([cmu]))
     text = json.loads((tmp_path / PROVENANCE_NAME).read_text())
-    text["trained_on"] *= 3  # a file written before session 77 may repeat entries
+    text["trained_on"] *= 3  # a file written by an older version may repeat entries
     (tmp_path / PROVENANCE_NAME).write_text(json.dumps(text))
     back = read_provenance(tmp_path)
     assert back is not None and back.trained_on == [cmu]
 
 
 def test_shipped_default_model_states_its_licence() -> None:
-    from simdiff.model.default import DEFAULT_MODEL_DIR
+    from simdiff.inference.default import DEFAULT_MODEL_DIR
 
     prov = read_provenance(DEFAULT_MODEL_DIR)
     assert prov is not None and {p.what for p in prov.trained_on} == {"backbone", "adapters"}

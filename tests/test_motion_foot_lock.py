@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import torch
 
+from simdiff.diffusion.config import SamplingConfig
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints, process_joints
 from simdiff.motion.foot_lock import CONTACT_JOINTS, clean_feet, lock_feet, lock_feet_numpy
@@ -88,14 +89,14 @@ def test_batch_lengths_dtype_and_errors() -> None:
 def test_generator_applies_the_lock_to_the_final_sample() -> None:
     from simdiff.model.checkpoint import build_network
     from simdiff.model.config import ModelConfig, backbone_preset
-    from simdiff.model.generator import MotionGenerator
+    from simdiff.inference.generator import MotionGenerator
     from simdiff.train.testing import HashTextEncoder
 
     torch.manual_seed(0)
     config = ModelConfig(backbone=backbone_preset("tiny"), sim=None)
     gen = MotionGenerator(build_network(config), config, HashTextEncoder())
-    a = gen.generate(["walk"] * 2, [24, 16], steps=3, seed=1)
-    b = gen.generate(["walk"] * 2, [24, 16], steps=3, seed=1, foot_lock=1.0)
+    a = gen.generate(["walk"] * 2, [24, 16], SamplingConfig(steps=3), seed=1)
+    b = gen.generate(["walk"] * 2, [24, 16], SamplingConfig(steps=3, foot_lock=1.0), seed=1)
     lens = torch.tensor([24, 16])
     valid = torch.arange(24)[None, :, None] < lens[:, None, None]
     assert torch.allclose(b.features, clean_feet(a.features, lens) * valid, atol=1e-5)

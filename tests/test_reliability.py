@@ -1,4 +1,4 @@
-"""Failure cases of outputs, the server and the CLI (issue 16): one-line errors, nothing half-written.
+"""Failure cases of outputs, the server and the CLI: one-line errors, nothing half-written.
 
 Read-only outputs and full disks are simulated (tests may run as root, where ``chmod`` does not
 block writes): ``os.replace`` raising ``EROFS``, a writer that writes half the bytes and then

@@ -1,5 +1,5 @@
 """The tracked tree leaves room for a lent GPU machine's call: everything that travels there (tracked files, untracked
-files git does not ignore, and the carried packs, text table and wheels) counts against its 64 MiB (session 76: at
+files git does not ignore, and the carried packs, text table and wheels) counts against its 64 MiB (measured: at
 90.7 MB tracked, every device call was refused before a machine started)."""
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ def test_tracked_tree_leaves_room_for_a_device_call() -> None:
         pytest.skip("not a git checkout")
     assert size <= LIMIT_MIB * 2**20, (
         f"tracked files take {size / 2**20:.1f} MiB, over {LIMIT_MIB} MiB: a GPU call could carry under 16 MiB; "
-        "keep large artefacts out of the tree (scripts/restore_report_weights.sh shows how)")
+        "keep large artefacts out of the tree")
 
 
 def test_tracked_bytes_counts_files(tmp_path: Path) -> None:

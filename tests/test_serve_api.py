@@ -9,6 +9,7 @@ import socket
 import threading
 import urllib.error
 import urllib.request
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -17,8 +18,9 @@ import pytest
 import torch
 
 from simdiff.cli.main import main
+from simdiff.diffusion.config import SamplingConfig
 from simdiff.errors import SimdiffError
-from simdiff.model.generator import MotionGenerator
+from simdiff.inference.generator import MotionGenerator
 from simdiff.motion import synthetic
 from simdiff.motion.features import features_to_joints, joints_to_features
 from simdiff.motion.io import load_joints, write_bvh
@@ -127,18 +129,19 @@ def test_generate_matches_direct_sampling(server, model_dir):
     meta = out["meta"]
     assert meta["source"] == "generate" and meta["frames"] == 40 and meta["seconds"] == 2.0 and meta["env_used"]
     assert isinstance(meta["touches_floor"], bool) and isinstance(meta["lowest_m"], float)
-    assert meta["params"]["text"] == "a person jumps forward" and meta["params"]["steps"] == STEPS
+    assert meta["params"]["text"] == "a person jumps forward" and meta["sampling"]["steps"] == STEPS
 
     gen = MotionGenerator.load(model_dir, load_text=False)
     gen.text_encoder = HashTextEncoder()
-    clip = gen.generate(["a person jumps forward"], 40, env=(-5.0, 3.0, -2.0), alpha=1.5, steps=STEPS, seed=7).clips()[0]
+    config = SamplingConfig(steps=STEPS, alpha=1.5)
+    clip = gen.generate(["a person jumps forward"], 40, config, env=(-5.0, 3.0, -2.0), seed=7).clips()[0]
     expected = features_to_joints(clip.numpy())
     np.testing.assert_allclose(joints, expected, atol=1e-4)  # rounded to 0.1 mm on the wire
-    assert meta["foot_lock"] == 0.0  # no sampling.json: off, as `simdiff generate`
+    assert meta["sampling"] == config.to_dict()  # no sampling.json: the SamplingConfig defaults, as `simdiff generate`
     status, out, _ = call(server, "/api/generate", {**body, "foot_lock": 1.0})
-    assert status == 200 and out["meta"]["foot_lock"] == 1.0
-    locked = gen.generate(["a person jumps forward"], 40, env=(-5.0, 3.0, -2.0), alpha=1.5, steps=STEPS, seed=7,
-                          foot_lock=1.0).clips()[0]
+    assert status == 200 and out["meta"]["sampling"]["foot_lock"] == 1.0
+    locked = gen.generate(["a person jumps forward"], 40, replace(config, foot_lock=1.0), env=(-5.0, 3.0, -2.0),
+                          seed=7).clips()[0]
     np.testing.assert_allclose(np.asarray(out["joints"]), features_to_joints(locked.numpy()), atol=1e-4)
 
 
@@ -197,7 +200,6 @@ def test_generation_requests_are_serialised(server):
     ({"text": "walk", "simulate": "yes"}, "simulate must be true or false, got 'yes'"),
     ({"text": "walk", "foot_lock": 2}, "foot_lock must be in [0, 1], got 2"),
     ({"text": "walk", "foot_lock": "on"}, "foot_lock must be a finite number, got 'on'"),
-    ({"text": "walk", "ballistic": 1.5}, "ballistic must be in [0, 1], got 1.5"),
     (["walk"], "request body must be a JSON object"),
 ])
 def test_bad_generate_request_is_a_400_with_one_line(server, body, needle):
@@ -331,14 +333,15 @@ def test_generate_takes_the_models_alpha_and_foot_lock_unless_given(server, mode
         defaults = call(server, "/api/info")[1]["defaults"]
         assert (defaults["alpha"], defaults["foot_lock"]) == (0.5, 1.0)  # the page starts where `generate` does
         status, stored, _ = call(server, "/api/generate", body)
-        assert status == 200 and stored["meta"]["foot_lock"] == 1.0 and stored["meta"]["params"]["alpha"] == 0.5
+        assert status == 200 and stored["meta"]["sampling"]["foot_lock"] == 1.0
+        assert stored["meta"]["sampling"]["alpha"] == 0.5
         status, given, _ = call(server, "/api/generate", {**body, "alpha": 0.5, "foot_lock": 1})
         assert given["joints"] == stored["joints"]
         status, off, _ = call(server, "/api/generate", {**body, "foot_lock": 0})
-        assert status == 200 and off["meta"]["foot_lock"] == 0.0
+        assert status == 200 and off["meta"]["sampling"]["foot_lock"] == 0.0
         (model_dir / "sampling.json").write_text('{"foot_lock": 3}')
         status, out, _ = call(server, "/api/generate", body)
-        assert status == 503 and "foot_lock must be in [0, 1], got 3" in out["error"]
+        assert status == 503 and "--foot-lock must be in [0, 1], got 3" in out["error"]
         assert call(server, "/api/info")[0] == 200  # the page still loads its defaults
     finally:
         (model_dir / "sampling.json").unlink()
@@ -347,9 +350,9 @@ def test_generate_takes_the_models_alpha_and_foot_lock_unless_given(server, mode
 def test_generate_env_guidance_from_sampling_json_or_the_request(server, model_dir):
     moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "gravity": -1.6}
     status, plain, _ = call(server, "/api/generate", moon)
-    assert status == 200 and plain["meta"]["env_guidance"] == 1.0
+    assert status == 200 and plain["meta"]["sampling"]["env_guidance"] == 1.0
     status, pushed, _ = call(server, "/api/generate", {**moon, "env_guidance": 3})
-    assert status == 200 and pushed["meta"]["env_guidance"] == 3.0 and pushed["joints"] != plain["joints"]
+    assert status == 200 and pushed["meta"]["sampling"]["env_guidance"] == 3.0 and pushed["joints"] != plain["joints"]
     earth = {**moon, "gravity": -9.81}
     assert call(server, "/api/generate", {**earth, "env_guidance": 3})[1]["joints"] == \
         call(server, "/api/generate", earth)[1]["joints"]  # Earth without wind: unchanged
@@ -363,70 +366,56 @@ def test_generate_env_guidance_from_sampling_json_or_the_request(server, model_d
     for bad in (-1, 11, "x"):
         status, out, _ = call(server, "/api/generate", {**moon, "env_guidance": bad})
         assert status == 400 and "env_guidance" in out["error"]
-    status, fb, _ = call(server, "/api/generate", {**moon, "env_guidance": 3, "env_guidance_fallback": 2})
-    assert status == 200 and fb["meta"]["env_guidance_fallback"] == 2.0 and isinstance(fb["meta"]["fell_back"], bool)
-    assert plain["meta"]["env_guidance_fallback"] is None and "fell_back" not in plain["meta"]
-    status, out, _ = call(server, "/api/generate", {**moon, "env_guidance_fallback": -1})
-    assert status == 400 and "env_guidance_fallback" in out["error"]
-
-
-def test_generate_anchor_alpha_from_sampling_json_or_the_request(server, model_dir):
-    earth = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5}
-    status, given, _ = call(server, "/api/generate", {**earth, "anchor": "backbone", "anchor_alpha": 0.25})
-    assert status == 200 and given["meta"]["params"]["anchor_alpha"] == 0.25
-    assert given["joints"] == call(server, "/api/generate", {**earth, "alpha": 0.25})[1]["joints"]
-    (model_dir / "sampling.json").write_text('{"anchor": "backbone", "anchor_alpha": 0.25}')
-    try:
-        status, stored, _ = call(server, "/api/generate", earth)
-        assert status == 200 and stored["joints"] == given["joints"]
-    finally:
-        (model_dir / "sampling.json").unlink()
-    status, out, _ = call(server, "/api/generate", {**earth, "anchor_alpha": -1})
-    assert status == 400 and "anchor_alpha must be in" in out["error"]
-    status, out, _ = call(server, "/api/generate", {**earth, "anchor_alpha": 0.25})  # the request's error: 400
-    assert status == 400 and "anchor_alpha 0.25 needs the backbone, reference or edit anchor" in out["error"], out
-
-
-def test_generate_anchor_t_max_from_sampling_json_or_the_request(server, model_dir):
-    moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5, "gravity": -1.6, "env_guidance": 2}
-    late = {**moon, "anchor": "reference", "anchor_alpha": 0.25}
-    status, given, _ = call(server, "/api/generate", {**late, "anchor_t_max": 500})
-    assert status == 200 and given["meta"]["params"]["anchor_t_max"] == 500
-    assert given["joints"] != call(server, "/api/generate", late)[1]["joints"]
-    (model_dir / "sampling.json").write_text('{"anchor": "reference", "anchor_alpha": 0.25, "anchor_t_max": 500}')
-    try:
-        status, stored, _ = call(server, "/api/generate", moon)
-        assert status == 200 and stored["joints"] == given["joints"]
-    finally:
-        (model_dir / "sampling.json").unlink()
-    for bad, message in ((1000, "anchor_t_max must be a whole timestep"), (500, "anchor_t_max 500 needs the backbone")):
-        status, out, _ = call(server, "/api/generate", {**moon, "anchor_t_max": bad})
-        assert status == 400 and message in out["error"], out
 
 
 def test_generate_edit_t_from_sampling_json_or_the_request(server, model_dir):
     moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5, "gravity": -1.6}
-    edit = {**moon, "anchor": "edit"}
-    status, given, _ = call(server, "/api/generate", {**edit, "edit_t": 100})
-    assert status == 200 and given["meta"]["params"]["edit_t"] == 100
-    assert given["joints"] != call(server, "/api/generate", edit)[1]["joints"]
-    (model_dir / "sampling.json").write_text('{"anchor": "edit", "edit_t": 100}')
+    status, given, _ = call(server, "/api/generate", {**moon, "edit_t": 100})
+    assert status == 200 and given["meta"]["sampling"]["edit_t"] == 100
+    assert given["joints"] != call(server, "/api/generate", moon)[1]["joints"]
+    (model_dir / "sampling.json").write_text('{"edit_t": 100}')
     try:
         status, stored, _ = call(server, "/api/generate", moon)
         assert status == 200 and stored["joints"] == given["joints"]
     finally:
         (model_dir / "sampling.json").unlink()
-    for bad, message in ((1000, "edit_t must be a whole timestep"), (500, "edit_t 500 needs the edit anchor")):
+    for bad, message in ((1000, "edit_t must be in [0, 999], got 1000"), (2.5, "edit_t must be an integer")):
         status, out, _ = call(server, "/api/generate", {**moon, "edit_t": bad})
         assert status == 400 and message in out["error"], out
+
+
+def test_the_viewer_and_the_cli_give_the_same_joints(server, model_dir, tmp_path):
+    """Same prompt, seed and φ, the model's sampling.json for both (non-round values, as the shipped model's):
+    the viewer's joints are the CLI's (to the 0.1 mm the wire rounds to)."""
+    from unittest import mock
+
+    (model_dir / "sampling.json").write_text('{"steps": 4, "eta": 1.0, "guidance": 3.0, "alpha": 0.925, '
+                                             '"env_guidance": 1.1, "edit_t": 950, "foot_lock": 1.0}')
+    try:
+        defaults = call(server, "/api/info")[1]["defaults"]
+        assert (defaults["alpha"], defaults["env_guidance"], defaults["guidance"]) == (0.925, 1.1, 3.0)
+        body = {"text": "a person jumps forward", "gravity": -3.7, "wind_x": 2.0, "seconds": 1.0, "seed": 5}
+        status, viewer, _ = call(server, "/api/generate", body)
+        assert status == 200, viewer
+        # the page sends its sliders, which start at the model's exact values: the same motion
+        sliders = {k: defaults[k] for k in ("alpha", "env_guidance", "guidance", "foot_lock")}
+        assert call(server, "/api/generate", {**body, **sliders})[1]["joints"] == viewer["joints"]
+        with mock.patch("simdiff.text.base.load_text_encoder", return_value=HashTextEncoder()):
+            code = main(["generate", body["text"], "--gravity", "-3.7", "--wind", "2", "0", "--length", "1",
+                         "--seed", "5", "--model", str(model_dir), "--format", "npy", "--out", str(tmp_path), "-q"])
+        assert code == 0
+    finally:
+        (model_dir / "sampling.json").unlink()
+    cli = np.load(tmp_path / "sample0_joints.npy")
+    np.testing.assert_allclose(np.asarray(viewer["joints"]), cli, atol=1e-4)
 
 
 def test_generate_eta_from_sampling_json_or_the_request(server, model_dir):
     moon = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5, "gravity": -1.6}
     status, plain, _ = call(server, "/api/generate", moon)
-    assert status == 200 and plain["meta"]["params"]["eta"] == 0.0
+    assert status == 200 and plain["meta"]["sampling"]["eta"] == 0.0
     status, noisy, _ = call(server, "/api/generate", {**moon, "eta": 1.0})
-    assert status == 200 and noisy["meta"]["params"]["eta"] == 1.0 and noisy["joints"] != plain["joints"]
+    assert status == 200 and noisy["meta"]["sampling"]["eta"] == 1.0 and noisy["joints"] != plain["joints"]
     (model_dir / "sampling.json").write_text('{"eta": 1.0}')
     try:
         status, stored, _ = call(server, "/api/generate", moon)
@@ -437,20 +426,3 @@ def test_generate_eta_from_sampling_json_or_the_request(server, model_dir):
     for bad, message in ((1.5, "eta must be in [0, 1], got 1.5"), ("x", "eta must be a finite number")):
         status, out, _ = call(server, "/api/generate", {**moon, "eta": bad})
         assert status == 400 and message in out["error"], out
-
-
-def test_generate_anchor_from_sampling_json_or_the_request(server, model_dir):
-    earth = {"text": "a person jumps", "seconds": 1.0, "seed": 3, "alpha": 0.5}
-    status, plain, _ = call(server, "/api/generate", earth)
-    assert status == 200 and plain["meta"]["params"]["anchor"] == "adapters"
-    status, anchored, _ = call(server, "/api/generate", {**earth, "anchor": "backbone"})
-    assert status == 200 and anchored["joints"] != plain["joints"]
-    assert anchored["joints"] == call(server, "/api/generate", {**earth, "alpha": 0.0})[1]["joints"]
-    (model_dir / "sampling.json").write_text('{"anchor": "backbone"}')
-    try:
-        status, stored, _ = call(server, "/api/generate", earth)
-        assert status == 200 and stored["joints"] == anchored["joints"]
-    finally:
-        (model_dir / "sampling.json").unlink()
-    status, out, _ = call(server, "/api/generate", {**earth, "anchor": "sim"})
-    assert status == 400 and "anchor must be one of adapters, backbone, reference, edit, got 'sim'" in out["error"]

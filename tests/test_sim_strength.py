@@ -1,4 +1,4 @@
-"""Issue 13: actuators and balance scale with max(1, |g_z|/9.81); nothing changes at |g_z| ≤ 9.81."""
+"""Actuators and balance scale with max(1, |g_z|/9.81); nothing changes at |g_z| ≤ 9.81."""
 
 from __future__ import annotations
 

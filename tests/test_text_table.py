@@ -9,7 +9,8 @@ import torch
 
 from simdiff.cli.main import main
 from simdiff.errors import SimdiffError
-from simdiff.text.table import CaptionTable, corpus_captions, write_caption_table
+from simdiff.data.humanml3d import corpus_captions
+from simdiff.text.table import CaptionTable, write_caption_table
 from simdiff.train.pipeline import budget_config, run_pipeline
 from simdiff.train.testing import EchoProjector, HashMiniLM as FakeMiniLM
 

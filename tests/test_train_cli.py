@@ -185,7 +185,7 @@ def test_adapters_train_on_a_simulator_augmented_corpus(runs, tmp_path, capsys) 
 def test_export_backbone_writes_the_frozen_backbone_bit_identical(runs, tmp_path, capsys) -> None:
     from safetensors.torch import load_file
 
-    from simdiff.model import MotionGenerator
+    from simdiff.inference.generator import MotionGenerator
     from simdiff.model.provenance import read_provenance
 
     src, out = runs / "ad" / "model", tmp_path / "bb_only"
@@ -221,7 +221,7 @@ def _perturbed_copy(src, dst, key: str = "backbone.", scale: float = 0.01):
 def test_extrapolate_moves_only_the_backbone_along_the_fine_tune(runs, tmp_path, capsys) -> None:
     from safetensors.torch import load_file
 
-    from simdiff.model import MotionGenerator
+    from simdiff.inference.generator import MotionGenerator
     from simdiff.model.provenance import read_provenance
 
     model = tmp_path / "model"

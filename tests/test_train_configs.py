@@ -21,7 +21,7 @@ def test_config_parses(path: Path) -> None:
     config = config_from_dict(json.loads(path.read_text()), RunConfig)
     assert config.train.mode in ("backbone", "adapters")
     assert (config.model.sim is not None) == (config.train.mode == "adapters")
-    # session 49: unmasked attention lets real frames attend to padding (MDM's bug); a run from scratch masks it
+    # unmasked attention lets real frames attend to padding (MDM's bug); a run from scratch masks it
     assert config.model.backbone.mask_frames, f"{path.name} trains with unmasked attention"
     assert config.train.optim.lr_schedule in LR_SCHEDULES
 

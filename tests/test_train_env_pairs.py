@@ -11,11 +11,11 @@ import torch
 
 from simdiff.data.augment import AugmentConfig, AugmentedHumanML3D, augment
 from simdiff.errors import SimdiffError
-from simdiff.eval.phi_usage import phi_usage
 from simdiff.eval.testing import write_tiny_corpus
 from simdiff.model import Condition, load_pretrained
 from simdiff.train import Trainer, synthetic_dataset
-from simdiff.train.data import StepBatcher, StepBatches, collate
+from simdiff.data.batch import collate
+from simdiff.train.data import StepBatcher, StepBatches
 from simdiff.train.geometric import CropConfig, crop_batch
 from simdiff.train.testing import HashTextEncoder as HashText
 from simdiff.train.testing import tiny_run_config as run_config
@@ -190,20 +190,8 @@ def test_paired_training_learns_a_response_to_phi_and_resumes_exactly(tmp_path: 
         assert all(torch.equal(after[k], v) for k, v in before.items())  # the backbone stays frozen
         responses[name] = _response(tmp_path / name / "model", ds)
     # φ alone (same x_t) now moves the prediction the right way (the truth is +0.5; 40 tiny steps learn a part of
-    # it; whether pairs learn it faster than the plain loss is the experiment's question, reports/training/)
+    # it; whether pairs learn it faster than the plain loss is a question for a full training run)
     assert 0.04 < responses["pairs"] < 0.6, responses
-    # the φ-usage diagnostic sees it: φ lowers the loss, and predicts more of the twins' change than x_t alone
-    trained, _, _ = load_pretrained(tmp_path / "pairs" / "model", "cpu")
-    usage = phi_usage(trained, ds, HashText(), batches=3, batch_size=6, seed=1)
-    assert usage["shuffled_minus_true"][0] > 0 and usage["pairs"] == 9
-    assert usage["response_r2"][0] > usage["response_r2_backbone"][0] + 0.01
-    fresh = Trainer(tmp_path / "fresh", run_config(1, mode="adapters", sim=True, env_pairs=1.0, batch_size=6), ds,
-                    text_encoder=HashText(), init_model=bb).network  # zero-initialised adapters: the backbone exactly
-    blind = phi_usage(fresh, ds, HashText(), batches=3, batch_size=6, seed=1)
-    assert blind["loss_true"] == blind["loss_shuffled"] == blind["loss_earth"] == blind["loss_backbone"]
-    assert blind["response_r2"] == blind["response_r2_backbone"]
-    with pytest.raises(SimdiffError, match="at least 2 batches"):
-        phi_usage(fresh, ds, HashText(), batches=1)
     # a paired run stopped at a checkpoint and resumed ends bit-identical
     cfg = run_config(6, mode="adapters", sim=True, env_pairs=10.0, batch_size=6, seed=4, save_every=3)
     Trainer(tmp_path / "full", cfg, ds, text_encoder=HashText(), init_model=bb).train(progress=False)

@@ -9,7 +9,7 @@ import torch
 from simdiff.motion.features import process_joints
 from simdiff.motion.synthetic import walk
 from simdiff.train import Trainer, synthetic_dataset
-from simdiff.train.data import collate
+from simdiff.data.batch import collate
 from simdiff.train.geometric import CropConfig, GeometricLossConfig, crop_batch, geometric_loss
 from simdiff.train.testing import HashTextEncoder, tiny_run_config
 

@@ -7,7 +7,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from simdiff.model import MotionGenerator
+from simdiff.diffusion.config import SamplingConfig
+from simdiff.inference.generator import MotionGenerator
 from simdiff.motion import synthetic
 from simdiff.motion.features import features_to_joints, joints_to_features
 from simdiff.motion.normalize import Normalizer
@@ -46,7 +47,7 @@ def _overfit(tmp_path: Path) -> None:
 
     gen = MotionGenerator.load(tmp_path / "model", load_text=False)
     gen.text_encoder = HashText()
-    out = gen.generate(CAPTIONS, FRAMES, sampler="ddim", steps=50, guidance=2.5, seed=0)
+    out = gen.generate(CAPTIONS, FRAMES, SamplingConfig(), seed=0)
     truth = [features_to_joints(torch.from_numpy(f).double()) for f in feats]
     for i, motion in enumerate(out.features):
         joints = features_to_joints(motion.double())

@@ -7,7 +7,7 @@ import json
 import pytest
 
 from simdiff.errors import SimdiffError
-from simdiff.model.generator import MotionGenerator
+from simdiff.inference.generator import MotionGenerator
 from simdiff.train.pipeline import budget_config, run_pipeline
 from simdiff.train.pipeline.config import set_option
 from simdiff.train.testing import EchoProjector, HashTextEncoder

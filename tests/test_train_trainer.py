@@ -10,7 +10,8 @@ import torch
 from safetensors.torch import load_file
 
 from simdiff.errors import SimdiffError
-from simdiff.model import Condition, MotionGenerator, load_pretrained
+from simdiff.model import Condition, load_pretrained
+from simdiff.inference.generator import MotionGenerator
 from simdiff.train import StepBatcher, Trainer, synthetic_dataset
 from simdiff.train.config import OptimConfig, lr_at
 from simdiff.train.testing import HashTextEncoder as HashText

@@ -23,13 +23,14 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 import torch
 from torch import Tensor
 
+from simdiff.diffusion.config import SAMPLER_STEPS, SamplingConfig
 from simdiff.diffusion.sampling import make_scheduler
 from simdiff.errors import SimdiffError
 from simdiff.motion.normalize import Normalizer
@@ -162,18 +163,22 @@ def default_projector(config: PhysDiffConfig) -> Projector:
     return SimProjector(None, config.workers, config.backend, config.residual_bound)
 
 
-def physdiff_generate(generator: Any, texts: Sequence[str], lengths: int | Sequence[int], config: PhysDiffConfig = PhysDiffConfig(),
-                      *, projector: Projector | None = None, seed: int | None = 0, **generate_kwargs: Any) -> tuple[Any, ProjectionHook]:
+def physdiff_generate(generator: Any, texts: Sequence[str], lengths: int | Sequence[int],
+                      config: PhysDiffConfig = PhysDiffConfig(), *, projector: Projector | None = None, seed: int | None = 0,
+                      sampling: SamplingConfig = SamplingConfig(), env: Sequence[float] | None = None,
+                      env_index: int | None = None) -> tuple[Any, ProjectionHook]:
     """Sample with PhysDiff projection.
 
     Args:
-        generator: a :class:`simdiff.model.MotionGenerator` (backbone or SimDiff; ``generate_kwargs``
-            such as ``env``/``alpha`` go to its ``generate``).
+        generator: a :class:`simdiff.inference.generator.MotionGenerator` (backbone or SimDiff).
         texts, lengths: as ``MotionGenerator.generate``.
-        config: see :class:`PhysDiffConfig`.
+        config: see :class:`PhysDiffConfig`; its sampler, steps and guidance replace ``sampling``'s (η 0, no foot
+            lock: the projection is the only post-process).
         projector: injected projector (tests); default the MuJoCo tracker.
+        sampling: the generator's other settings (α, environment guidance, ``edit_t``).
+        env, env_index: φ or the environment category, as ``MotionGenerator.generate``.
     Returns:
-        (the :class:`simdiff.model.Generation`, the hook with its per-call log).
+        (the :class:`simdiff.inference.generator.Generation`, the hook with its per-call log).
     """
     at = check_schedule(config.sampler, config.steps, config.project_at)
     b = len(texts)
@@ -183,8 +188,10 @@ def physdiff_generate(generator: Any, texts: Sequence[str], lengths: int | Seque
     proj = projector or default_projector(config)
     hook = ProjectionHook(normalizer, lens, Environment(*config.env).validate(), proj, config.refloor)
     try:
-        generation = generator.generate(texts, lens, sampler=config.sampler, steps=config.steps, guidance=config.guidance,
-                                         seed=seed, x0_hook=hook, hook_timesteps=at, **generate_kwargs)
+        run = replace(sampling, sampler=config.sampler, steps=config.steps or SAMPLER_STEPS[config.sampler], eta=0.0,
+                      guidance=config.guidance, foot_lock=0.0)
+        generation = generator.generate(texts, lens, run, env=env, env_index=env_index, seed=seed, x0_hook=hook,
+                                        hook_timesteps=at)
     finally:
         if own:
             getattr(proj, "close", lambda: None)()

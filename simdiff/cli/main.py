@@ -20,7 +20,7 @@ from simdiff.errors import SimdiffError
 def command_group(subparsers: argparse._SubParsersAction, name: str, help: str) -> argparse._SubParsersAction:
     """Return the sub-subparsers of group ``name`` (e.g. ``data``), creating it once.
 
-    Lets several command modules add to one group (``simdiff data build-cmu``,
+    Lets several command modules add to one group (``simdiff data build``,
     ``simdiff data augment``) without knowing about each other.
     """
     groups: dict[str, argparse._SubParsersAction] = subparsers.__dict__.setdefault("_simdiff_groups", {})

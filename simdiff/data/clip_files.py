@@ -1,7 +1,7 @@
-"""Clips of a HumanML3D-layout corpus on disk, shared by both builders.
+"""Clips of a HumanML3D-layout corpus on disk.
 
-Used by ``simdiff data build-cmu`` (:mod:`simdiff.data.cmu.build`) and ``simdiff data build``
-(:mod:`simdiff.data.corpus.build`): ground contact of a window, features of a clip and its
+Used by ``simdiff data build`` (:mod:`simdiff.data.corpus.build`) and ``simdiff data loop``
+(:mod:`simdiff.data.loop`): ground contact of a window, features of a clip and its
 mirror, the three files of a clip (``new_joint_vecs/ID.npy`` (T-1, 263),
 ``new_joints/ID.npy`` (T-1, 22, 3) metres Y-up 20 fps, ``texts/ID.txt``), the per-item cache
 records, split lists, stale-file removal and ``Mean.npy``/``Std.npy``.
@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.data.cmu.splits import SPLIT_NAMES
-from simdiff.data.cmu.writer import write_lines, write_npy, write_text
+from simdiff.data.corpus.splits import SPLIT_NAMES
+from simdiff.data.writer import write_lines, write_npy, write_text
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 

@@ -281,3 +281,15 @@ def collate(batch: list[dict[str, Any]]) -> dict[str, Any]:
         "tokens": [b["tokens"] for b in batch],
         "ids": [b["id"] for b in batch],
     }
+
+
+def corpus_captions(corpus: str | Path) -> list[str]:
+    """Every caption of a HumanML3D-layout corpus (``texts/*.txt``, all splits), in file order, without repeats."""
+    folder = Path(corpus) / "texts"
+    if not folder.is_dir():
+        raise SimdiffError(f"no texts/ folder in corpus {corpus}")
+    seen: dict[str, None] = {}
+    for path in sorted(folder.glob("*.txt")):
+        for caption in read_captions(path):
+            seen.setdefault(caption.text, None)
+    return list(seen)

@@ -1,6 +1,6 @@
 """Looped locomotion clips: a short cyclic walk or run repeated to a longer clip (``simdiff data loop``).
 
-Why (session 77): every corpus3 train clip captioned "a person runs forward." is 40-75 frames long (2-3.75 s;
+Why: every train clip of the all-source corpus captioned "a person runs forward." is 40-75 frames long (2-3.75 s;
 capture volumes are small), while its only runs of 96-150 frames are elderly or weary ones (1.35-1.94 m/s). The
 8-layer model samples a 6 s "runs forward" at about 1.4-1.5 m/s instead of the plain runs' 2.65; a likely cause is
 that it never saw a plain run that long. A looped clip shows it one, at the speed the capture had.
@@ -166,7 +166,7 @@ def loop_corpus(corpus: str | Path, types: Sequence[str], frames: int, split: st
     from tqdm import tqdm
 
     from simdiff.data.clip_files import process_clip, write_clip
-    from simdiff.data.cmu.writer import write_json, write_lines
+    from simdiff.data.writer import write_json, write_lines
 
     root = Path(corpus)
     out_split = out_split or f"{split}_loop"

@@ -1,4 +1,4 @@
-"""Clip encoding of version-2 ("joints") packs: joints in, features rebuilt on unpack.
+"""Clip encoding of training packs (:mod:`simdiff.data.pack`): joints in, features rebuilt on unpack.
 
 A corpus clip's features are ``process_joints`` of its window; the canonical joints those
 features describe ((T+1, 22, 3): ``features_to_joints`` plus ``extend_last_frame``) give the

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Callable, Iterable
 import torch
 from torch import Tensor
 
+from simdiff.diffusion.config import SamplingConfig
 from simdiff.diffusion.ddim import DDIMScheduler
 from simdiff.diffusion.ddpm import DDPMScheduler
 from simdiff.diffusion.guidance import Denoiser, GuidedDenoiser
@@ -37,49 +38,37 @@ def make_scheduler(name: str, steps: int | None = None, eta: float = 0.0, num_tr
 @torch.no_grad()
 def sample(
     denoiser: Denoiser,
-    scheduler: BaseScheduler,
+    config: SamplingConfig,
     cond: Condition,
     num_frames: int,
     *,
     nfeats: int = 263,
-    guidance: float = 2.5,
     batched_cfg: bool = True,
     generator: torch.Generator | None = None,
     x_init: Tensor | None = None,
     x0_hook: X0Hook | None = None,
     hook_timesteps: Iterable[int] | None = None,
     progress: Callable[[Iterable[Tensor]], Iterable[Tensor]] | None = None,
-    env_guidance: float = 1.0,
-    anchor: str = "adapters",
-    anchor_alpha: float = 0.0,
-    anchor_t_max: int | None = None,
-    edit_t: int | None = None,
 ) -> Tensor:
     """Run the reverse process from pure noise; returns x₀ (B, num_frames, nfeats) normalised features.
 
     Args:
         denoiser: x₀-predicting network ``(x, t, cond) -> x̂₀``.
-        scheduler: a DDPM/DDIM scheduler with timesteps set.
+        config: sampler, steps, η, text guidance, environment guidance and ``edit_t`` (:class:`GuidedDenoiser`);
+            its ``alpha`` and ``foot_lock`` are the caller's (they live in ``cond`` and the post-process).
         cond: the condition (B items) on the target device.
-        guidance: CFG scale s (1 = off).
         batched_cfg: one 2B forward per step instead of two B forwards.
         generator: for the initial noise and the sampler's noise.
         x0_hook: replaces x̂₀ at the timesteps in ``hook_timesteps`` (all when None).
         progress: optional iterable wrapper (e.g. ``tqdm``).
-        env_guidance: environment guidance s_e (1 = off; :class:`GuidedDenoiser`), continuous φ only.
-        anchor: what the text guidance runs on, ``"adapters"``, ``"backbone"`` or ``"reference"``
-            (:class:`GuidedDenoiser`).
-        anchor_alpha: adapter strength of the backbone or reference anchor's text guidance (0: the backbone alone).
-        anchor_t_max: that anchor only at timesteps ≤ this, the adapters anchor above (None: every step).
-        edit_t: the edit anchor's last timestep at the reference φ (None: its default; :class:`GuidedDenoiser`).
     """
     device = cond.text.device
     b = cond.batch_size
     x = x_init.to(device) if x_init is not None else torch.randn(
         (b, num_frames, nfeats), generator=generator, device=generator.device if generator else device
     ).to(device)
-    model = GuidedDenoiser(denoiser, guidance, batched_cfg, env_scale=env_guidance, anchor=anchor,
-                           anchor_alpha=anchor_alpha, anchor_t_max=anchor_t_max, edit_t=edit_t)
+    scheduler = make_scheduler(config.sampler, config.steps, config.eta)
+    model = GuidedDenoiser(denoiser, config.guidance, batched_cfg, env_scale=config.env_guidance, edit_t=config.edit_t)
     hooked = None if hook_timesteps is None else {int(t) for t in hook_timesteps}
     steps: Iterable[Tensor] = scheduler.timesteps
     if progress is not None:

@@ -160,7 +160,8 @@ class TextMotionEvaluator(nn.Module):
 
 def save_evaluator(folder: str | os.PathLike[str], model: TextMotionEvaluator, extra: dict[str, Any] | None = None) -> None:
     """Write ``model.safetensors`` and ``config.json`` (``{"evaluator": config, **extra}``) atomically."""
-    from simdiff.model.checkpoint import atomic_save_tensors, atomic_write_json
+    from simdiff.fsio import atomic_save_tensors
+    from simdiff.model.checkpoint import atomic_write_json
 
     folder = Path(folder)
     atomic_save_tensors(model.state_dict(), folder / "model.safetensors", metadata={"library": "simdiff", "kind": "t2m-evaluator"})

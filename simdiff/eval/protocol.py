@@ -37,6 +37,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from simdiff.diffusion.config import SamplingConfig
 from simdiff.errors import SimdiffError
 from simdiff.eval import metrics as M
 
@@ -98,7 +99,7 @@ class ProtocolConfig:
 
 def _draw(dataset: Any, rng: np.random.Generator, config: ProtocolConfig) -> list[dict[str, Any]]:
     """This replication's batches of collated GT items (raw features added)."""
-    from simdiff.train.data import collate
+    from simdiff.data.batch import collate
 
     n_batches = min(config.max_batches, len(dataset) // config.batch_size)
     if n_batches == 0:
@@ -224,50 +225,33 @@ def _multimodality(evaluator: Evaluator, batches: list[dict[str, Any]], generate
     return M.multimodality(np.stack(embs), min(config.mm_times, config.mm_repeats), np.random.default_rng([config.seed, r, 4]))
 
 
-def generator_fn(generator: Any, *, env: Sequence[float] | None = None, env_index: int | None = None, alpha: float = 1.0,
-                 sampler: str = "ddim", steps: int | None = None, guidance: float = 2.5,
-                 physdiff: Any = None, projector: Any = None, simulate: bool = False,
-                 finish_projector: Any = None, foot_lock: float = 0.0, env_guidance: float = 1.0,
-                 anchor: str = "adapters", anchor_alpha: float = 0.0, anchor_t_max: int | None = None,
-                 ballistic: float = 0.0, edit_t: int | None = None, eta: float = 0.0) -> GenerateFn:
-    """A :data:`GenerateFn` over a :class:`simdiff.model.MotionGenerator` (optionally with PhysDiff projection).
+def generator_fn(generator: Any, sampling: SamplingConfig = SamplingConfig(), *, env: Sequence[float] | None = None,
+                 env_index: int | None = None, physdiff: Any = None, projector: Any = None, simulate: bool = False,
+                 finish_projector: Any = None) -> GenerateFn:
+    """A :data:`GenerateFn` over a :class:`simdiff.inference.generator.MotionGenerator` sampling with ``sampling``
+    (e.g. the shipped model's :func:`simdiff.inference.default.sampling_config`), optionally with PhysDiff
+    projection (``physdiff``: its sampler, steps and guidance replace ``sampling``'s; η must be 0).
 
     ``simulate``: the simulated finish: every final sample is re-tracked by ``finish_projector``
     (default ``projector``) under φ (``env``, Earth when None) and its features are replaced by the
     rollout's where it tracked (frames after a fall keep the generated ones, as a PhysDiff
     projection does). The returned function's ``finish_log`` lists one entry per finished sample
-    (``success``: tracked to the end; ``frames_replaced``), in generation order. ``foot_lock``: the
-    generator's foot lock strength (0: off; not with ``physdiff``); ``env_guidance``: environment guidance s_e
-    (1: off; SimDiff continuous models); ``anchor``: what the text guidance runs on (:mod:`simdiff.diffusion.guidance`);
-    ``anchor_alpha``: the backbone or reference anchor's adapter strength (0: the backbone alone); ``anchor_t_max``:
-    that anchor only at timesteps ≤ this (None: every step); ``edit_t``: the edit anchor's last timestep at Earth (None:
-    its default); ``ballistic``: the generator's ballistic flight strength (0: off; not with ``physdiff``); ``eta``: the
-    DDIM sampler's η (0: deterministic; not with ``physdiff``).
+    (``success``: tracked to the end; ``frames_replaced``), in generation order.
     """
-    from simdiff.model.generator import guidance_kwargs
-
-    if ballistic and physdiff is not None:
-        raise SimdiffError("ballistic flight is a generator option; the PhysDiff baseline takes none (leave it at 0)")
-    if eta and physdiff is not None:
-        raise SimdiffError(f"DDIM eta {eta} is a generator option; the PhysDiff baseline takes none (leave it at 0)")
+    if sampling.eta and physdiff is not None:
+        raise SimdiffError(f"DDIM eta {sampling.eta:g} is a generator option; the PhysDiff baseline takes none "
+                           "(leave it at 0)")
     finish_log: list[dict[str, Any]] = []
 
     def generate(captions: list[str], lengths: list[int], seed: int) -> Tensor:
-        kwargs: dict[str, Any] = {}
-        if generator.is_simdiff:
-            kwargs = {"env": env, "env_index": env_index, "alpha": alpha,
-                      **guidance_kwargs(env_guidance, anchor, anchor_alpha, anchor_t_max, edit_t=edit_t)}
-        if ballistic:
-            kwargs["ballistic"] = ballistic
-        if eta:
-            kwargs["eta"] = eta
+        phi = {"env": env, "env_index": env_index} if generator.is_simdiff else {}
         if physdiff is not None:
             from simdiff.baselines.physdiff import physdiff_generate
 
-            out, _ = physdiff_generate(generator, captions, lengths, physdiff, projector=projector, seed=seed, **kwargs)
+            out, _ = physdiff_generate(generator, captions, lengths, physdiff, projector=projector, seed=seed,
+                                       sampling=sampling, **phi)
         else:
-            out = generator.generate(captions, lengths, sampler=sampler, steps=steps, guidance=guidance, seed=seed,
-                                     foot_lock=foot_lock, **kwargs)
+            out = generator.generate(captions, lengths, sampling, seed=seed, **phi)
         feats = out.features.detach().cpu()
         if simulate:
             feats = simulated_finish(generator, feats, lengths, env, finish_projector or projector, log=finish_log)

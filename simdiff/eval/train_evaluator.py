@@ -61,7 +61,7 @@ def contrastive_loss(text: Tensor, motion: Tensor, captions: list[str], margin: 
 
 
 def _batch(dataset: Any, indices: list[int], rng: np.random.Generator) -> dict[str, Any]:
-    from simdiff.train.data import collate
+    from simdiff.data.batch import collate
 
     return collate([dataset.get(i, rng) for i in indices])
 
@@ -85,8 +85,9 @@ def evaluate_matching(model: TextMotionEvaluator, dataset: Any, text_encoder: An
 
 
 def _save_checkpoint(folder: Path, model: TextMotionEvaluator, optim: torch.optim.Optimizer, meta: dict[str, Any]) -> None:
-    from simdiff.model.checkpoint import atomic_save_tensors, atomic_write_json
-    from simdiff.train.state import optimizer_to_flat
+    from simdiff.fsio import atomic_save_tensors
+    from simdiff.model.checkpoint import atomic_write_json
+    from simdiff.model.optimizer_state import optimizer_to_flat
 
     opt_tensors, opt_meta = optimizer_to_flat(optim.state_dict())
     tensors = {f"model.{k}": v for k, v in model.state_dict().items()} | opt_tensors
@@ -97,7 +98,7 @@ def _save_checkpoint(folder: Path, model: TextMotionEvaluator, optim: torch.opti
 def _load_checkpoint(folder: Path, model: TextMotionEvaluator, optim: torch.optim.Optimizer) -> dict[str, Any] | None:
     from safetensors.torch import load_file
 
-    from simdiff.train.state import optimizer_from_flat
+    from simdiff.model.optimizer_state import optimizer_from_flat
 
     if not (folder / "state.json").is_file() or not (folder / "state.safetensors").is_file():
         return None

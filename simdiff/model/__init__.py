@@ -1,4 +1,4 @@
-"""The diffusion network: MDM backbone, Sim Encoder, Motion Adapters, checkpoint I/O, inference model."""
+"""The diffusion network: MDM backbone, Sim Encoder, Motion Adapters, configs, condition and checkpoint I/O."""
 
 from simdiff.model.adapter import MotionAdapter
 from simdiff.model.backbone import MDMBackbone
@@ -11,12 +11,11 @@ from simdiff.model.checkpoint import (
 )
 from simdiff.model.condition import Condition
 from simdiff.model.config import BackboneConfig, ModelConfig, SimConfig, backbone_preset, config_from_dict
-from simdiff.model.generator import Generation, MotionGenerator
 from simdiff.model.sim_encoder import SimEncoder
 from simdiff.model.simdiff_net import SimDiffNet
 
 __all__ = [
-    "BackboneConfig", "Condition", "Generation", "MDMBackbone", "ModelConfig", "MotionAdapter", "MotionGenerator",
+    "BackboneConfig", "Condition", "MDMBackbone", "ModelConfig", "MotionAdapter",
     "SimConfig", "SimDiffNet", "SimEncoder", "backbone_preset", "build_network", "config_from_dict",
     "load_mdm_checkpoint", "load_mdm_state_dict", "load_pretrained", "save_pretrained",
 ]

@@ -10,10 +10,11 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import torch
-from safetensors.torch import load_file, save
+from safetensors.torch import load_file
 from torch import Tensor, nn
 
 from simdiff.errors import SimdiffError
+from simdiff.fsio import atomic_save_tensors
 from simdiff.model.backbone import MDMBackbone
 from simdiff.model.config import BackboneConfig, ModelConfig, config_from_dict
 from simdiff.model.simdiff_net import SimDiffNet
@@ -41,30 +42,6 @@ def _atomic(path: Path, write: Any) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-
-
-def atomic_save_tensors(tensors: Mapping[str, Tensor], path: str | os.PathLike[str], metadata: dict[str, str] | None = None) -> None:
-    """Write a safetensors file atomically (tensors made contiguous, on CPU); the same tensors and metadata give the
-    same bytes (:func:`canonical_safetensors`)."""
-    clean = {k: v.detach().to("cpu").contiguous() for k, v in tensors.items()}
-    blob = canonical_safetensors(save(clean, metadata=metadata))
-    _atomic(Path(path), lambda tmp: Path(tmp).write_bytes(blob))
-
-
-def canonical_safetensors(blob: bytes) -> bytes:
-    """``blob`` (a serialised safetensors file) with its ``__metadata__`` keys sorted: the library writes that map in
-    a per-process random order, so the same weights hashed differently from run to run. Tensor entries and data are
-    untouched; the header keeps its length (it is the same JSON reordered)."""
-    n = int.from_bytes(blob[:8], "little")
-    header = json.loads(blob[8:8 + n])
-    meta = header.get("__metadata__")
-    if not meta:
-        return blob
-    header["__metadata__"] = dict(sorted(meta.items()))
-    text = json.dumps(header, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
-    if len(text) > n:  # never: the same keys and values, reordered (kept safe: then the library's bytes stand)
-        return blob
-    return blob[:8] + text + b" " * (n - len(text)) + blob[8 + n:]
 
 
 def atomic_write_json(data: Any, path: str | os.PathLike[str]) -> None:

@@ -1,8 +1,8 @@
 """Extrapolate a fine-tune in weight space (task arithmetic): backbone θ = θ_model + λ·(θ_model − θ_parent).
 
 ``model`` must be ``parent`` fine-tuned (same architecture and feature Mean/Std); λ 0 copies ``model``, λ > 0 goes
-further in the direction the fine-tune moved the weights (session 53: session 41's jump-weighted fine-tune at λ 1
-doubled its gain in Earth jumps on val, `reports/training/s53_extrapolate/`), λ in [−1, 0) goes back towards
+further in the direction the fine-tune moved the weights (a jump-weighted fine-tune extrapolated at λ 1
+doubled its gain in Earth jumps on val), λ in [−1, 0) goes back towards
 ``parent``. Only the backbone changes: a
 SimDiff model's Sim Encoder and Motion Adapters, its normaliser, config and ``sampling.json`` are ``model``'s.
 The output folder records the recipe in ``extrapolation.json`` and both models' training data in ``provenance.json``.

@@ -9,7 +9,7 @@ A model folder may hold ``provenance.json`` beside ``model.safetensors`` and ``c
 ``hours`` counts original motion only (a mirrored ``M…`` clip adds nothing beyond its original),
 over the clips the training actually read (the split of a corpus, the source clips behind the kept
 pairs of an augmented folder). ``licences`` maps each licence code of
-:data:`simdiff.data.corpus.item.LICENCES` to its hours.
+:data:`simdiff.licences.LICENCES` to its hours.
 
 The rule (:func:`weights_licence`): the most restrictive licence among all the data used decides.
 Any ``CC-BY-NC-4.0`` motion makes the weights non-commercial; else any ``CC-BY-SA-3.0`` motion makes
@@ -47,7 +47,7 @@ CMU_ONLY_FORMAT = "simdiff-cmu-corpus"
 
 
 def _known_codes() -> dict[str, str]:
-    from simdiff.data.corpus.item import LICENCES
+    from simdiff.licences import LICENCES
 
     return LICENCES
 

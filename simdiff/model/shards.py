@@ -35,7 +35,7 @@ def _nbytes(t: Tensor) -> int:
 
 def shard_tensors(tensors: Mapping[str, Tensor], folder: str | Path, max_bytes: int) -> list[str]:
     """Write ``tensors`` into ``folder`` as shards of at most ``max_bytes`` each (file size); returns file names."""
-    from simdiff.model.checkpoint import atomic_save_tensors
+    from simdiff.fsio import atomic_save_tensors
 
     folder = Path(folder)
     budget = max_bytes - HEADER_SLACK

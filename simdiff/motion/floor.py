@@ -3,7 +3,7 @@
 HumanML3D's processing shifts every clip vertically so that its lowest joint over all frames is at
 height 0. A generated motion need not be: the shipped model's test samples stand with their own
 floor (the 5th percentile of the lowest joint) 19 mm above y = 0 against the ground truth's 2 mm,
-and under g = −1.6 with strong environment guidance its runs float a metre up (session 50). A
+and under g = −1.6 with strong environment guidance its runs float a metre up. A
 vertical shift of the whole clip changes no pose, no velocity and no contact; in the 263 features
 it moves the root height (feature 3) and the heights of the "ric" joints (features 4..66, every
 third from 5), which are heights above the floor.
@@ -14,7 +14,7 @@ from __future__ import annotations
 import torch
 
 from simdiff.motion.features import SLICES
-from simdiff.motion.foot_lock import batch_features
+from simdiff.motion.contact_features import batch_features
 from simdiff.motion.metrics import FLOOR_CLEARANCE
 
 RIC_Y: slice = slice(SLICES["ric"].start + 1, SLICES["ric"].stop, 3)

@@ -20,7 +20,7 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints
-from simdiff.motion.foot_lock import CONTACT_THRESHOLD, batch_features, yaw_rotate
+from simdiff.motion.contact_features import CONTACT_THRESHOLD, batch_features, yaw_rotate
 from simdiff.motion.metrics import OWN_FLOOR_PERCENTILE
 from simdiff.motion.skeleton import FPS
 

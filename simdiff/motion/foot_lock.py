@@ -9,7 +9,7 @@ same amount); poses, heights, the root's yaw and the contact channels are untouc
 exactly as generated. It is the classic root-trajectory part of foot-skate cleanup, not inverse kinematics: two
 planted feet that slide apart (a split) keep the lower one in place, not both. The generator's ``foot_lock``
 applies :func:`clean_feet`: this lock, then :mod:`simdiff.motion.foot_clearance` (swinging feet that drag along
-the floor are lifted clear of it, the knee re-solved), both at the same strength, and since session 52 lowers a
+the floor are lifted clear of it, the knee re-solved), both at the same strength, and lowers a
 clip that never touches the floor onto it (:func:`simdiff.motion.floor.drop_floating`).
 """
 
@@ -20,37 +20,18 @@ import torch
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.features import SLICES, features_to_joints
+from simdiff.motion.floor import drop_floating
+from simdiff.motion.foot_clearance import clear_swing_feet
+from simdiff.motion.contact_features import CONTACT_THRESHOLD, batch_features, yaw_rotate
 from simdiff.motion.skeleton import FOOT_LEFT, FOOT_RIGHT
 
 CONTACT_JOINTS: tuple[int, int, int, int] = (*FOOT_LEFT, *FOOT_RIGHT)
 """Joints of the four contact channels, in channel order (left ankle, left toe, right ankle, right toe)."""
 
 CLEANUP_VERSION: int = 3
-"""What the generator's ``foot_lock`` does: 1 the lock alone (sessions 36-37), 2 the lock and the swing-foot
-clearance (sessions 38-51), 3 those and a floating clip dropped onto the floor (session 52; :func:`clean_feet`).
+"""What the generator's ``foot_lock`` does: 1 the lock alone, 2 the lock and the swing-foot
+clearance, 3 those and a floating clip dropped onto the floor (:func:`clean_feet`).
 Cached measurements made with a foot lock carry it in their fingerprint."""
-
-CONTACT_THRESHOLD: float = 0.5
-"""A contact channel above this marks its joint as planted (the channels are 0/1 in the data)."""
-
-
-def batch_features(features: torch.Tensor, lengths: torch.Tensor | None, what: str) -> tuple[torch.Tensor, bool, torch.Tensor]:
-    """A float64 working copy (B, T, 263) of (B, T, 263) or (T, 263) features, whether the input was one clip, and
-    the (B, T) bool mask of valid frames (``lengths`` (B,), None: all T); ``what`` names the caller in the error."""
-    single = features.dim() == 2
-    f = (features[None] if single else features).detach().to(torch.float64).clone()
-    if f.shape[-1] != 263 or f.shape[-2] < 2:
-        raise SimdiffError(f"{what} needs (B, T >= 2, 263) features, got {tuple(features.shape)}")
-    b, t = f.shape[:2]
-    lens = torch.full((b,), t, dtype=torch.long) if lengths is None else torch.as_tensor(lengths).long().cpu()
-    return f, single, (torch.arange(t)[None] < lens[:, None]).to(f.device)
-
-
-def yaw_rotate(half: torch.Tensor, x: torch.Tensor, z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """World (x, z) into the root-facing frame of yaw half-angle ``half`` (inverse of features' un-rotation)."""
-    c, s = torch.cos(2 * half), torch.sin(2 * half)
-    return c * x + s * z, -s * x + c * z
-
 
 def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, strength: float = 1.0,
               planted: torch.Tensor | None = None) -> torch.Tensor:
@@ -107,9 +88,6 @@ def clean_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, stre
     lifted clear of the floor (:func:`simdiff.motion.foot_clearance.clear_swing_feet`), then, whatever the
     strength > 0, a clip that never comes within 0.10 m of the floor lowered onto it
     (:func:`simdiff.motion.floor.drop_floating`; clips that touch it are not moved). Shapes as :func:`lock_feet`."""
-    from simdiff.motion.floor import drop_floating
-    from simdiff.motion.foot_clearance import clear_swing_feet
-
     cleaned = clear_swing_feet(lock_feet(features, lengths, strength), lengths, strength)
     return drop_floating(cleaned, lengths) if strength > 0 else cleaned
 

@@ -234,8 +234,8 @@ def never_touches(
 
     The floor is y = 0, not the motion's own floor: a sample that hovers a metre up all clip long has a
     perfect own-floor gait and flights by the relative rule of :mod:`simdiff.motion.flight`, yet no
-    body part ever reaches the ground (session 50's runs under g = −1.6). Real motion under any gravity
-    touches the floor to take off. Joints (B, T, 22, 3) or (T, 22, 3), metres, Y-up; lengths (B,).
+    body part ever reaches the ground (generated runs under g = −1.6 with strong environment
+    guidance). Real motion under any gravity touches the floor to take off. Joints (B, T, 22, 3) or (T, 22, 3), metres, Y-up; lengths (B,).
     """
     arr, lens = _prepare(joints, lengths)
     lowest = arr[..., 1].min(axis=-1)  # (B, T)
@@ -291,8 +291,8 @@ def glides(
     """(B,) bool: the body travels (mean horizontal pelvis speed > :data:`GLIDE_SPEED`) while no foot joint ever
     lifts (each of the four foot joints' height range over the valid frames < :data:`GLIDE_LIFT`).
 
-    A frozen pose carried along, which no legged body can do; session 52's runs under g = −1.6 at environment
-    guidance 4 were such statues, a metre up before the foot cleanup dropped them, skating after. A standing or
+    A frozen pose carried along, which no legged body can do; generated runs under g = −1.6 at environment
+    guidance 4 were such statues: a metre up, and skating once the foot cleanup dropped them onto the floor. A standing or
     in-place motion (slow pelvis) never glides. Joints (B, T, 22, 3) or (T, 22, 3), metres, Y-up, 20 fps; lengths (B,).
     """
     arr, lens = _prepare(joints, lengths)

@@ -21,7 +21,7 @@ from simdiff import __version__
 from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
 from simdiff.product.outputs import env_label, render_video, write_metadata, write_motion
-from simdiff.product.request import DEFAULT_EDIT_T, GenerationRequest
+from simdiff.product.request import GenerationRequest
 from simdiff.product.simulate import SimulatedMotion, load_simulator, simulate_finish, write_simulated
 from simdiff.sim.env import Environment
 
@@ -65,7 +65,6 @@ class Sample:
         env: φ it was generated under; None for a backbone-only model.
         features: (T, 263) float32 un-normalised features.
         joints: (T, 22, 3) float32 positions in metres, Y-up.
-        fell_back: re-sampled at the request's ``env_guidance_fallback`` (None: no fallback asked for).
     """
 
     column: int
@@ -75,7 +74,6 @@ class Sample:
     features: np.ndarray
     joints: np.ndarray
     simulated: "SimulatedMotion | None" = None
-    fell_back: bool | None = None
 
 
 def _progress(quiet: bool):
@@ -93,7 +91,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
     """Encode the prompt once, sample every (environment, k) pair, and decode joints.
 
     Args:
-        generator: a :class:`~simdiff.model.generator.MotionGenerator` with a text encoder.
+        generator: a :class:`~simdiff.inference.generator.MotionGenerator` with a text encoder.
         request: the validated request; its environments are ignored for a backbone-only model.
     """
     from tqdm.auto import tqdm
@@ -105,7 +103,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
     with timer.stage("encode_text"):
         text = generator.encode_text([request.text])
     runs = [(c, k) for c in range(len(envs)) for k in range(request.num_samples)]
-    bar = tqdm(total=request.steps * len(runs), desc=f"{request.sampler} sampling", unit="step", leave=False,
+    bar = tqdm(total=request.sampling.steps * len(runs), desc=f"{request.sampling.sampler} sampling", unit="step", leave=False,
                disable=quiet, file=sys.stderr, dynamic_ncols=True)
 
     def progress(steps: Iterable) -> Iterator:
@@ -114,34 +112,21 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
             bar.update(1)
 
     features: list[np.ndarray] = []
-    fell_back: list[bool | None] = []
     try:
         with timer.stage("sample"):
             for c, k in runs:
                 env = envs[c]
-                out = generator.generate(
-                    [request.text], request.frames, env=None if env is None else env.as_tuple(),
-                    alpha=request.alpha, sampler=request.sampler, steps=request.steps, guidance=request.guidance,
-                    **({"eta": request.eta} if request.eta else {}),
-                    seed=request.seed + k, text_embeddings=text, progress=progress, foot_lock=request.foot_lock,
-                    **({"env_guidance": request.env_guidance} if request.env_guidance != 1.0 else {}),
-                    **({"env_guidance_fallback": request.env_guidance_fallback}
-                       if request.env_guidance_fallback is not None and env is not None else {}),
-                    **({"anchor": request.anchor} if request.anchor != "adapters" else {}),
-                    **({"anchor_alpha": request.anchor_alpha} if request.anchor_alpha else {}),
-                    **({"anchor_t_max": request.anchor_t_max} if request.anchor_t_max is not None else {}),
-                    **({"edit_t": request.edit_t} if request.edit_t is not None else {}),
-                    **({"ballistic": request.ballistic} if request.ballistic else {}),
-                )
+                out = generator.generate([request.text], request.frames, request.sampling,
+                                         env=None if env is None else env.as_tuple(), seed=request.seed + k,
+                                         text_embeddings=text, progress=progress)
                 features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
-                fell_back.append(None if out.fell_back is None else bool(out.fell_back[0]))
     finally:
         bar.close()
     samples = []
     with timer.stage("decode"):
-        for (c, k), f, back in zip(runs, features, fell_back):
+        for (c, k), f in zip(runs, features):
             joints = np.asarray(features_to_joints(f), dtype=np.float32)
-            samples.append(Sample(c, k, request.seed + k, envs[c], f, joints, fell_back=back))
+            samples.append(Sample(c, k, request.seed + k, envs[c], f, joints))
     return samples
 
 
@@ -224,7 +209,7 @@ def model_provenance(model_dir: Path) -> dict:
 
 
 def metadata(request: GenerationRequest, generator, model_dir: Path, samples: list[Sample],
-             files: list[dict[str, Path]], videos: list[Path], timer: Timer, alpha_source: str = "default") -> dict:
+             files: list[dict[str, Path]], videos: list[Path], timer: Timer) -> dict:
     """The ``generation.json`` record of one run (file names relative to the output folder)."""
     from simdiff.motion.foot_lock import CLEANUP_VERSION
 
@@ -233,7 +218,6 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
     records = [{"index": s.index, "seed": s.seed, "environment": None if s.env is None else _env_dict(s.env),
                 "frames": int(s.joints.shape[0]), "files": {kind: p.name for kind, p in written.items()},
                 **floor_contact(s.joints),
-                **({"fell_back": s.fell_back} if s.fell_back is not None else {}),
                 **({"simulated": _simulated_summary(s.simulated)} if s.simulated is not None else {})}
                for s, written in zip(samples, files)]
     return {
@@ -256,22 +240,11 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
                     if simdiff_model and request.compare else None),
         "seed": request.seed,
         "num_samples": request.num_samples,
-        "sampler": request.sampler,
-        "steps": request.steps,
-        "eta": request.eta if request.sampler == "ddim" else None,
-        "guidance": request.guidance,
-        "alpha": request.alpha if simdiff_model else None,
-        "alpha_source": alpha_source if simdiff_model else None,
-        "foot_lock": request.foot_lock,
-        "foot_cleanup": CLEANUP_VERSION if request.foot_lock else None,
-        "ballistic": request.ballistic,
-        "env_guidance": request.env_guidance if simdiff_model else None,
-        "env_guidance_fallback": request.env_guidance_fallback if simdiff_model else None,
-        "anchor": request.anchor if simdiff_model else None,
-        "anchor_alpha": request.anchor_alpha if simdiff_model else None,
-        "anchor_t_max": request.anchor_t_max if simdiff_model else None,
-        "edit_t": (request.edit_t if request.edit_t is not None else DEFAULT_EDIT_T)
-        if simdiff_model and request.anchor == "edit" else None,
+        **request.sampling.to_dict(),
+        "alpha": request.sampling.alpha if simdiff_model else None,
+        "env_guidance": request.sampling.env_guidance if simdiff_model else None,
+        "edit_t": request.sampling.edit_t if simdiff_model else None,
+        "foot_cleanup": CLEANUP_VERSION if request.sampling.foot_lock else None,
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",
         "samples": records,
@@ -338,7 +311,7 @@ def warm_simulator() -> threading.Thread:
 
 
 def run_generation(generator, request: GenerationRequest, out_dir: Path, model_dir: Path, timer: Timer,
-                   quiet: bool = False, alpha_source: str = "default", simulate: bool = False,
+                   quiet: bool = False, simulate: bool = False,
                    force: bool = False, finisher: Finisher | None = None) -> tuple[dict, list[Path]]:
     """Sample (and with ``simulate`` re-track under φ: in ``finisher``'s processes when given, which
     should have been started before the model loaded), write every file and ``generation.json``;
@@ -354,7 +327,7 @@ def run_generation(generator, request: GenerationRequest, out_dir: Path, model_d
         except SimdiffError as exc:  # the generated motions are written all the same, then the error is raised
             failure = exc
     files, videos = write_outputs(samples, request, out_dir, timer, quiet)
-    meta = metadata(request, generator, model_dir, samples, files, videos, timer, alpha_source)
+    meta = metadata(request, generator, model_dir, samples, files, videos, timer)
     if simulate:  # where the finish ran: its CPU seconds are the worker's (in each sample's tracking), not this process's
         meta["simulate_workers"] = finisher.workers if finisher is not None else 0
     if failure is not None:

@@ -3,9 +3,9 @@
 Routes:
     ``GET /`` and ``GET /static/<file>``: the page (html, js, css shipped in the package).
     ``GET /api/info``: model status, listed files, slider ranges, skeleton.
-    ``POST /api/generate`` (``application/json``): ``{text, gravity, wind_x, wind_y, alpha, seconds, seed}`` and
-    optionally ``steps, guidance, simulate, foot_lock, env_guidance`` (``alpha``, ``foot_lock`` and
-    ``env_guidance`` left out: the model's ``sampling.json`` values, as ``simdiff generate``)
+    ``POST /api/generate`` (``application/json``): ``{text, gravity, wind_x, wind_y, seconds, seed, simulate}`` and
+    optionally the sampling settings ``steps, eta, guidance, alpha, env_guidance, edit_t, foot_lock`` (left out:
+    the model's ``sampling.json`` values, as ``simdiff generate``)
     → ``{joints, fps, parents, meta}``.
     ``POST /api/open?name=FILE`` (``application/octet-stream``, the file's bytes) → same.
     ``GET /api/files/<i>``: the i-th file named on the command line → same.

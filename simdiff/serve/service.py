@@ -10,13 +10,14 @@ import os
 import tempfile
 import threading
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 
 from simdiff import __version__
+from simdiff.diffusion.config import SamplingConfig
 from simdiff.errors import SimdiffError
 from simdiff.serve.params import GenerateParams, limits
 from simdiff.serve.payload import motion_payload, skeleton_info
@@ -88,14 +89,14 @@ class MotionService:
         text_encoder: replaces the model's own text encoder (tests use a hash encoder; the model
             is then loaded without MiniLM).
         progress: wraps the sampler's step iterator (e.g. a tqdm bar on the server's console).
-        steps: DDIM steps when a request names none (None: the sampler's default, 50).
+        steps: denoising steps when a request names none (None: the model's).
         max_queue: generation requests that may wait behind the running one (more: :class:`QueueFull`).
     """
 
     def __init__(self, model: str | os.PathLike[str] | None = None, *, device: str = "cpu",
                  files: Sequence[ListedMotion] = (), text_encoder: object | None = None,
                  progress: Progress | None = None, steps: int | None = None, max_queue: int = MAX_QUEUE) -> None:
-        from simdiff.model.default import default_model_dir
+        from simdiff.inference.default import default_model_dir
 
         self.model_dir = default_model_dir(model)
         self.device = device
@@ -144,54 +145,28 @@ class MotionService:
             return "backbone"
         return "simdiff" if config.sim.mode == "continuous" else "categorical"
 
-    def _resolved(self, params: GenerateParams, strict: bool) -> GenerateParams:
-        """``params`` with the fields left None (α, foot lock, env guidance) taken from the model's ``sampling.json``,
-        as ``simdiff generate`` does (α 1, no foot lock, no env guidance and η 0 without one). A bad file is the model's
-        error when ``strict``, else ignored (the page's defaults still load)."""
-        from simdiff.model.default import sampling_defaults
-        from simdiff.product.request import (check_anchor, check_anchor_alpha, check_anchor_t_max, check_edit_t,
-                                             stored_anchor_alpha, stored_anchor_t_max, stored_edit_t, stored_eta,
-                                             stored_setting)
+    def sampling(self, params: GenerateParams | None = None, strict: bool = True) -> SamplingConfig:
+        """The model's :class:`SamplingConfig` (``sampling.json``) with ``params``' settings over it, as
+        ``simdiff generate`` does (and the server's ``steps`` when the request names none). A bad file is the
+        model's error when ``strict``, else ignored (the page's defaults still load); a bad request value is the
+        request's error."""
+        from simdiff.inference.default import sampling_config
 
         try:
-            stored = sampling_defaults(self.model_dir)
-            alpha = params.alpha if params.alpha is not None else stored_setting(stored, "alpha", 1.0)
-            lock = params.foot_lock if params.foot_lock is not None else stored_setting(stored, "foot_lock", 0.0)
-            push = params.env_guidance if params.env_guidance is not None else stored_setting(stored, "env_guidance", 1.0)
-            anchor = params.anchor if params.anchor is not None else check_anchor("anchor", stored.get("anchor", "adapters"))
-            fallback = params.env_guidance_fallback
-            if fallback is None and stored.get("env_guidance_fallback") is not None:
-                fallback = stored_setting(stored, "env_guidance_fallback", 1.0)
-            anchor_alpha = stored_anchor_alpha(stored, anchor) if params.anchor_alpha is None else 0.0
-            t_max = stored_anchor_t_max(stored, anchor) if params.anchor_t_max is None else None
-            edit_t = stored_edit_t(stored, anchor) if params.edit_t is None else None
-            ballistic = params.ballistic if params.ballistic is not None else stored_setting(stored, "ballistic", 0.0)
-            eta = params.eta if params.eta is not None else stored_eta(stored, "ddim")  # the viewer samples with DDIM
+            base = sampling_config(self.model_dir)
         except SimdiffError as exc:
             if strict:
                 raise ModelUnavailable(str(exc)) from None
-            alpha, lock = (1.0 if params.alpha is None else params.alpha), (params.foot_lock or 0.0)
-            push = 1.0 if params.env_guidance is None else params.env_guidance
-            anchor = params.anchor or "adapters"
-            fallback = params.env_guidance_fallback
-            anchor_alpha, t_max, edit_t = 0.0, None, None
-            ballistic = params.ballistic or 0.0
-            eta = params.eta or 0.0
-        # the request's own values against the anchor: its error (400), not the model's
-        if params.anchor_alpha is not None:
-            anchor_alpha = check_anchor_alpha("anchor_alpha", params.anchor_alpha, anchor)
-        if params.anchor_t_max is not None:
-            t_max = check_anchor_t_max("anchor_t_max", params.anchor_t_max, anchor)
-        if params.edit_t is not None:
-            edit_t = check_edit_t("edit_t", params.edit_t, anchor)
-        return replace(params, alpha=float(alpha), foot_lock=float(lock), env_guidance=float(push), anchor=anchor,
-                       env_guidance_fallback=fallback, anchor_alpha=float(anchor_alpha), anchor_t_max=t_max,
-                       edit_t=edit_t, ballistic=float(ballistic), eta=float(eta))
+            base = SamplingConfig()
+        given = {} if params is None else params.sampling()
+        if self.steps is not None:
+            given.setdefault("steps", self.steps)
+        return base.updated(**given)
 
     def _load_locked(self) -> Any:
         """The generator, loaded on first call (caller holds the lock)."""
         if self._generator is None:
-            from simdiff.model.default import load_default
+            from simdiff.inference.default import load_default
 
             try:
                 generator = load_default(self.model_dir, self.device, load_text=self._text_encoder is None)
@@ -214,7 +189,7 @@ class MotionService:
             "files": [{"index": i, "name": f.name, "frames": int(f.joints.shape[0])} for i, f in enumerate(self.files)],
             "limits": limits(),
             "queue": self.queue_status(),
-            "defaults": self._resolved(GenerateParams(text=DEFAULT_PROMPT), strict=False).as_dict(),
+            "defaults": {**GenerateParams(text=DEFAULT_PROMPT).as_dict(), **self.sampling(strict=False).to_dict()},
             "skeleton": skeleton_info(),
         }
 
@@ -229,8 +204,6 @@ class MotionService:
             ModelUnavailable: no loadable model.
             SimdiffError: the model rejected the request.
         """
-        if params.steps is None and self.steps is not None:
-            params = replace(params, steps=self.steps)
         with self._admit:
             if self._pending > self.max_queue:
                 raise QueueFull(self._pending, self.max_queue)
@@ -255,18 +228,10 @@ class MotionService:
             uses_env = generator.is_simdiff
             start = time.perf_counter()
             waited = start - queued
-            params = self._resolved(params, strict=True)
-            out = generator.generate([params.text], params.frames,
+            config = self.sampling(params)
+            out = generator.generate([params.text], params.frames, config,
                                      env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
-                                     alpha=params.alpha if uses_env else 0.0, sampler="ddim", steps=params.steps,
-                                     guidance=params.guidance, seed=params.seed, progress=self._progress,
-                                     eta=params.eta or 0.0,
-                                     foot_lock=params.foot_lock, ballistic=params.ballistic or 0.0,
-                                     **({"env_guidance": params.env_guidance, "anchor": params.anchor,
-                                         "env_guidance_fallback": params.env_guidance_fallback,
-                                         "anchor_alpha": params.anchor_alpha or 0.0,
-                                         "anchor_t_max": params.anchor_t_max,
-                                         "edit_t": params.edit_t} if uses_env else {}))
+                                     seed=params.seed, progress=self._progress)
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count
@@ -275,11 +240,7 @@ class MotionService:
         from simdiff.product.pipeline import floor_contact
 
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
-                "kind": self._kind(generator.config), "env_used": uses_env, "foot_lock": params.foot_lock,
-                "ballistic": params.ballistic,
-                "env_guidance": params.env_guidance if uses_env else None,
-                "env_guidance_fallback": params.env_guidance_fallback if uses_env else None,
-                **({"fell_back": bool(out.fell_back[0])} if out.fell_back is not None else {}),
+                "kind": self._kind(generator.config), "env_used": uses_env, "sampling": config.to_dict(),
                 "elapsed_s": round(elapsed, 3), **floor_contact(joints),
                 "queue_position": position, "waited_s": round(waited, 3)}
         if params.simulate:

@@ -22,10 +22,10 @@ def write_tiny_model(folder: str | os.PathLike[str], seed: int = 0, jitter: floa
         the folder.
     """
     from simdiff.model.checkpoint import build_network
-    from simdiff.model.generator import MotionGenerator
-    from simdiff.train.testing import tiny_run_config
+    from simdiff.inference.generator import MotionGenerator
+    from simdiff.model.testing import tiny_model_config
 
-    config = tiny_run_config(sim=True).model
+    config = tiny_model_config(sim=True)
     torch.manual_seed(seed)
     network = build_network(config)
     with torch.no_grad():

@@ -1,8 +1,8 @@
 """A second rollout with other tracker settings when the first fell or its feet slid.
 
 A tracked rollout is chaotic in its details: the same generated motion tracked with two close
-tracker settings can slide 0.2 mm/frame with one and 0.8 with the other, or fall with one only
-(``reports/experiments/s35_fallback/``). Both rollouts are simulations under the same φ, so
+tracker settings can slide 0.2 mm/frame with one and 0.8 with the other, or fall with one only.
+Both rollouts are simulations under the same φ, so
 either is physically valid; :func:`simdiff.sim.project.project` keeps the first unless it fell
 or its CLoSD foot sliding is above :attr:`FallbackConfig.sliding_trigger`, and then keeps the
 better of the two (a rollout tracked to the end over a fall, then the lower sliding).
@@ -63,10 +63,10 @@ better_rollout = better
 
 
 FINISH_FALLBACK: bool = True
-"""Whether the simulated finish makes the second try (``benchmarks/bench_finish.py --no-fallback`` measures it without)."""
+"""Whether the simulated finish makes the second try."""
 
 FINISH_FALLBACK_SLIDING: float = 0.5
-""":attr:`FallbackConfig.sliding_trigger` of the simulated finish (mm/frame): issue 15's target for the
+""":attr:`FallbackConfig.sliding_trigger` of the simulated finish (mm/frame): the target for the
 finish's output; a rollout at or below it is kept without a second try."""
 
 

@@ -31,7 +31,7 @@ from simdiff.sim.tracker import PDTrackerConfig, Tracker
 SIM_VERSION: int = 4
 """Version of the physics behind :func:`project` with its defaults, recorded with augmented pairs.
 
-1: Earth strength at every gravity. 2 (issue 13): actuators, the tracker's balance layer and
+1: Earth strength at every gravity. 2: actuators, the tracker's balance layer and
 the residual's torque bound scale with max(1, |g_z|/9.81) (:mod:`simdiff.sim.strength`);
 identical to 1 at |g_z| ≤ 9.81. 3: also the residual's pelvis-orientation gains (kp_rot × s,
 kd_rot × √s); identical to 2 at |g_z| ≤ 9.81. 4: the same physics; the rollout is returned

@@ -1,9 +1,9 @@
-"""A second try under weak gravity: the source slowed to the same Froude number (issue 13).
+"""A second try under weak gravity: the source slowed to the same Froude number.
 
 Under ``|g_z| < 9.81`` the flight clock (:mod:`simdiff.sim.flight`) keeps the mocap's take-off
 speed, so flights last ``2v/|g|``; a run's stride then lands with a pitch its Earth-timed
-stance cannot undo, and most low-g rollouts of clips with flight fall
-(``reports/augment/flight_landing.md``). A motion that is *dynamically similar* to the source
+stance cannot undo, and most low-g rollouts of clips with flight fall.
+A motion that is *dynamically similar* to the source
 under ``g`` is the source slowed by ``s = sqrt(9.81/|g|)``: every position is the same, every
 velocity is divided by ``s`` and every acceleration by ``s²`` (the Froude number v²/(g·L)
 stays the source's), so the floor, the legs and the weight stand in Earth's proportions.
@@ -22,9 +22,9 @@ Only the reference is slowed; the body, its gains and the tracker are as at Eart
 the actuators the similar strength, kp × |g|/9.81 and kd × sqrt(|g|/9.81), kept fewer pairs
 on a 28-pair sample, 5 against 9).
 
-Measured (``benchmarks/bench_flight_keep.py`` → ``reports/augment/retime.md``; corpus3 train
-clips with flight, augmentation filter): kept at g ∈ [−3, −1) 10 → 32 % (200 clips), [−5, −3)
-16 → 57 %, [−8.5, −5) 34 → 47 % (100 clips; Earth 39 %); CPU per pair 0.7 → 2.3 s at [−3, −1).
+Measured on train clips with flight of the all-source corpus (augmentation filter), one try → with
+the second try: kept at g ∈ [−3, −1) 10 → 32 % (200 clips), [−5, −3) 16 → 57 %, [−8.5, −5) 34 → 47 %
+(100 clips; Earth 39 %); CPU per pair 0.7 → 2.3 s at [−3, −1).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ class RetimeConfig:
         exponent: time scale ``(9.81/|g_z|) ** exponent``; 0.5 is dynamic similarity (Froude).
         pose_trigger: retry a finished rollout whose pose d_L2 (normalised units, against the
             re-timed source) is above this; 6.5 is about the pose bound the augmentation
-            filter calibrated on corpus3 (6.557). Without a normaliser only falls trigger.
+            filter calibrated on the all-source corpus (6.557). Without a normaliser only falls trigger.
         max_scale: the longest slow-down (3.13 at g = −1 with the default exponent).
     """
 

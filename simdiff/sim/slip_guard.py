@@ -54,12 +54,11 @@ FINISH_SLIP_GUARD: SlipGuardConfig = SlipGuardConfig(start=0.5, floor=0.0)
 """The slip guard of the simulated finish's second try (:func:`simdiff.sim.fallback.finish_fallback`): the
 swing leg's PD pull falls from full at a stance-foot force ratio of 0.5·μ to none at μ.
 
-Chosen (session 35) on the 48 bench samples' seeds 0–2 (4 bench prompts × g −9.81/−3.7, 24 samples)
+Chosen on the 48 bench samples' seeds 0–2 (4 bench prompts × g −9.81/−3.7, 24 samples)
 among start 0.3 / 0.4 / 0.5 / 0.6 / 0.7 with floor 0, start 0.4 / 0.5 / 0.7 with floor 0.3 and start 0.5 with
 floor 0.5: as the only tracker, tracked and ≤ 0.5 mm/frame 16 → 20 of 24 (the others 14–19; four variants
 triggered by the stance foot's measured slip speed instead of the force: 13–16), and as the second try of the
-finish 16 → 21 (others 17–20). Seeds 3–5, not used to choose: alone 21 → 19, as the second try 21 → 23
-(``reports/experiments/s35_fallback/probes/``)."""
+finish 16 → 21 (others 17–20). Seeds 3–5, not used to choose: alone 21 → 19, as the second try 21 → 23."""
 
 
 def stance_forces(model, data, geom_side: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

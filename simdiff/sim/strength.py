@@ -16,8 +16,8 @@ pelvis help was capped at Earth's 300 N·m, so the body sagged and tipped. Scali
 together keeps τ_ff / kp and the servo lag kd / kp as on Earth; scaling the limits keeps the
 torque headroom.
 
-Measured (``benchmarks/bench_high_gravity.py`` → ``reports/augment/high_gravity.json``; 24
-corpus3 train clips without flight that track at Earth, augmentation settings): success at
+Measured on 24 train clips of the all-source corpus without flight that track at Earth
+(augmentation settings): success at
 g = −15 / −18 / −20 went from 0.88 / 0.75 / 0.71 (Earth strength) to 1.0 / 1.0 / 1.0; on the
 clips both track, median pose d_L2 6.54 / 6.66 / 6.70 → 6.40 / 6.49 / 6.48 and local joint
 error 44 / 43 / 44 → 39 / 40 / 39 mm (Earth: 6.29, 41 mm); median residual 47 / 51 / 52 →
@@ -28,7 +28,7 @@ Version 3 also stiffens the root residual's pelvis-orientation loop (``residual_
 kp_rot × s, kd_rot × √s). With version 2 the standing clips still tilted back at high g (a
 Bandai-Namco wave at −18.9: pelvis pitch error 13° against 5° at Earth; pose d_L2 8.4 against
 5.6), so the pose filter rejected half of the plain pairs at g ∈ [−20, −15). Measured on 40
-plain original pairs of that bin drawn from the full corpus3 run (seed 0): kept 21 → 30,
+plain original pairs of that bin drawn from a full augmentation run of the all-source corpus (seed 0): kept 21 → 30,
 median pose d_L2 change −0.84; the price is a larger pelvis torque from the residual, median
 196 → 242 N·m (Earth rollouts of the same clips: 82 N·m), i.e. 0.18 → 0.22 of the weight
 moment m·|g_z|·0.85 m (Earth 0.14); the torque bound itself is unchanged from version 2.
@@ -78,7 +78,7 @@ class StrengthConfig:
 
 
 NO_SCALING = StrengthConfig(gains=False, limits=False, balance=False, residual_torque=False, residual_gains=False)
-"""Earth-strength actuators at every gravity (the behaviour before issue 13)."""
+"""Earth-strength actuators at every gravity (the simulator version 1 behaviour)."""
 
 
 def apply_strength(model, gravity: float, config: StrengthConfig | None) -> float:

@@ -151,7 +151,7 @@ the reference's offset from the stance foot; when the simulation lags a generate
 land a few frames late) it is large, and the stance leg, pushing the body forward, pushes its foot
 back along the floor: the skids that made the finish's walks slide ~1 mm/frame.
 
-Measured (session 33; 48 generated samples: the 4 bench prompts × g −9.81/−3.7 × seeds 0–5). Dropping
+Measured on 48 generated samples (the 4 bench prompts × g −9.81/−3.7 × seeds 0–5). Dropping
 the term everywhere (kp_xy 0): samples tracked to the end *and* sliding ≤ 0.5 mm/frame 27 → 37 of 48,
 but on the val split's finish row (288 × 2) R@3 0.516 → 0.446 and FID 24.1 → 29.1 at the same sliding
 (0.62 → 0.58); kp_xy 2 and 5 lost R@3 as well (0.450, 0.467). Only while moving (this setting): 27 → 34
@@ -163,28 +163,27 @@ R@3 within 0.02 of kp_xy 20 (the rule fixed before the val runs). Mocap (the aug
 FINISH_MOVING_ROT_SCALE: float | None = None
 """``BalanceConfig.moving_rot_scale`` of the simulated finish: None, full pelvis-orientation gains.
 
-Measured and not adopted (session 34). Halving the gains while the motion moves (0.5) helps the bench
+Measured and not adopted. Halving the gains while the motion moves (0.5) helps the bench
 prompts: on the 48 bench samples (4 bench prompts × g −9.81/−3.7 × seeds 0–5) tracked-and-≤ 0.5 mm/frame
 37 → 42 (seeds 0–2, where it was chosen among 0 / 0.3 / 0.5 / 0.7: 16 → 19; seeds 3–5: 21 → 23), and
 every seed-0 sample ≤ 0.5. On the val split's finish row (288 × 2) it did not: sliding 0.519 → 0.513
 (0.3: 0.525), R@3 0.521 → 0.524, 566 → 565 tracked; the rule fixed before those runs (track at least as
 many, R@3 within 0.02, then lowest sliding) keeps the full gains, and a paired re-test declared before
-its runs (val, 288 × 5, the same generated motions) found no effect: sliding +0.000 ± 0.012 mm/frame.
-``benchmarks/bench_finish.py --moving-rot-scale`` measures it."""
+its runs (val, 288 × 5, the same generated motions) found no effect: sliding +0.000 ± 0.012 mm/frame."""
 
 FINISH_LATE_FOOT: str = "place"
 """``BalanceConfig.late_foot`` of the simulated finish: a swing foot still in the air when the generated
 motion has it down goes on being placed by the capture point until it lands. With ``"release"`` (the
-augmentation's; sessions 31–33's finish) the placement stopped the moment the reference's foot landed
-and the PD pose swung the late foot back to the reference's footprint: it came down moving backwards
-and skidded (the bench walk at Earth: the toe travelled 22 cm back in its last 5 frames of descent and
+augmentation's setting) the placement stops the moment the reference's foot lands
+and the PD pose swings the late foot back to the reference's footprint: it comes down moving backwards
+and skids (the bench walk at Earth: the toe travelled 22 cm back in its last 5 frames of descent and
 slid 36 mm at touchdown, half of that walk's sliding).
 
-Measured (session 34). Val split, finish row, 288 × 2 (rule fixed before the runs: lowest CLoSD sliding
+Measured on the val split's finish row, 288 × 2 (rule fixed before the runs: lowest CLoSD sliding
 among settings tracking as many and with R@3 within 0.02 of ``"release"``): release R@3 0.523, FID 24.0,
 sliding 0.58 mm/frame, 566 of 576 tracked; ``"hold"`` (repeat the last placement) 0.524, 24.3, 0.52, 565;
-``"place"`` 0.521, 24.3, 0.52, 566. On the 48 bench samples (4 bench prompts × g −9.81/−3.7 × seeds 0–5,
-``benchmarks/bench_finish.py``) place: tracked to the end 43 → 45, tracked and ≤ 0.5 mm/frame 34 → 37, the
+``"place"`` 0.521, 24.3, 0.52, 566. On the 48 bench samples (4 bench prompts × g −9.81/−3.7 × seeds 0–5)
+place: tracked to the end 43 → 45, tracked and ≤ 0.5 mm/frame 34 → 37, the
 walks' mean sliding 0.51 → 0.31. Mocap (the augmentation) keeps ``"release"``."""
 
 

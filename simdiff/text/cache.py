@@ -66,7 +66,7 @@ def write_caption_file(path: str | os.PathLike[str], captions: list[str], table:
     and the encoder's name in the metadata (the format of the cache and of :mod:`simdiff.text.table`)."""
     import json
 
-    from simdiff.model.checkpoint import atomic_save_tensors
+    from simdiff.fsio import atomic_save_tensors
 
     atomic_save_tensors({"embeddings": table}, path, metadata={"captions": json.dumps(captions), "encoder": encoder})
 

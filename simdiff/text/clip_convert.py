@@ -23,7 +23,7 @@ TEXT_KEYS: tuple[str, ...] = ("token_embedding.", "positional_embedding", "trans
 
 def convert(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> int:
     """Load the trusted TorchScript archive ``src``, write its text-tower tensors to ``dst``; returns their count."""
-    from simdiff.model.checkpoint import atomic_save_tensors
+    from simdiff.fsio import atomic_save_tensors
 
     src, dst = Path(src), Path(dst)
     if not src.is_file():

@@ -1,7 +1,7 @@
 """Precomputed caption embeddings as a frozen text encoder (for machines without the encoder's weights).
 
 A GPU machine lent for training has no internet and no room to carry MiniLM's 88 MB of weights
-within its 64 MiB; a corpus's captions are few (corpus3: 2,753 distinct captions, 2 MiB as
+within its 64 MiB; a corpus's captions are few (the all-source corpus: 2,753 distinct captions, 2 MiB as
 float16), so they are encoded here once (``simdiff train text-table``) and the pipeline reads
 them there (``simdiff train pipeline --text-table FILE``). A caption that is not in the table is
 an error naming it, never a silent zero vector. The file has the layout of
@@ -73,20 +73,6 @@ def open_caption_table(path: str | os.PathLike[str], encoder: str, device: torch
     if table.name != encoder:
         raise SimdiffError(f"text table {path} holds {table.name!r} embeddings, the run uses {encoder!r}")
     return table
-
-
-def corpus_captions(corpus: str | os.PathLike[str]) -> list[str]:
-    """Every caption of a HumanML3D-layout corpus (``texts/*.txt``, all splits), in file order, without repeats."""
-    from simdiff.data.humanml3d import read_captions
-
-    folder = Path(corpus) / "texts"
-    if not folder.is_dir():
-        raise SimdiffError(f"no texts/ folder in corpus {corpus}")
-    seen: dict[str, None] = {}
-    for path in sorted(folder.glob("*.txt")):
-        for caption in read_captions(path):
-            seen.setdefault(caption.text, None)
-    return list(seen)
 
 
 def write_caption_table(captions: Iterable[str], encoder: TextEncoder, out: str | os.PathLike[str],

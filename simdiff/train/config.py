@@ -72,11 +72,11 @@ class TrainConfig:
         drift_pairs: which twins the drift term (``env_pairs_drift``) compares: ``"all"`` or ``"wind"`` (only twins
             whose φ differ in wind). Paired over their common frames (``twin_frames="prefix"``), low-gravity twins
             differ in mean root velocity 4–13× as much as wind twins (their longer flights lag behind), which
-            swamps the wind's drift (session 58).
+            swamps the wind's drift.
         pair_twins: which twins the per-frame paired loss (``env_pairs``) compares: ``"all"`` or ``"wind"`` (only
             twins whose φ differ in wind; gravity's answer is then learnt from the plain denoising loss alone). A
             longer low-gravity flight puts the twins out of step after its first landing; there the per-frame
-            difference cannot be told from the noise, and regressing it averages timings away (session 59).
+            difference cannot be told from the noise, and regressing it averages timings away.
         twin_frames: adapters mode: ``"equal"`` (replays of one source clip are twins only with equal frames),
             ``"prefix"`` (trimmed to their common first frames, so replays that fly longer under low gravity are
             paired too) or ``"overlap"`` (kept whole, cropped from their first frames and compared over the frames
@@ -84,11 +84,11 @@ class TrainConfig:
             :class:`simdiff.data.augment.dataset.AugmentedHumanML3D`.
         cross_twins: share p in [0, 1] of paired twins (needs ``env_pairs`` > 0) whose x_t is built from the *other*
             twin's x₀ (same t and ε) while the target stays their own: "replay my twin's motion under my φ". The plain
-            loss lets the network read a jump's height off x_t below t ≈ 900 whatever φ says (session 69's probe), so
+            loss lets the network read a jump's height off x_t below t ≈ 900 whatever φ says (measured with a probe), so
             φ alone decides it in the noisiest steps; crossed twins ask φ to act where x_t already shows the motion
             (an edit of the twin, as the simulator's replay is; sample with the edit anchor,
-            :mod:`simdiff.diffusion.guidance`). 0 = off. Session 70: 600 CPU steps at p 0.5 taught the single
-            denoising step half of the simulator's low-g lift; ``reports/training/s70_cross/``.
+            :mod:`simdiff.diffusion.guidance`). 0 = off. Measured: 600 CPU steps at p 0.5 taught the single
+            denoising step half of the simulator's low-g lift.
         cross_match: a regular expression (case-insensitive, searched in the caption) limiting ``cross_twins`` to the
             twin pairs whose caption matches, e.g. ``"jump|hop|leap"``: only those pairs are crossed, the rest keep
             their own x_t. "" (default) = every paired twin may be crossed.

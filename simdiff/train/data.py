@@ -14,6 +14,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from simdiff.data.batch import collate
 from simdiff.errors import SimdiffError
 from simdiff.train.geometric import crop_batch
 
@@ -30,25 +31,6 @@ def fetch(dataset: MotionDataset, index: int, rng: np.random.Generator) -> dict[
     """Item ``index``, drawn with ``rng`` when the dataset supports it (so runs are reproducible)."""
     get = getattr(dataset, "get", None)
     return get(index, rng) if callable(get) else dataset[index]
-
-
-def collate(items: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """Stack items: motion (B, T, 263), lengths (B,), mask (B, T) bool, captions, and env / env_index when present."""
-    if not items:
-        raise SimdiffError("cannot collate an empty batch")
-    motion = torch.stack([torch.as_tensor(np.asarray(it["motion"]), dtype=torch.float32) for it in items])
-    lengths = torch.tensor([int(it["length"]) for it in items], dtype=torch.long)
-    batch: dict[str, Any] = {
-        "motion": motion,
-        "lengths": lengths,
-        "mask": torch.arange(motion.shape[1])[None, :] < lengths[:, None],
-        "captions": [str(it["caption"]) for it in items],
-    }
-    if all("env" in it for it in items):
-        batch["env"] = torch.stack([torch.as_tensor(np.asarray(it["env"]), dtype=torch.float32).reshape(3) for it in items])
-    if all("env_index" in it for it in items):
-        batch["env_index"] = torch.tensor([int(it["env_index"]) for it in items], dtype=torch.long)
-    return batch
 
 
 class StepBatcher:

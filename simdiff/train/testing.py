@@ -6,7 +6,7 @@ from typing import Any, Sequence
 
 import torch
 
-from simdiff.model.config import ModelConfig, SimConfig, backbone_preset
+from simdiff.model.testing import tiny_model_config
 from simdiff.train.config import OptimConfig, RunConfig, TrainConfig
 
 
@@ -38,7 +38,7 @@ class HashMiniLM(HashTextEncoder):
 def tiny_run_config(steps: int = 10, mode: str = "backbone", sim: bool = False, dropout: float = 0.1,
                     lr: float = 1e-3, **train: Any) -> RunConfig:
     """A ``tiny``-preset run config (batch 4, no periodic checkpoints unless ``save_every`` is given)."""
-    model = ModelConfig(backbone=backbone_preset("tiny", dropout=dropout), sim=SimConfig() if sim else None)
+    model = tiny_model_config(sim=sim, dropout=dropout)
     train.setdefault("batch_size", 4)
     train.setdefault("save_every", 0)
     return RunConfig(model=model, train=TrainConfig(mode=mode, steps=steps, optim=OptimConfig(lr=lr), **train))

@@ -1,7 +1,7 @@
 """Body renders of motions with MuJoCo's offscreen OpenGL renderer: MP4, GIF or PNG filmstrip.
 
 A motion is either HumanML3D joints ``(T, 22, 3)`` (Y-up metres, 20 fps), turned into
-humanoid states with the simulator's IK (:func:`simdiff.sim.convert.ik_sequence`), or
+humanoid states with the simulator's IK (:func:`simdiff.sim.retarget.ik_sequence`), or
 humanoid states ``(T, nq)`` (a rollout's qpos sampled at the frame rate) used as they are.
 Each frame sets qpos, runs ``mj_forward`` and renders the humanoid of
 :mod:`simdiff.sim.humanoid` on a checkered floor under a shadow-casting sun, seen by a
@@ -198,14 +198,14 @@ def motion_qpos(motion: np.ndarray, model=None) -> np.ndarray:
 
     Args:
         motion: (T, 22, 3) HumanML3D joints (Y-up metres), converted with the simulator's
-            IK (closed form + Gauss-Newton polish, :func:`simdiff.sim.convert.ik_sequence`;
+            IK (closed form + Gauss-Newton polish, :func:`simdiff.sim.retarget.ik_sequence`;
             no ground alignment, smoothing or resampling, so the render shows the motion as
             it is), or (T, nq) humanoid states used unchanged.
         model: the simulation humanoid (default :func:`simdiff.sim.humanoid.load_model`).
     Raises:
         SimdiffError: any other shape, or non-finite values.
     """
-    from simdiff.sim.convert import RetargetConfig, ik_sequence
+    from simdiff.sim.retarget import RetargetConfig, ik_sequence
     from simdiff.sim.humanoid import hml_to_world, load_model
 
     model = model if model is not None else load_model()

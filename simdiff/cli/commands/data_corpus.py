@@ -1,4 +1,4 @@
-"""``simdiff data build``: one corpus from every motion source under ``../shared/data``."""
+"""``simdiff data build`` (one corpus from every motion source under ``../shared/data``) and ``simdiff data report``."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from simdiff.cli.main import command_group
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from simdiff.data.corpus.item import LICENCE_SETS
+    from simdiff.licences import LICENCE_SETS
     from simdiff.data.corpus.registry import SOURCES
 
     group = command_group(subparsers, "data", "corpus tools")
@@ -22,8 +22,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "cross-checks), retarget to 22 joints at 20 fps, cut 2-9.8 s clips, add M<id> mirrors, "
             "captions (>= 2 per clip), licence per clip, splits by trial stratified by source and motion "
             "type, Mean/Std and manifest.json. Resumable; output independent of --workers. "
-            "`build-cmu` stays as it was; `build --sources cmu` makes the same CMU windows plus the extra "
-            "CMU BVH and padded short takes, with stratified splits."
+            "`--sources cmu` builds the CMU trials alone."
         ),
     )
     build.add_argument("--shared", type=Path, required=True, help="shared data root (e.g. ../shared/data)")
@@ -38,6 +37,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     build.add_argument("--no-mirror", action="store_true", help="do not write mirrored M<id> clips")
     build.add_argument("--quiet", action="store_true", help="no progress bar")
     build.set_defaults(func=run_build)
+
+    report = group.add_parser(
+        "report",
+        help="quality report of a built corpus (markdown + PNG)",
+        description=(
+            "Hours by source, licence, motion type and split; flight time; physics metrics per source with "
+            "outliers; dedupe cross-checks (kept copy vs the other copies of a capture); a filmstrip per source."
+        ),
+    )
+    report.add_argument("corpus", type=Path, help="corpus folder written by `simdiff data build`")
+    report.add_argument("--out", type=Path, default=None, help="report folder (default CORPUS/report)")
+    report.add_argument("--seed", type=int, default=0, help="seed for the clips shown in filmstrips")
+    report.add_argument("--no-crosscheck", action="store_true", help="skip the comparison of copies")
+    report.set_defaults(func=run_report)
 
 
 def run_build(args: argparse.Namespace) -> int:
@@ -67,4 +80,14 @@ def run_build(args: argparse.Namespace) -> int:
         reasons[reason] = reasons.get(reason, 0) + 1
     for reason, count in sorted(reasons.items(), key=lambda kv: -kv[1])[:10]:
         print(f"  skipped {count}: {reason}")
+    return 0
+
+
+def run_report(args: argparse.Namespace) -> int:
+    from simdiff.data.corpus.report import write_corpus_report
+    from simdiff.viz.stick import render_filmstrip
+
+    path = write_corpus_report(args.corpus, args.out, render_filmstrip=render_filmstrip, seed=args.seed,
+                               crosscheck=not args.no_crosscheck)
+    print(f"report written to {path}")
     return 0

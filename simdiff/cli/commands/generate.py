@@ -5,10 +5,12 @@ from __future__ import annotations
 import argparse
 import sys
 from contextlib import nullcontext
+from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from simdiff.product.request import ANCHORS
+from simdiff.diffusion.config import SAMPLER_STEPS, SAMPLERS, SamplingConfig
+from simdiff.inference.default import DEFAULT_MODEL_DIR, SAMPLING_NAME, sampling_config
 
 if TYPE_CHECKING:
     from simdiff.product.finisher import Finisher
@@ -32,7 +34,7 @@ compare_sampleK.gif shows the environments side by side (same prompt, same noise
 
 examples:
   simdiff generate "a person jumps forward" --gravity -3.7 --wind 2 0
-  simdiff generate "a person walks in a circle" --length 8 --num-samples 3 --no-video
+  simdiff generate "a person walks in a circle" --length 8 --num-samples 3 --format npy,bvh
   simdiff generate "a person jumps forward" --compare gravity=-9.81,-3.7,-1.6
   simdiff generate "a person jumps forward" --gravity -3.7 --simulate
 """
@@ -64,61 +66,39 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           "simulated motion and its tracking result beside it")
     env.add_argument("--force", action="store_true",
                      help="allow environments outside the trained range (gravity -20..-1 m/s², |wind| <= 10 N)")
-    smp = p.add_argument_group("sampling")
-    length = smp.add_mutually_exclusive_group()
-    length.add_argument("--length", type=float, metavar="SECONDS", help="motion length in seconds, up to 9.8 (default 6)")
-    length.add_argument("--frames", type=int, metavar="N", help="motion length in frames at 20 fps, 1..196 (default 120)")
+    smp = p.add_argument_group("sampling (defaults: the model's sampling.json; shown: the shipped model's)")
+    cfg = shipped_sampling()
+    smp.add_argument("--length", type=float, metavar="SECONDS", help="motion length in seconds, up to 9.8 (default 6)")
     smp.add_argument("--seed", type=int, default=0, metavar="S", help="noise seed; sample K uses seed+K (default 0)")
     smp.add_argument("--num-samples", type=int, default=1, metavar="K", help="samples to generate (default 1)")
-    smp.add_argument("--sampler", choices=["ddim", "ddpm"], help="diffusion sampler (default ddim)")
-    smp.add_argument("--steps", type=int, metavar="N", help="diffusion steps (default 50 for ddim, 1000 for ddpm)")
+    smp.add_argument("--sampler", choices=SAMPLERS, help=f"diffusion sampler (default {cfg.sampler})")
+    smp.add_argument("--steps", type=int, metavar="N",
+                     help=f"diffusion steps, 1..1000 (default {cfg.steps}; {SAMPLER_STEPS['ddpm']} with a "
+                          "--sampler switched to ddpm)")
     smp.add_argument("--eta", type=float, metavar="E",
-                     help="DDIM's noise scale in [0, 1]: 0 deterministic, 1 fresh noise at every step (default 0, or "
-                          "the model's sampling.json)")
-    smp.add_argument("--guidance", type=float, metavar="W", help="classifier-free guidance scale, 1 = off (default 2.5)")
+                     help=f"DDIM's noise scale in [0, 1]: 0 deterministic, 1 fresh noise at every step (default "
+                          f"{cfg.eta:g})")
+    smp.add_argument("--guidance", type=float, metavar="W",
+                     help=f"classifier-free guidance scale on the text, 1 = off (default {cfg.guidance:g})")
     smp.add_argument("--alpha", type=float, metavar="A",
-                     help="strength of the environment adapters, 0 = ignore φ (default 1, or the model's sampling.json)")
+                     help=f"strength of the environment adapters, 0 = ignore φ (default {cfg.alpha:g})")
     smp.add_argument("--foot-lock", type=float, metavar="S",
                      help="foot cleanup, strength 0..1: move the root so the feet the motion marks planted do not "
                           "slide, lift swinging feet that drag along the floor 2 cm clear of it, and lower a motion "
-                          "that never comes within 0.10 m of the floor onto it "
-                          "(0 = off; default 0, or the model's sampling.json)")
+                          f"that never comes within 0.10 m of the floor onto it (0 = off; default {cfg.foot_lock:g})")
     smp.add_argument("--env-guidance", type=float, metavar="S",
-                     help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off; "
-                          "motions under Earth without wind are unchanged (default 1, or the model's sampling.json)")
-    smp.add_argument("--env-guidance-fallback", type=float, metavar="S",
-                     help="environment guidance for the samples that come out floating (never within 0.10 m of the "
-                          "floor) or gliding (travelling while no foot lifts 5 cm) at --env-guidance: they are "
-                          "sampled again with the same seed at S (default off, or the model's sampling.json)")
-    smp.add_argument("--anchor", choices=ANCHORS,
-                     help="what the text guidance runs on: the network with its adapters (adapters), or the backbone "
-                          "alone, the adapters adding only their answer to φ against Earth without wind (backbone), "
-                          "or the network under Earth without wind at --anchor-alpha, the adapters anchor's whole "
-                          "answer to φ added (reference), or, under another gravity, that network until --edit-t, "
-                          "then the adapters under φ (edit); default adapters, or the model's sampling.json")
-    smp.add_argument("--anchor-alpha", type=float, metavar="A",
-                     help="with --anchor backbone, reference or edit: run its text guidance with the adapters at strength "
-                          "A, so motions under Earth without wind are those of --alpha A while the answer to φ is "
-                          "--alpha's (default 0, or the model's sampling.json)")
-    smp.add_argument("--anchor-t-max", type=int, metavar="T",
-                     help="with --anchor backbone or reference: use it only at the denoising steps whose timestep is "
-                          "at most T (0-999), the adapters anchor at the earlier ones (default every step, or the "
-                          "model's sampling.json)")
+                     help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off "
+                          f"(default {cfg.env_guidance:g})")
     smp.add_argument("--edit-t", type=int, metavar="T",
-                     help="with --anchor edit: a motion under another gravity follows its Earth motion (same "
-                          "seed) down to timestep T (0-999), then continues under its gravity and wind (default 800, or the "
-                          "model's sampling.json)")
-    smp.add_argument("--ballistic", type=float, metavar="S",
-                     help="ballistic flight strength in [0, 1]: while no foot is on the ground the body's height "
-                          "follows the parabola of the chosen gravity (1), as generated (0); default 0, or the "
-                          "model's sampling.json")
+                     help="under another gravity than Earth's, the motion follows its Earth motion (same seed) down "
+                          f"to denoising timestep T (0-999), then continues under φ (default {cfg.edit_t})")
     out = p.add_argument_group("output")
     out.add_argument("--out", type=Path, metavar="DIR",
                      help="output folder, files in it are replaced (default ./out/<prompt>, or <prompt>-2, -3, ... "
                           "when that one is not empty)")
     out.add_argument("--format", metavar="LIST",
-                     help="comma-separated outputs among npy, bvh, gif, mp4 (default npy,bvh,gif)")
-    out.add_argument("--no-video", action="store_true", help="skip the GIF/MP4 (fastest)")
+                     help="comma-separated outputs among npy, bvh, gif, mp4 (default npy,bvh,gif; npy,bvh is "
+                          "fastest)")
     out.add_argument("-q", "--quiet", action="store_true",
                      help="no progress bars or notes (warnings still show); print only the file paths")
     run_ = p.add_argument_group("model and compute")
@@ -126,8 +106,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                       help="model folder with model.safetensors + config.json (default $SIMDIFF_MODEL, else the "
                            "shipped model)")
     run_.add_argument("--device", default="cpu", help="torch device, e.g. cpu or cuda (default cpu)")
-    run_.add_argument("--threads", type=int, metavar="N",
-                      help="CPU threads for torch (default: the idle cores, from the load average)")
     p.set_defaults(func=run)
 
 
@@ -137,28 +115,28 @@ def _note(args: argparse.Namespace, message: str) -> None:
         print(f"simdiff: {message}", file=sys.stderr)
 
 
+def shipped_sampling() -> SamplingConfig:
+    """The shipped model's sampling configuration (one small JSON file; no torch)."""
+    path = DEFAULT_MODEL_DIR / SAMPLING_NAME
+    return SamplingConfig.read(path) if path.is_file() else SamplingConfig()
+
+
+def given_sampling(args: argparse.Namespace) -> dict[str, object]:
+    """The sampling options the user gave (None for the others)."""
+    return {f.name: getattr(args, f.name) for f in fields(SamplingConfig)}
+
+
 def run(args: argparse.Namespace) -> int:
     import time
 
-    from simdiff.errors import SimdiffError
     from simdiff.product.request import build_request
 
     start = time.perf_counter()
+    sampling = sampling_config(args.model).updated(**given_sampling(args))
     request = build_request(  # every user value is checked before torch is imported
-        args.text, gravity=args.gravity, wind=args.wind, length_s=args.length, frames=args.frames, seed=args.seed,
-        num_samples=args.num_samples, sampler=args.sampler or "ddim", steps=args.steps,
-        guidance=2.5 if args.guidance is None else args.guidance, alpha=1.0 if args.alpha is None else args.alpha,
-        foot_lock=0.0 if args.foot_lock is None else args.foot_lock,
-        env_guidance=1.0 if args.env_guidance is None else args.env_guidance, anchor=args.anchor or "adapters",
-        env_guidance_fallback=args.env_guidance_fallback,
-        anchor_alpha=0.0 if args.anchor_alpha is None else args.anchor_alpha,
-        anchor_t_max=args.anchor_t_max, edit_t=args.edit_t, eta=0.0 if args.eta is None else args.eta,
-        ballistic=0.0 if args.ballistic is None else args.ballistic,
-        compare=args.compare, formats=args.format,
-        no_video=args.no_video, force=args.force,
+        args.text, gravity=args.gravity, wind=args.wind, length_s=args.length, seed=args.seed,
+        num_samples=args.num_samples, sampling=sampling, compare=args.compare, formats=args.format, force=args.force,
     )
-    if args.threads is not None and args.threads < 1:
-        raise SimdiffError(f"--threads must be at least 1, got {args.threads}")
     finisher = None
     if args.simulate:  # the simulator loads in its own process while this one loads torch and samples
         from simdiff.product.finisher import start_finisher
@@ -174,23 +152,14 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
 
     from simdiff.errors import SimdiffError
     from simdiff.product.outputs import fresh_dir, prepare_out_dir, slug
-    from simdiff.product.request import with_model_defaults
     from simdiff.sim.env import GRAVITY_RANGE, MAX_WIND
-    from simdiff.model.default import check_model_dir, sampling_defaults  # imports torch (simdiff.model)
-
-    folder = check_model_dir(args.model)
-    stored = sampling_defaults(args.model)
+    from simdiff.inference.default import check_model_dir
     from simdiff.model.extrapolate import read_recipe
     from simdiff.model.provenance import read_provenance
 
+    folder = check_model_dir(args.model)
     read_provenance(folder)  # a malformed provenance.json fails now, not after sampling
     read_recipe(folder)  # likewise extrapolation.json
-    given = {name for name in ("sampler", "steps", "guidance", "alpha", "foot_lock", "env_guidance",
-                               "env_guidance_fallback", "anchor", "anchor_alpha", "anchor_t_max", "edit_t",
-                               "ballistic", "eta")
-             if getattr(args, name) is not None}
-    request = with_model_defaults(request, stored, given)
-    alpha_source = "--alpha" if "alpha" in given else ("sampling.json" if "alpha" in stored else "default")
     for env in request.envs:
         try:
             env.validate()
@@ -206,16 +175,13 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
 
     import torch
 
-    from simdiff.model.default import load_default
+    from simdiff.inference.default import load_default
     from simdiff.product.pipeline import Timer, describe_env, run_generation
 
     try:
         device = torch.device(args.device)
     except (RuntimeError, ValueError):
         raise SimdiffError(f"unknown --device {args.device!r}; use cpu or cuda") from None
-    from simdiff.product.threads import default_threads
-
-    torch.set_num_threads(args.threads if args.threads is not None else default_threads(torch.get_num_threads()))
     timer = Timer()
     _note(args, f"loading model {folder}")
     with timer.stage("load_model"):
@@ -229,7 +195,7 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
         request = request.with_envs(request.envs[:1])
     elif generator.config.sim.mode != "continuous":
         raise SimdiffError(f"{folder} has categorical environments; use `simdiff sample --env-index` with it")
-    meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet, alpha_source,
+    meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet,
                                  simulate=args.simulate, force=args.force, finisher=finisher)
     from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT
 

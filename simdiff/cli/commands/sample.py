@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import fields
 from pathlib import Path
+
+from simdiff.diffusion.config import SAMPLERS, SamplingConfig
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -19,11 +22,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--env", type=float, nargs=3, metavar=("G_Z", "W_X", "W_Y"),
                    help="φ for SimDiff models: gravity m/s² and wind N (default -9.81 0 0)")
     p.add_argument("--env-index", type=int, help="environment category for categorical SimDiff models")
-    p.add_argument("--alpha", type=float, default=1.0, help="adapter strength α (0 = backbone only; default 1)")
-    p.add_argument("--sampler", choices=["ddim", "ddpm"], default="ddim", help="sampler (default ddim)")
-    p.add_argument("--steps", type=int, help="sampling steps (default: 50 for ddim, 1000 for ddpm)")
-    p.add_argument("--eta", type=float, default=0.0, help="DDIM η (default 0, deterministic)")
-    p.add_argument("--guidance", type=float, default=2.5, help="classifier-free guidance scale (default 2.5; 1 = off)")
+    smp = p.add_argument_group("sampling (default: the model's sampling.json, else the SamplingConfig defaults)")
+    smp.add_argument("--sampler", choices=SAMPLERS, help="sampler")
+    smp.add_argument("--steps", type=int, help="sampling steps, 1..1000")
+    smp.add_argument("--eta", type=float, help="DDIM η in [0, 1] (0: deterministic)")
+    smp.add_argument("--guidance", type=float, help="classifier-free guidance scale (1 = off)")
+    smp.add_argument("--alpha", type=float, help="adapter strength α (0 = backbone only)")
+    smp.add_argument("--env-guidance", type=float, help="environment guidance s_e (1 = off; continuous φ only)")
+    smp.add_argument("--edit-t", type=int, help="last timestep (0..999) at which φ off Earth's gravity follows Earth")
+    smp.add_argument("--foot-lock", type=float, help="foot cleanup strength in [0, 1] (0 = off)")
     p.add_argument("--unbatched-cfg", action="store_true", help="run CFG as two forwards (MDM's way) instead of one")
     p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
     p.add_argument("--batch", type=int, default=1, help="samples per caption (default 1)")
@@ -40,7 +47,8 @@ def run(args: argparse.Namespace) -> int:
 
     from simdiff.errors import SimdiffError
     from simdiff.fsio import check_writable, ensure_dir, save_npy, write_json
-    from simdiff.model.generator import MAX_FRAMES, MotionGenerator
+    from simdiff.inference.default import sampling_config
+    from simdiff.inference.generator import MAX_FRAMES, MotionGenerator
 
     from simdiff.product.request import check_text
 
@@ -49,8 +57,7 @@ def run(args: argparse.Namespace) -> int:
         raise SimdiffError(f"--length must be 1..{MAX_FRAMES} frames (9.8 s at 20 fps), got {args.length}")
     if args.batch < 1:
         raise SimdiffError("--batch must be at least 1")
-    if args.steps is not None and args.steps < 1:
-        raise SimdiffError("--steps must be positive")
+    config = sampling_config(args.model).updated(**{f.name: getattr(args, f.name) for f in fields(SamplingConfig)})
     try:
         device = torch.device(args.device)
     except RuntimeError:
@@ -62,10 +69,9 @@ def run(args: argparse.Namespace) -> int:
     def progress(steps):
         from tqdm.auto import tqdm
 
-        return tqdm(steps, desc=f"{args.sampler} sampling", unit="step", leave=False, dynamic_ncols=True)
+        return tqdm(steps, desc=f"{config.sampler} sampling", unit="step", leave=False, dynamic_ncols=True)
 
-    out = gen.generate(texts, args.length, env=args.env, env_index=args.env_index, alpha=args.alpha,
-                       sampler=args.sampler, steps=args.steps, eta=args.eta, guidance=args.guidance, seed=args.seed,
+    out = gen.generate(texts, args.length, config, env=args.env, env_index=args.env_index, seed=args.seed,
                        batched_cfg=not args.unbatched_cfg, progress=None if args.no_progress else progress)
     try:
         from simdiff.motion.features import features_to_joints
@@ -80,8 +86,8 @@ def run(args: argparse.Namespace) -> int:
             save_npy(args.out / f"sample_{i:03d}_joints.npy", features_to_joints(features))
             entry["joints"] = f"sample_{i:03d}_joints.npy"
         index.append(entry)
-    meta = {"model": str(args.model), "sampler": args.sampler, "steps": args.steps, "guidance": args.guidance,
-            "seed": args.seed, "alpha": args.alpha, "env": args.env, "env_index": args.env_index, "samples": index}
+    meta = {"model": str(args.model), **config.to_dict(), "seed": args.seed, "env": args.env,
+            "env_index": args.env_index, "samples": index}
     write_json(args.out / "samples.json", meta, indent=2)
     print(f"wrote {len(index)} motion(s) to {args.out}")
     return 0

@@ -41,7 +41,7 @@ def build_server(args: argparse.Namespace):  # -> simdiff.serve.ViewerServer (im
 
     from simdiff.errors import SimdiffError
     from simdiff.serve import MotionService, ViewerServer, read_listed
-    from simdiff.product.request import MAX_STEPS
+    from simdiff.diffusion.config import MAX_STEPS
 
     if not 0 <= args.port <= 65535:
         raise SimdiffError(f"--port must be 0..65535, got {args.port}")

@@ -35,11 +35,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     k = group.add_parser("pack", help="write a corpus as compact arrays (for carrying to a GPU machine)")
     k.add_argument("corpus", type=Path, help="HumanML3D-layout corpus folder")
     k.add_argument("--out", type=Path, required=True, help="pack folder")
-    k.add_argument("--content", choices=["joints", "features"], default="joints",
-                   help="joints (v2, default): original clips' joints, features and mirrors rebuilt on unpack; "
-                        "features (v1): every clip's features as --dtype")
-    k.add_argument("--dtype", choices=["float16", "float32"], default="float16",
-                   help="feature dtype of --content features (float32: exact)")
     k.add_argument("--workers", type=int, default=1, help="processes encoding clips (0: all cores)")
     k.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     k.add_argument("--splits", nargs="+", help="pack only these split files' clips (default all)")
@@ -110,8 +105,8 @@ def run_pipeline_cmd(args: argparse.Namespace) -> int:
 def run_pack(args: argparse.Namespace) -> int:
     from simdiff.data.pack import pack
 
-    info = pack(args.corpus, args.out, dtype=args.dtype, budget_mib=args.budget_mib, splits=args.splits,
-                content=args.content, workers=args.workers, progress=not args.no_progress)
+    info = pack(args.corpus, args.out, budget_mib=args.budget_mib, splits=args.splits, workers=args.workers,
+                progress=not args.no_progress)
     print(f"packed {info['clips']} clips ({info.get('mirrors', 0)} as mirrors), {info['frames']} frames "
           f"({info['dtype']}): "
           f"{info['bytes'] / 2**20:.2f} MiB in {args.out}")
@@ -129,7 +124,8 @@ def run_unpack(args: argparse.Namespace) -> int:
 def run_text_table(args: argparse.Namespace) -> int:
     from simdiff.errors import SimdiffError
     from simdiff.text.base import load_text_encoder
-    from simdiff.text.table import corpus_captions, write_caption_table
+    from simdiff.data.humanml3d import corpus_captions
+    from simdiff.text.table import write_caption_table
 
     captions: list[str] = []
     for corpus in args.corpus:

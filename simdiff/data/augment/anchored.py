@@ -1,7 +1,7 @@
 """Source-anchored training targets for the adapters (``simdiff train adapters --targets source-anchored``).
 
 A simulated item's plain target is the simulator's replay x_sim(φ) (frames × 263 HumanML3D features). The tracker's
-Earth replays are far from the clips they replay (session 55, measurement M1: R@3 0.18–0.28 below ground truth, FID
+Earth replays are far from the clips they replay (measured: R@3 0.18–0.28 below ground truth, FID
 14–24), so adapters trained on plain targets also learn the tracker's look. A source-anchored target keeps only the
 simulator's *change* under φ:
 

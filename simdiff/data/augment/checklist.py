@@ -1,4 +1,4 @@
-"""Issue 13's "done when", evaluated on an augmentation run's numbers (PASS / FAIL / NO DATA).
+"""Quality checks of an augmentation run, evaluated on its numbers (PASS / FAIL / NO DATA).
 
 Each criterion is computed from the report's tables, never written in:
 
@@ -7,12 +7,12 @@ Each criterion is computed from the report's tables, never written in:
 * ``flight_gravity``: ≥ 25 % at every gravity bin for clips with flight (class ``flight``);
 * ``wind``: ≥ 60 % at every wind bin (w_x and w_y) over the clips without acrobatics
   (``plain`` and ``flight`` pooled);
-* ``earth``: Earth keep rate over all clips ≥ 66 % (the previous filter's);
+* ``earth``: Earth keep rate over all clips ≥ 66 % (that of a filter without the flight clock,
+  d_L2 ≤ 7 and residual ≤ 0.1·m·|g_z|; :mod:`simdiff.data.augment.decide`);
 * ``confound``: every |r| between a φ component and a content statistic ≤ 0.1;
-* ``low_g_flight`` (a proxy on the run's own pairs; the issue's test is the CMU jumps at
-  g = −1.6, ``benchmarks/bench_flight.py``): over ``flight`` clips whose Earth rollout flew,
-  pairs in the lowest gravity bin g ∈ [−3, −1): median longest-flight ratio to the clip's Earth
-  rollout ≥ 3 and ≥ 70 % tracked to the end.
+* ``low_g_flight`` (a proxy on the run's own pairs for the CMU jumps at g = −1.6): over ``flight``
+  clips whose Earth rollout flew, pairs in the lowest gravity bin g ∈ [−3, −1): median longest-flight
+  ratio to the clip's Earth rollout ≥ 3 and ≥ 70 % tracked to the end.
 
 A bin that has no pair of the class reads NO DATA and fails the overall verdict. Each criterion
 is evaluated in every view of the report (all pairs; clips whose Earth rollout tracked).
@@ -34,7 +34,7 @@ PASS, FAIL, NO_DATA = "PASS", "FAIL", "NO DATA"
 
 @dataclass(frozen=True)
 class DoneWhen:
-    """The bounds of issue 13 (fractions; |r|; flight ratio)."""
+    """The bounds of the quality checks (fractions; |r|; flight ratio)."""
 
     plain_gravity_keep: float = 0.5
     flight_gravity_keep: float = 0.25
@@ -142,12 +142,11 @@ def checklist(views: dict[str, dict[str, Any]], confounds: dict[str, dict[str, A
                 "views": {v: _confound(confounds[v], cfg.confound_r) for v in views}})
     out.append({"key": "low_g_flight",
                 "criterion": f"proxy: flight clips at g ∈ [−3, −1) fly ≥ {cfg.low_g_flight_ratio:g}× their Earth rollout "
-                             f"(median) and ≥ {cfg.low_g_landed:.0%} track to the end (issue: CMU jumps at g = −1.6, "
-                             "benchmarks/bench_flight.py)",
+                             f"(median) and ≥ {cfg.low_g_landed:.0%} track to the end (for the CMU jumps at g = −1.6)",
                 "views": {v: low_g_flight(records, classes, None if v == "all" else tracked, cfg) for v in views}})
     verdict = all(i["views"]["all"]["status"] == PASS for i in out) if "all" in views else None
     return {"items": out, "passes": verdict,
-            "not_evaluated": ["ballistic fit of apex and flight time (reports/augment/README.md §1)",
+            "not_evaluated": ["ballistic fit of apex and flight time",
                               "tests of the time-warped reference, the filter and the confound check (tests/)"]}
 
 

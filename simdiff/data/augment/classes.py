@@ -1,9 +1,10 @@
 """Content classes of the augmented pairs and the keep-rate table per condition bin × class.
 
-Issue 13 states its keep-rate criteria per content class, so the report counts them that way:
+The quality checks (:mod:`simdiff.data.augment.checklist`) bound keep rates per content class, so the
+report counts them that way:
 
 * ``acrobatics``: the corpus manifest (``<corpus>/manifest.json``, per clip ``motion_type``)
-  says ``acrobatics`` (no keep-rate bound in the issue);
+  says ``acrobatics`` (no keep-rate bound in the quality checks);
 * ``flight``: otherwise, the source clip's longest flight lasts at least
   :data:`simdiff.motion.flight.MIN_FLIGHT_S` (0.2 s), the rule of the corpus report
   (:func:`simdiff.motion.flight.has_flight` on ``content["flight_s"]``, the longest flight of

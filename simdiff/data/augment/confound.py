@@ -11,7 +11,7 @@ each descriptor of the source clip's content:
   CMU subject; the ``max_groups`` most frequent groups, the rest pooled as ``other``).
 
 An indicator with one value only (no variance) has no correlation and is left out. The check
-passes when every |r| ≤ ``bound`` (issue 13: 0.1).
+passes when every |r| ≤ ``bound`` (the quality checks use 0.1).
 """
 
 from __future__ import annotations

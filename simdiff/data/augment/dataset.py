@@ -65,8 +65,8 @@ class AugmentedHumanML3D:
             have the same frames. ``"prefix"``: such items are all trimmed to their shortest replay's frames and
             are twins. A low-gravity rollout is longer than its Earth twin (the flight clock waits while the body
             flies longer: :mod:`simdiff.sim.rollout`), so under ``"equal"`` the replays that fly longer have no twin
-            and the paired loss sees mostly replays that did not change (session 58: 116 of 712 low-gravity items
-            of a jump augmentation had a twin, median apex change 0.000 m; the 596 others +0.48 m). The trim keeps
+            and the paired loss sees mostly replays that did not change (measured on a jump augmentation: 116 of
+            712 low-gravity items had a twin, median apex change 0.000 m; the 596 others +0.48 m). The trim keeps
             the frames both replays share from the start, where they track the same reference frames until the
             first flight. ``"overlap"``: such items are twins and keep their own frames; every crop starts at the
             item's first frame, so twins are aligned and the paired loss compares the frames they share

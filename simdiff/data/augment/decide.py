@@ -6,8 +6,8 @@ the same command again re-finalises without simulating.
 
 ``max_pose_d_l2 = "auto"`` calibrates the pose threshold on the run's own Earth pairs: the
 smallest value at which the Earth keep rate (kept Earth pairs / all Earth pairs, every
-criterion applied) reaches ``earth_keep`` (default 0.66, the previous filter's Earth keep
-rate on the old corpus, issue 13). When fewer Earth pairs than that tracked with an
+criterion applied) reaches ``earth_keep`` (default 0.66, the Earth keep rate of a filter
+without the flight clock, d_L2 ≤ 7 and residual ≤ 0.1·m·|g_z|). When fewer Earth pairs than that tracked with an
 acceptable residual, the target is unreachable and the threshold is the largest pose d_L2
 among those pairs (every tracked, residual-ok Earth pair is kept). Pairs derived from a
 mirror (``mirrored_from``) do not enter the calibration and follow their original's decision.

@@ -13,7 +13,7 @@ A pair (source clip, φ) is kept when the rollout passes every criterion:
    over the rollout at most ``max_residual_n`` **newtons**, the same for every φ.
 
 Why an absolute budget: the residual corrects the tracker's stance errors (foot placement,
-retargeting), whose size does not scale with g. A budget of 0.1·m·|g_z| (the previous rule)
+retargeting), whose size does not scale with g. A relative budget of 0.1·m·|g_z|
 is 71 N on Earth but 11.5 N at g = −1.6, below what the stance correction needs on any
 motion, so it rejected nearly every low-gravity pair (5 of 97 at g ≥ −3.2). The default,
 70.6 N = 0.1·72 kg·9.81 m/s², keeps the Earth threshold where it was (so the Earth keep rate
@@ -26,11 +26,10 @@ measured on 24 clips without flight: median residual 41 N at Earth, 54-58 N at �
 torque cap scaled the same way by the tracker).
 
 Calibration of ``max_pose_d_l2`` = 5.2: on the Earth rollouts of 24 CMU clips (with the
-official HumanML3D Mean/Std), the previous filter (no clock, d_L2 ≤ 7, ≤ 0.1·m·g) kept 11;
+official HumanML3D Mean/Std), a filter without the clock (d_L2 ≤ 7, ≤ 0.1·m·g) kept 11;
 the 11th smallest pose d_L2 of the tracked, residual-ok Earth rollouts with the clock was
 5.14, rounded up; with the final clock settings 5.2 keeps 12 of those 24 (the equal-rate
-point is 4.62), so the Earth keep rate is not lower (``benchmarks/bench_augment_sample.py``,
-``reports/augment/README.md``).
+point is 4.62), so the Earth keep rate is not lower.
 Like d_L2 it is in normalised units, so it depends on the normaliser: on the all-source corpus
 with its own Mean/Std, 5.2 keeps 18 % at Earth. ``max_pose_d_l2 = "auto"`` (the CLI default in
 paired and binary mode) calibrates it per run so that the Earth keep rate is ``earth_keep``
@@ -64,8 +63,8 @@ class FilterConfig:
             or ``"auto"``: calibrated at finalize on the run's Earth pairs (needs the records).
         max_residual_n: largest mean root residual force (N), for every φ.
         max_d_l2: largest paper d_L2 (eq. 13; the paper's 7.0), off by default.
-        max_residual: largest mean residual force as a fraction of m·|g_z| (the previous
-            rule), off by default.
+        max_residual: largest mean residual force as a fraction of m·|g_z| (the relative
+            budget), off by default.
         earth_keep: with ``"auto"``, the Earth keep rate the threshold is calibrated to reach.
         residual_follows_strength: above Earth gravity the residual budget is
             ``max_residual_n · s`` with the body-strength factor ``s = max(1, |g_z|/9.81)``

@@ -1,5 +1,5 @@
 """The augmentation report: keep rates and rejections per condition bin and per bin × content class
-(:mod:`simdiff.data.augment.classes`), issue 13's "done when" checklist
+(:mod:`simdiff.data.augment.classes`), the quality checks
 (:mod:`simdiff.data.augment.checklist`), confound check, physics signal."""
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ def build_report(records: Sequence[dict[str, Any]], conditions: Sequence[Augment
             :mod:`simdiff.data.augment.classes`); None: no clip counts as acrobatics.
 
     The per-class views (``by_class``: all pairs, and clips whose Earth rollout tracked) and
-    the "done when" ``checklist`` of issue 13 (:mod:`simdiff.data.augment.checklist`) are
+    the quality checks (``checklist``, :mod:`simdiff.data.augment.checklist`) are
     computed from the same records.
 
     Pairs derived from a mirror (``mirrored_from``, ``--share-mirrors``) count in the keep
@@ -112,7 +112,7 @@ def report_markdown(report: dict[str, Any]) -> str:
         f"* filter: {report['filter']['thresholds']}; tracker residual bound {report['settings']['residual_bound']}·m·g",
         *_calibration_lines(report["filter"].get("calibration")),
         f"* simulator CPU time: {report['sim_cpu_s_total']} s ({report.get('cpu_s_per_sim_s')} CPU s per simulated s)", "",
-        "## Issue 13 \"done when\" (computed from this run)", "",
+        "## Quality checks (computed from this run)", "",
         *(checklist_markdown(report["checklist"], VIEWS) if "checklist" in report else []),
         "## Keep rate per condition bin (each criterion judged on its own)", "",
         "| bin | pairs | kept | kept % | failed | faithfulness | residual | error |", "|---|---|---|---|---|---|---|---|",

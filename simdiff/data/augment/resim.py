@@ -1,7 +1,7 @@
 """Re-simulate, in an existing run, only the pairs whose physics changed (``--resimulate-gravity-below``).
 
 Every shard record carries ``sim_version`` (:data:`simdiff.sim.project.SIM_VERSION`; records
-without it are version 1). When the simulator changes for part of φ space (version 2, issue 13:
+without it are version 1). When the simulator changes for part of φ space (version 2:
 actuators and balance scale with max(1, |g_z|/9.81), so exactly the pairs with g_z < −9.81
 changed and every other pair is bit-identical), a finished run need not be redone:
 :func:`resimulate` re-projects, in every finished shard, the *original* pairs (not
@@ -26,10 +26,12 @@ from typing import Any
 import numpy as np
 
 from simdiff.data.augment.conditions import AugmentEnv
+from simdiff.data.augment.pairs import info_dict, load_source_joints, pair_record
 from simdiff.data.augment.projector import Projector
 from simdiff.data.augment.share import mirror_info, mirror_rollout
-from simdiff.data.cmu.writer import write_json
+from simdiff.data.writer import write_json
 from simdiff.errors import SimdiffError
+from simdiff.fsio import read_json
 from simdiff.sim.env import Environment
 from simdiff.sim.project import SIM_VERSION
 
@@ -53,17 +55,13 @@ def _condition(record: dict[str, Any]) -> AugmentEnv:
 
 def count_stale(paths: Sequence[Path], gravity_below: float) -> int:
     """Original pairs :func:`resimulate` would project in these shard files."""
-    from simdiff.data.augment.run import _read_json
-
-    return sum(is_stale(r, gravity_below) for p in paths if p.is_file() for r in _read_json(p)["records"])
+    return sum(is_stale(r, gravity_below) for p in paths if p.is_file() for r in read_json(p)["records"])
 
 
 def resimulate_shard(corpus: Path, out: Path, path: Path, projector: Projector, gravity_below: float,
                      tick: Callable[[int], None] = lambda n: None) -> int:
     """Re-project the stale pairs of one finished shard file (see the module docstring); returns how many."""
-    from simdiff.data.augment.run import _info_dict, _pair_record, _read_json, load_source_joints
-
-    shard = _read_json(path)
+    shard = read_json(path)
     records: list[dict[str, Any]] = shard["records"]
     joints: dict[str, np.ndarray] = {}
     for clip in dict.fromkeys(r["clip"] for r in records if is_stale(r, gravity_below)):
@@ -88,13 +86,13 @@ def resimulate_shard(corpus: Path, out: Path, path: Path, projector: Projector, 
             rollout, info = next(results)
         except StopIteration:
             raise SimdiffError(f"the projector returned fewer results than the {len(targets)} motions given") from None
-        simulated[r["id"]] = (rollout, _info_dict(info))
-        new[r["id"]] = _pair_record(corpus, out, r["clip"], _condition(r), rollout, _info_dict(info), r.get("content"))
+        simulated[r["id"]] = (rollout, info_dict(info))
+        new[r["id"]] = pair_record(corpus, out, r["clip"], _condition(r), rollout, info_dict(info), r.get("content"))
         tick(1)
     for r in derived:
         rollout, info = simulated[r["mirrored_from"]]
         cond = _condition(r)
-        record = _pair_record(corpus, out, r["clip"], cond, mirror_rollout(rollout), mirror_info(info, cond.env),
+        record = pair_record(corpus, out, r["clip"], cond, mirror_rollout(rollout), mirror_info(info, cond.env),
                               r.get("content"))
         new[r["id"]] = {**record, "mirrored_from": r["mirrored_from"]}
     write_json(path, {**shard, "records": [new.get(r["id"], r) for r in records]})  # (3)

@@ -10,7 +10,7 @@ Output (``out``), in the HumanML3D layout plus φ::
     train.txt, all.txt        kept ids (``<clip>_e<condition:02d>``)
                               (features/joints/texts exist for every tracked pair, kept or not)
     first_try.txt             the kept ids whose rollout tracked the source as given (no retime second try:
-                              a re-timed pair keeps its Earth apex by construction, reports/augment/retime.md)
+                              a re-timed pair keeps its Earth apex by construction)
     env.json                  {id: {env: [g_z, w_x, w_y], env_index, condition, factor, source
                               [, retime_scale: the source's slow-down, only when re-timed]}}
     conditions.json           the condition list
@@ -49,8 +49,6 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-import numpy as np
-
 from simdiff.fsio import read_json as _read_json, write_text
 from simdiff.data.augment.classes import load_motion_types
 from simdiff.data.augment.conditions import (DEFAULT_PAIRED_K, FACTORS, AugmentEnv, check_factors, check_gravity_range,
@@ -59,11 +57,11 @@ from simdiff.data.augment.decide import decide
 from simdiff.data.augment.filter import AUTO, FilterConfig
 from simdiff.data.augment.report import build_report, report_markdown
 from simdiff.data.augment.share import group_mirrors, mirror_condition, mirror_info, mirror_rollout, mirror_sources
+from simdiff.data.augment.pairs import clip_id_for, info_dict, load_source_joints, pair_record
 from simdiff.data.augment.projector import Projector, SimProjector
-from simdiff.data.cmu.writer import write_bytes, write_json, write_lines, write_npy
+from simdiff.data.writer import write_bytes, write_json, write_lines
 from simdiff.errors import SimdiffError
 from simdiff.sim.env import GRAVITY_RANGE, Environment
-from simdiff.sim.project import SIM_VERSION
 from simdiff.sim.retime import RetimeConfig
 
 BINARY_SIM_INDEX: int = 1
@@ -95,7 +93,7 @@ class AugmentConfig:
             conditions are then mirror(``<id>``'s), not independent draws.
         resimulate_gravity_below: after the shards are done, re-project the pairs with g_z
             below this (m/s²) that an older simulator version made, and their mirrors
-            (:mod:`simdiff.data.augment.resim`; −9.81: what issue 13 changed). Not a setting:
+            (:mod:`simdiff.data.augment.resim`; −9.81: the pairs the gravity-scaled actuators changed). Not a setting:
             a resumed run may add it. None: off.
         retime: under |g_z| < 9.81, retry a rollout that fell or strayed from the source's pose on
             the source slowed to the same Froude number and keep the better one
@@ -189,51 +187,9 @@ def conditions_for(clips: Sequence[str], conditions: Sequence[AugmentEnv], confi
     return out
 
 
-def clip_id_for(clip: str, condition: AugmentEnv) -> str:
-    """Id of the augmented copy of ``clip`` under ``condition``."""
-    return f"{clip}_e{condition.index:02d}"
-
-
 def env_index_for(mode: str, condition: AugmentEnv) -> int:
     """Categorical label of a simulated clip (see module docstring)."""
     return BINARY_SIM_INDEX if mode == "binary" else condition.index
-
-
-def load_source_joints(corpus: Path, clip: str) -> np.ndarray:
-    """The full (T, 22, 3) joint sequence of a source clip (T = feature rows + 1).
-
-    Uses ``new_joints`` (T-1 frames, as HumanML3D ships them) extended by the last feature
-    row's velocities; falls back to recovering the joints from the features.
-    """
-    from simdiff.motion.features import extend_last_frame, features_to_joints
-
-    feats_path = corpus / "new_joint_vecs" / f"{clip}.npy"
-    if not feats_path.is_file():
-        raise SimdiffError(f"{feats_path}: missing features of clip {clip}")
-    feats = np.load(feats_path, allow_pickle=False).astype(np.float32)
-    joints_path = corpus / "new_joints" / f"{clip}.npy"
-    joints = np.load(joints_path, allow_pickle=False) if joints_path.is_file() else features_to_joints(feats)
-    joints = np.asarray(joints, dtype=np.float32)
-    if joints.shape != (len(feats), 22, 3):
-        joints = np.asarray(features_to_joints(feats), dtype=np.float32)
-    return extend_last_frame(joints, feats)
-
-
-def rollout_to_layout(rollout: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(T, 22, 3) rollout joints → ((T-1, 263) features, (T-1, 22, 3) joints) as the corpus stores them."""
-    from simdiff.motion.features import features_to_joints, process_joints
-
-    features = process_joints(np.asarray(rollout, dtype=np.float64)).features.astype(np.float32)
-    if not np.all(np.isfinite(features)):
-        raise SimdiffError("non-finite features from a rollout")
-    return features, np.asarray(features_to_joints(features), dtype=np.float32)
-
-
-def _info_dict(info: Any) -> Any:
-    if info is None or isinstance(info, (str, dict)):
-        return info
-    to_dict = getattr(info, "to_dict", None)
-    return to_dict() if callable(to_dict) else dataclasses.asdict(info)
 
 
 def _shard_path(out: Path, index: int) -> Path:
@@ -289,42 +245,6 @@ def _check_settings(out: Path, config: AugmentConfig, conditions: list[AugmentEn
         write_json(path, settings)
 
 
-def _tracked(info: Any) -> bool:
-    return bool(getattr(info, "success", False) or (isinstance(info, dict) and info.get("success")))
-
-
-def _pair_record(corpus: Path, out: Path, clip: str, cond: AugmentEnv, rollout: np.ndarray | None, info: Any,
-                 content: dict[str, float] | None) -> dict[str, Any]:
-    """Write a tracked pair's files (features, joints, caption) and return its shard record.
-
-    The record's ``written`` says whether the files exist; ``reason`` is ``"error"`` when the
-    projection or the conversion failed (None otherwise; the keep decision is made at finalize).
-    """
-    from simdiff.data.augment.signal import measure
-
-    aid = clip_id_for(clip, cond)
-    written, reason = False, ("error" if info is None or isinstance(info, str) else None)
-    if reason is None and rollout is not None and _tracked(info):
-        try:
-            feats, joints = rollout_to_layout(rollout)
-        except SimdiffError as exc:
-            reason, info = "error", str(exc)
-        else:
-            write_npy(out / "new_joint_vecs" / f"{aid}.npy", feats)
-            write_npy(out / "new_joints" / f"{aid}.npy", joints)
-            write_bytes(out / "texts" / f"{aid}.txt", (corpus / "texts" / f"{clip}.txt").read_bytes())
-            written = True
-    signal = None
-    if written:
-        try:
-            signal = measure(rollout)
-        except SimdiffError:
-            signal = None
-    return {"clip": clip, "condition": cond.index, "id": aid, "written": written, "reason": reason, "info": info,
-            "env": list(cond.env.as_tuple()), "factor": cond.factor, "signal": signal, "content": content,
-            "sim_version": SIM_VERSION}
-
-
 def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: dict[str, list[AugmentEnv]],
                config: AugmentConfig, projector: Projector, tick: Callable[[int], None]) -> dict[str, Any]:
     """Project one shard and write its tracked pairs' files; returns its record (written by the caller)."""
@@ -361,13 +281,13 @@ def _run_shard(corpus: Path, out: Path, index: int, clips: list[str], assigned: 
             rollout, info = next(results)
         except StopIteration:
             raise SimdiffError(f"the projector returned fewer results than the {len(pairs)} motions given") from None
-        simulated[(clip, cond.index)] = (rollout, _info_dict(info))
-        records.append(_pair_record(corpus, out, clip, cond, rollout, _info_dict(info), content.get(clip)))
+        simulated[(clip, cond.index)] = (rollout, info_dict(info))
+        records.append(pair_record(corpus, out, clip, cond, rollout, info_dict(info), content.get(clip)))
         tick(1)
     for mx, x in derived.items():
         for cond in assigned[mx]:
             rollout, info = simulated[(x, cond.index)]
-            record = _pair_record(corpus, out, mx, cond, mirror_rollout(rollout), mirror_info(info, cond.env),
+            record = pair_record(corpus, out, mx, cond, mirror_rollout(rollout), mirror_info(info, cond.env),
                                   content.get(mx))
             records.append({**record, "mirrored_from": clip_id_for(x, cond)})
             tick(1)

@@ -15,16 +15,16 @@ import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from simdiff.data.clip_files import files_exist, load_record, remove_stale, write_splits, write_stats
-from simdiff.data.cmu.build import BUILD_DIR, BuildResult
-from simdiff.data.cmu.windows import MAX_WINDOW, MIN_WINDOW
-from simdiff.data.cmu.writer import write_json
+from simdiff.data.corpus.windows import MAX_WINDOW, MIN_WINDOW
+from simdiff.data.writer import write_json
 from simdiff.data.corpus.clips import ClipSettings, process_item, source_relative
-from simdiff.data.corpus.item import LICENCE_SETS, Item
+from simdiff.data.corpus.item import Item
+from simdiff.licences import LICENCE_SETS
 from simdiff.data.corpus.registry import SOURCES, discover_all
 from simdiff.data.corpus.splits import assign_stratified
 from simdiff.errors import SimdiffError
@@ -35,6 +35,9 @@ PIPELINE_VERSION: int = 2
 """Bump when an item's clips change for the same inputs (invalidates the item cache)."""
 
 FORMAT: str = "simdiff-corpus"
+
+BUILD_DIR: str = ".build"
+"""Per-item cache folder inside the output corpus."""
 
 
 @dataclass
@@ -64,8 +67,16 @@ class CorpusConfig:
     progress: bool = True
 
 
-CorpusResult = BuildResult
-"""Summary of a build (the same record as ``build-cmu``'s)."""
+@dataclass
+class CorpusResult:
+    """Summary of a build: clip records, skipped items and timings (seconds)."""
+
+    clips: list[dict[str, Any]]
+    skipped: list[dict[str, str]]
+    reused: int = 0
+    processed: int = 0
+    elapsed: float = 0.0
+    split_counts: dict[str, int] = field(default_factory=dict)
 
 
 def code_digest() -> str:

@@ -9,9 +9,8 @@ from typing import Any
 import numpy as np
 
 from simdiff.data.clip_files import Pending, clip_variants, ground_contact, support_of, write_clip
-from simdiff.data.cmu import captions as cmu_captions
-from simdiff.data.cmu.build import kit_for_window
-from simdiff.data.cmu.windows import MIN_WINDOW, Window, plan_windows
+from simdiff.data.corpus import cmu_captions
+from simdiff.data.corpus.windows import MIN_WINDOW, Window, plan_windows
 from simdiff.data.corpus.item import Item
 from simdiff.data.corpus.load import load_item, source_fps
 from simdiff.data.corpus.phrasing import sentences
@@ -62,7 +61,7 @@ def window_captions(item: Item, window: Window, clip_id: str, cfg: ClipSettings)
     n = max(cfg.captions, MIN_CAPTIONS)
     trial = item.meta.get("cmu_trial")
     if trial is not None:
-        human = kit_for_window(trial, window)  # type: ignore[arg-type]
+        human = cmu_captions.kit_for_window(trial, window)  # type: ignore[arg-type]
         generated = cmu_captions.describe(trial.description, n=n, seed=cfg.seed, key=clip_id)  # type: ignore[attr-defined]
         if len(human) >= MIN_CAPTIONS:
             return human, "kitml"

@@ -1,10 +1,9 @@
 """Agreement between the kept copy of a trial and its other copies (dedupe cross-check).
 
-As in ``build-cmu``'s AMC/BVH check, both copies are retargeted at 120 fps (so they can be
-synced to 1/120 s), run through the corpus joint stage (canonical skeleton, floor, facing
-+Z: :func:`simdiff.motion.features.process_joints`) and compared by
-:func:`simdiff.data.cmu.crosscheck.compare_joints` (best lag within ±0.2 s, then yaw + 3D
-translation). Results are cached in ``CORPUS/.build/crosscheck_all.json`` by the
+Both copies are retargeted at 120 fps (so they can be synced to 1/120 s), run through the
+corpus joint stage (canonical skeleton, floor, facing +Z: :func:`simdiff.motion.features.process_joints`)
+and compared by :func:`simdiff.data.corpus.joint_agreement.compare_joints` (best lag within ±0.2 s,
+then yaw + 3D translation). Results are cached in ``CORPUS/.build/crosscheck_all.json`` by the
 bytes of both files.
 """
 
@@ -16,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from simdiff.data.cmu.crosscheck import CHECK_FPS
-from simdiff.data.cmu.writer import write_json
+from simdiff.data.corpus.joint_agreement import CHECK_FPS
+from simdiff.data.writer import write_json
 from simdiff.data.corpus.item import Item
 from simdiff.errors import SimdiffError
 from simdiff.fsio import file_digest
@@ -30,7 +29,7 @@ TARGET_M: float = 0.03
 
 def _joints_120(item: Item) -> np.ndarray:
     """(T, 22, 3) canonical joints of ``item`` at :data:`CHECK_FPS`."""
-    from simdiff.data.cmu.load import read_source_rig
+    from simdiff.data.corpus.cmu_load import read_source_rig
     from simdiff.motion.features import process_joints
     from simdiff.motion.io import load_rig, retarget_rig
 
@@ -46,7 +45,7 @@ def crosscheck_items(items: list[Item], cache_path: Path, progress: bool = True)
     """One row per (kept item, alternate copy): trial, sources, frames, lag, MPJPE and pose-only (m)."""
     from tqdm import tqdm
 
-    from simdiff.data.cmu.crosscheck import compare_joints
+    from simdiff.data.corpus.joint_agreement import compare_joints
 
     try:
         cache = json.loads(cache_path.read_text())

@@ -1,5 +1,5 @@
 """What a motion source hands the corpus builder: one :class:`Item` per take, plus the
-licence table and the motion types shared by every source."""
+motion types shared by every source (licence codes: :mod:`simdiff.licences`)."""
 
 from __future__ import annotations
 
@@ -7,20 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from simdiff.errors import SimdiffError
-
-LICENCES: dict[str, str] = {
-    "CMU": "CMU Graphics Lab mocap terms: free for all uses, data may not be resold",
-    "MIT": "MIT (repository licence of the files)",
-    "CC-BY-SA-3.0": "Creative Commons Attribution-ShareAlike 3.0 (derived data shared alike)",
-    "CC-BY-NC-4.0": "Creative Commons Attribution-NonCommercial 4.0 (non-commercial use only)",
-}
-"""Licence code -> meaning, as recorded per clip in the manifest."""
-
-LICENCE_SETS: dict[str, frozenset[str]] = {
-    "all": frozenset(LICENCES),
-    "permissive": frozenset({"CMU", "MIT"}),
-}
-"""``--licence`` choices: ``all`` (research use) and ``permissive`` (no NC, no share-alike)."""
+from simdiff.licences import LICENCES
 
 MOTION_TYPES: tuple[str, ...] = (
     "dance", "acrobatics", "sports", "exercise", "ground", "climb", "jump", "run", "walk", "gesture", "other",

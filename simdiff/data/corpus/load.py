@@ -49,14 +49,13 @@ def _check(item: Item, joints: np.ndarray) -> np.ndarray:
 def load_item(item: Item) -> tuple[np.ndarray, int]:
     """(T, 22, 3) float32 joints of ``item`` at 20 fps and the leading source frames dropped.
 
-    CMU copies in ``shared/cmu`` go through :func:`simdiff.data.cmu.load.load_source` (same
-    output as ``build-cmu``); the rest through :func:`simdiff.motion.io.load_joints` (which
-    knows the Bandai, Motionbuilder, Daz, HDM05 and DeepMimic rigs and their clean-ups).
+    CMU copies in ``shared/cmu`` go through :func:`simdiff.data.corpus.cmu_load.load_source`; the rest through
+    :func:`simdiff.motion.io.load_joints` (which knows the Bandai, Motionbuilder, Daz, HDM05 and DeepMimic rigs and their clean-ups).
 
     Raises:
         SimdiffError: (often MotionFormatError) naming the file.
     """
-    from simdiff.data.cmu.load import load_source
+    from simdiff.data.corpus.cmu_load import load_source
     from simdiff.motion.io import load_joints
 
     if item.source in _CMU_RIG and "cmu_trial" in item.meta:

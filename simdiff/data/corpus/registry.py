@@ -6,7 +6,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from simdiff.data.corpus import src_bandai, src_cmu, src_deepmimic, src_hdm05
-from simdiff.data.corpus.item import LICENCE_SETS, Item
+from simdiff.data.corpus.item import Item
+from simdiff.licences import LICENCE_SETS
 from simdiff.errors import SimdiffError
 
 SOURCES: dict[str, Callable[[Path, Path], list[Item]]] = {

@@ -16,11 +16,13 @@ from typing import Any
 import numpy as np
 
 from simdiff.data.corpus.crosscheck import TARGET_M, crosscheck_items
-from simdiff.data.corpus.item import LICENCES
-from simdiff.data.report_blocks import (
-    clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table, write_report_files,
+from simdiff.data.corpus.report_blocks import (
+    FilmstripRenderer, clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table,
+    write_report_files,
 )
+from simdiff.licences import LICENCES
 from simdiff.motion.flight import GROUND_PERCENTILE, LIFT, LIFT_EDGE, MIN_FLIGHT_S, MIN_FRAMES, flight_stats, has_flight
+
 SPLITS: tuple[str, ...] = ("train", "val", "test")
 METRICS: tuple[str, ...] = ("penetration", "floating", "sliding", "skate_ratio")
 
@@ -134,10 +136,10 @@ def _crosscheck_section(manifest: dict[str, Any], corpus: Path, progress: bool) 
     return md
 
 
-def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, seed: int = 0,
-                        crosscheck: bool = True, progress: bool = True) -> Path:
-    """Write ``report.md``, ``summary.png``, filmstrips and ``clip_metrics.csv`` into ``out``
-    (default ``corpus/report``); returns the path of ``report.md``."""
+def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, render_filmstrip: FilmstripRenderer,
+                        seed: int = 0, crosscheck: bool = True, progress: bool = True) -> Path:
+    """Write ``report.md``, ``summary.png``, filmstrips (drawn by ``render_filmstrip``) and ``clip_metrics.csv``
+    into ``out`` (default ``corpus/report``); returns the path of ``report.md``."""
     corpus, manifest, out, clips = open_report(corpus, out)
     originals = [c for c in clips if c["mirror_of"] is None]
     metrics = clip_metrics(corpus, originals)
@@ -191,7 +193,7 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, se
                f"({', '.join(f'{k} {v}' for k, v in sorted(Counter(c['source'] for c in padded).items()))})."]
     summary_figure(out / "summary.png", clips, metrics)
     md += ["", "## Filmstrips", "", "Each row: 8 evenly spaced frames of one clip as stored in `new_joints`.", ""]
-    for title, image in filmstrips(corpus, out, clips, seed):
+    for title, image in filmstrips(corpus, out, clips, seed, render_filmstrip):
         md += [f"### {title}", "", f"![{title}]({image.name})", ""]
     skipped = manifest.get("skipped", [])
     if skipped:

@@ -13,9 +13,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from simdiff.data.cmu import captions as cmu_captions
-from simdiff.data.cmu.sources import Trial, discover as discover_cmu, normalise_trial
-from simdiff.data.cmu.sources import _read_descriptions, _read_rates
+from simdiff.data.corpus import cmu_captions
+from simdiff.data.corpus.cmu_sources import Trial, discover as discover_cmu, normalise_trial
+from simdiff.data.corpus.cmu_sources import read_descriptions, read_rates
 from simdiff.data.corpus.archive import source_dir
 from simdiff.data.corpus.item import Item
 
@@ -89,8 +89,8 @@ def discover(shared: Path, cache: Path) -> list[Item]:
     extra = source_dir(shared, cache, "cmu-bvh")
     if extra is None:
         return items
-    rates, csv_desc = _read_rates(src) if src.is_dir() else ({}, {})
-    descriptions = {**csv_desc, **(_read_descriptions(src) if src.is_dir() else {})}
+    rates, csv_desc = read_rates(src) if src.is_dir() else ({}, {})
+    descriptions = {**csv_desc, **(read_descriptions(src) if src.is_dir() else {})}
     for folder, source in (("motionbuilder", "cmu-mb"), ("daz", "cmu-daz")):
         for path in sorted((extra / folder).glob("*.bvh")):
             name = normalise_trial(path.stem)

@@ -33,22 +33,22 @@ def measure(runner: Runner, spec: ModelSpec, sampler: str) -> dict[str, Any]:
     gen = runner.model(spec)
     kwargs: dict[str, Any] = {}
     if gen.is_simdiff:
-        kwargs = {"alpha": spec.alpha, "env_index": spec.env_index}
+        kwargs = {"env_index": spec.env_index}
         if gen.config.sim.mode == "continuous":
             kwargs["env"] = spec.env or list(EARTH)
     for w in range(t.warmup):
-        gen.generate([t.text], t.length, sampler="ddim", steps=spec.steps, guidance=spec.guidance, seed=w, **kwargs)
+        gen.generate([t.text], t.length, runner.sampling(spec, "ddim"), seed=w, **kwargs)
     repeats = t.ddpm_repeats if sampler == "ddpm" else t.repeats
     times, proj = [], []
     for r in range(repeats):
         start = time.perf_counter()
         if spec.physdiff is not None:
             _, hook = physdiff_generate(gen, [t.text], [t.length], runner.physdiff_config(spec, sampler),
-                                        projector=runner.serial_projector(), seed=r, **kwargs)
+                                        projector=runner.serial_projector(), seed=r,
+                                        sampling=runner.sampling(spec, sampler), **kwargs)
             proj.append(sum(e["wall_s"] for e in hook.log))
         else:
-            out = gen.generate([t.text], t.length, sampler=sampler, steps=spec.sampler_steps(sampler),
-                               guidance=spec.guidance, seed=r, **kwargs)
+            out = gen.generate([t.text], t.length, runner.sampling(spec, sampler), seed=r, **kwargs)
             if spec.simulate:  # the simulated finish of `simdiff generate --simulate`: one in-process re-tracking
                 from simdiff.motion.features import features_to_joints
                 from simdiff.sim.env import Environment

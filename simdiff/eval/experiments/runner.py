@@ -25,6 +25,7 @@ from typing import Any, Callable
 import numpy as np
 import torch
 
+from simdiff.diffusion.config import SAMPLER_STEPS, SamplingConfig
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ExperimentConfig, ModelSpec
 from simdiff.eval.experiments.provenance import provenance
@@ -110,7 +111,7 @@ class Runner:
         strip = self.backbone_of_simdiff(spec)
         key = str(path) + ("#backbone" if strip else "")
         if key not in self._models:
-            from simdiff.model import MotionGenerator
+            from simdiff.inference.generator import MotionGenerator
 
             if not (path / "model.safetensors").is_file():
                 hint = f" (set it with --{spec.model.replace('_', '-')} DIR)" if spec.model and not spec.path else ""
@@ -288,12 +289,18 @@ class Runner:
         use_env = None
         if gen.is_simdiff and gen.config.sim.mode == "continuous":
             use_env = list(env) if env is not None else spec.env
-        return generator_fn(gen, env=use_env, env_index=spec.env_index if gen.is_simdiff else None,
-                            alpha=spec.alpha if alpha is None else float(alpha), sampler=sampler,
-                            steps=spec.sampler_steps(sampler), guidance=spec.guidance, physdiff=phys,
+        return generator_fn(gen, self.sampling(spec, sampler, alpha), env=use_env,
+                            env_index=spec.env_index if gen.is_simdiff else None, physdiff=phys,
                             projector=self.sim if phys is not None else None, simulate=spec.simulate,
-                            finish_projector=self.finish_sim if spec.simulate else None,
-                            env_guidance=spec.env_guidance)
+                            finish_projector=self.finish_sim if spec.simulate else None)
+
+    @staticmethod
+    def sampling(spec: ModelSpec, sampler: str, alpha: float | None = None) -> SamplingConfig:
+        """The :class:`SamplingConfig` of one method row: its sampler and steps, guidance, α (``alpha`` when given)
+        and environment guidance."""
+        return SamplingConfig(sampler=sampler, steps=spec.sampler_steps(sampler) or SAMPLER_STEPS[sampler],
+                              guidance=spec.guidance, alpha=spec.alpha if alpha is None else float(alpha),
+                              env_guidance=spec.env_guidance)
 
     def generate(self, fn: GenerateFn, captions: list[str], lengths: list[int], seed: int) -> tuple[torch.Tensor, float]:
         """Generate in batches of the protocol's size; returns ((N, T, 263) features, seconds)."""

@@ -45,7 +45,8 @@ def write_tiny_setup(root: str | Path, n_test: int = 16, frames: int = 44, seed:
     layers are random too (not zero as in training), so α and φ visibly change the motion."""
     from simdiff.eval.evaluator import EvaluatorConfig, TextMotionEvaluator, save_evaluator
     from simdiff.eval.testing import write_tiny_corpus
-    from simdiff.model import ModelConfig, MotionGenerator, SimConfig, backbone_preset, build_network
+    from simdiff.model import ModelConfig, SimConfig, backbone_preset, build_network
+    from simdiff.inference.generator import MotionGenerator
 
     root = Path(root)
     corpus = write_tiny_corpus(root / "corpus", n_train=4, n_test=n_test, frames=frames, seed=seed)

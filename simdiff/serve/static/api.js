@@ -22,7 +22,7 @@ export const api = {
   /** Model status, listed files, slider limits, defaults, skeleton. */
   info: () => request("/api/info"),
 
-  /** Generate one motion: {text, gravity, wind_x, wind_y, alpha, env_guidance, seconds, seed, simulate, foot_lock} → {joints, fps, parents, meta}. */
+  /** Generate one motion: {text, gravity, wind_x, wind_y, seconds, seed, simulate, alpha, env_guidance, guidance, foot_lock} → {joints, fps, parents, meta}. */
   generate: (params) => request("/api/generate", {
     method: "POST",
     headers: { "Content-Type": "application/json" },

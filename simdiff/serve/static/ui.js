@@ -4,7 +4,9 @@ import { api } from "./api.js";
 import { SkeletonPlayer } from "./player.js";
 
 const $ = (id) => document.getElementById(id);
-const SLIDERS = ["gravity", "wind_x", "wind_y", "alpha", "env_guidance"];
+const SLIDERS = ["gravity", "wind_x", "wind_y", "alpha", "env_guidance", "guidance"];
+/** Sliders that act only with a physics (SimDiff) model. */
+const ENV_SLIDERS = ["gravity", "wind_x", "wind_y", "alpha", "env_guidance"];
 
 const state = {
   status: "starting",  // starting | loading | generating | opening | ready | idle | error
@@ -62,7 +64,7 @@ function show(motion) {
     const p = meta.params;
     state.params = p;
     state.generation_id += 1;
-    caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${p.alpha.toFixed(2)}` + (p.env_guidance !== 1 ? ` · environment guidance ${p.env_guidance.toFixed(1)}` : "") : "");
+    caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${meta.sampling.alpha}` + (meta.sampling.env_guidance !== 1 ? ` · environment guidance ${meta.sampling.env_guidance}` : "") : "");
     if (meta.simulated) caption += ` · simulated finish (${meta.simulated.status}, joint error ${Math.round(meta.simulated.err_mm)} mm)`;
     const waited = meta.queue_position ? ` after waiting ${meta.waited_s.toFixed(1)} s behind ${meta.queue_position} request(s)` : "";
     setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s${waited}.`);
@@ -78,16 +80,18 @@ function show(motion) {
 
 let busy = false;
 let pending = null;
+/** Foot-lock strength when the box is ticked: the model's own (1 if it has none). */
+let footLock = 1;
 
 function readParams() {
   const value = (id) => Number($(id).value);
   return {
     text: $("prompt").value.trim() || $("prompt").placeholder,
     gravity: value("gravity"), wind_x: value("wind_x"), wind_y: value("wind_y"), alpha: value("alpha"),
-    env_guidance: value("env_guidance"),
+    env_guidance: value("env_guidance"), guidance: value("guidance"),
     seconds: value("seconds"), seed: Math.round(value("seed")),
     simulate: Boolean($("simulate") && $("simulate").checked),
-    foot_lock: $("foot_lock") && $("foot_lock").checked ? 1 : 0,
+    foot_lock: $("foot_lock") && $("foot_lock").checked ? footLock : 0,
   };
 }
 
@@ -127,23 +131,24 @@ function configure(info) {
   const { limits, defaults } = info;
   const ranges = {
     gravity: limits.gravity, wind_x: [-limits.wind, limits.wind], wind_y: [-limits.wind, limits.wind], alpha: limits.alpha,
-    env_guidance: limits.env_guidance,
+    env_guidance: limits.env_guidance, guidance: limits.guidance,
   };
   for (const id of SLIDERS) {
     const input = $(id);
     [input.min, input.max] = ranges[id].map(String);
-    input.value = String(defaults[id]);
-    const label = () => { $(`${id}-value`).textContent = Number(input.value).toFixed(id === "gravity" || id === "alpha" ? 2 : 1); };
+    input.value = String(defaults[id]);  // step "any": the model's exact value, not snapped to a grid
+    const label = () => { $(`${id}-value`).textContent = String(Number(Number(input.value).toFixed(3))); };
     label();
     input.addEventListener("input", label);
     input.addEventListener("change", generate);
-    input.disabled = !info.model.env;
+    input.disabled = ENV_SLIDERS.includes(id) && !info.model.env;
   }
   $("env-note").hidden = info.model.env || !info.model.found;
   $("prompt").value = defaults.text;
   Object.assign($("seconds"), { min: String(1 / limits.fps), max: String(limits.seconds), value: String(defaults.seconds) });
   $("seed").value = String(defaults.seed);
   $("foot_lock").checked = Number(defaults.foot_lock) > 0;
+  footLock = Number(defaults.foot_lock) > 0 ? Number(defaults.foot_lock) : 1;
   $("version").textContent = `v${info.version}`;
   const m = info.model;
   $("model-info").textContent = m.error ? m.error : `Model: ${m.path} (${m.kind})`;

@@ -74,10 +74,10 @@ class RetargetConfig:
 FINISH_SWING_CLEARANCE: float = 0.02
 """``RetargetConfig.swing_clearance`` (m) of the simulated finish. Measured on 48 generated samples
 (the 4 bench prompts × g −9.81/−3.7 × seeds 0–5, shipped default model, probe not shipped; tracker
-lead 1.5, before :data:`simdiff.sim.tracker.FINISH_LEAD`): rollouts
+lead 1.5, not :data:`simdiff.sim.tracker.FINISH_LEAD`): rollouts
 tracked to the end 33 → 41 (walks 3 → 10 of 12, runs 6 → 7, jumps 24 both); on the 24 walks and
 runs 0.01 m tracked 15, 0.02 m 17, 0.03 m 16 (none: 9). Sliding is not reduced: ≤ 0.5 mm/frame
-33 → 30 of 48, the walks now tracked to the end slide 1.5 mm/frame on average (1.3 for the 3 tracked without it)."""
+33 → 30 of 48, the walks tracked to the end with it slide 1.5 mm/frame on average (1.3 for the 3 tracked without it)."""
 
 
 def finish_retarget(anchor_stance: bool = True) -> RetargetConfig:

@@ -149,7 +149,7 @@ def _quick() -> PipelineConfig:
 
 def _cpu() -> PipelineConfig:
     # The backbone is the design small_geo_crop, ahead of the 10 fps design at 40 training CPU-minutes each on
-    # corpus3 (benchmarks/train_curves.py; reports/training/README.md, "All-source corpus").
+    # the all-source corpus.
     geo = GeometricLossConfig(position=0.0, velocity=1.0, foot_contact=1.0)
     return PipelineConfig(
         budget="cpu",
@@ -163,8 +163,7 @@ def _cpu() -> PipelineConfig:
 
 
 def _gpu() -> PipelineConfig:
-    # One H200, <= 25 min wall (scripts/gpu_budget.sh lowers the caps to today's 10-min device command with MINUTES):
-    # step counts are first guesses (not measured yet); max_minutes caps the
+    # One H200, <= 25 min wall: step counts are first guesses (not measured); max_minutes caps the
     # training stages so the budget holds whatever the real step rate turns out to be.
     geo = GeometricLossConfig(position=0.0, velocity=1.0, foot_contact=1.0)
     return PipelineConfig(

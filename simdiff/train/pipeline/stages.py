@@ -175,8 +175,9 @@ def evaluation_settings(ctx: PipelineContext) -> dict[str, Any]:
 def run_evaluation(ctx: PipelineContext) -> dict[str, Any]:
     from simdiff.data.humanml3d import HumanML3D
     from simdiff.eval.evaluator import OurEvaluator
+    from simdiff.diffusion.config import SAMPLER_STEPS, SamplingConfig
     from simdiff.eval.protocol import ProtocolConfig, evaluate_t2m, generator_fn
-    from simdiff.model.generator import MotionGenerator
+    from simdiff.inference.generator import MotionGenerator
 
     ev, seed = ctx.config.evaluation, ctx.config.seed
     evaluator = OurEvaluator.load(ctx.out / "evaluator", ctx.device, text_encoder=ctx.text())
@@ -186,8 +187,9 @@ def run_evaluation(ctx: PipelineContext) -> dict[str, Any]:
     config = ProtocolConfig(replications=ev.replications, batch_size=ev.batch_size, samples_limit=ev.samples_limit,
                             seed=seed)
     categorical = ctx.config.adapters.sim_mode == "categorical"  # category 0: the source (Earth) clips
-    generate = generator_fn(generator, env=None if categorical else list(ev.env), env_index=0 if categorical else None,
-                            sampler=ev.sampler, steps=ev.steps, guidance=ev.guidance)
+    sampling = SamplingConfig(sampler=ev.sampler, steps=ev.steps or SAMPLER_STEPS[ev.sampler], guidance=ev.guidance)
+    generate = generator_fn(generator, sampling, env=None if categorical else list(ev.env),
+                            env_index=0 if categorical else None)
     result = evaluate_t2m(evaluator, dataset, generate, config, progress=ctx.progress)
     write_json(ctx.out / "evaluation" / "evaluation.json", result)
     gen = result["summary"].get("generated", {})
