@@ -26,8 +26,8 @@ SHORT = {"--length": "0.5", "--steps": "2"}
 
 
 def commands(doc: str) -> list[str]:
-    """The literal ``simdiff ...`` commands of ``doc``: lines of its bash blocks, the last part of a ``&&`` chain,
-    and inline code spans that are whole commands."""
+    """The literal ``simdiff ...`` commands of ``doc``: lines of its bash blocks (the last part of a ``&&`` chain)
+    and inline ``simdiff generate TEXT ...`` spans without placeholders."""
     text = (ROOT / doc).read_text(encoding="utf-8")
     found: list[str] = []
     for block in re.findall(r"```bash\n(.*?)```", text, flags=re.S):
@@ -35,7 +35,7 @@ def commands(doc: str) -> list[str]:
             part = line.split("&&")[-1].strip()
             if part.startswith("simdiff "):
                 found.append(part)
-    for span in re.findall(r"`(simdiff [^`]+)`", text):
+    for span in re.findall(r"`(simdiff generate [^`]+)`", text):  # a whole command shown inline, e.g. a figure's
         if not re.search(r"[A-Z]{2,}|\[|\||\.\.\.|…", span) and span not in found:
             found.append(span)
     return found
@@ -87,6 +87,22 @@ def test_every_documented_command_runs(doc: str, tmp_path: Path, monkeypatch) ->
             serve_once(argv, tmp_path)
             continue
         assert main(argv) == 0, f"{doc}: `{command}` failed"
+
+
+def test_tutorial_python_gives_the_joints_generate_writes(tmp_path: Path, monkeypatch) -> None:
+    """The tutorial's Python example runs and, with the same prompt, φ and seed, gives ``simdiff generate``'s joints."""
+    import numpy as np
+
+    code = re.findall(r"```python\n(.*?)```", (ROOT / "docs/tutorial.md").read_text(encoding="utf-8"), flags=re.S)[-1]
+    code = code.replace("120, config", "20, config.updated(steps=2)")
+    scope: dict = {}
+    exec(compile(code, "tutorial.md", "exec"), scope)  # noqa: S102 - the documented example itself
+    monkeypatch.chdir(tmp_path)
+    assert main(["generate", "a person jumps forward", "--gravity", "-3.7", "--wind", "2", "0", "--length", "1",
+                 "--steps", "2", "--format", "npy", "--out", "o", "-q"]) == 0
+    written = np.load(tmp_path / "o" / "sample0_joints.npy")
+    assert scope["joints"].shape == written.shape == (20, 22, 3)
+    assert float(np.abs(scope["joints"] - written).max()) < 1e-5
 
 
 def test_commands_are_found() -> None:

@@ -63,12 +63,12 @@ class Environment:
         lo, hi = GRAVITY_RANGE
         if not lo <= self.gravity <= hi:
             raise SimdiffError(
-                f"gravity {self.gravity} m/s² is outside the validated range [{lo}, {hi}] (use force=True / --force)"
+                f"gravity {self.gravity} m/s² is outside the validated range [{lo}, {hi}] (use --force)"
             )
         w = float(np.hypot(self.wind_x, self.wind_y))
         if w > MAX_WIND + 1e-9:
             raise SimdiffError(
-                f"wind |({self.wind_x}, {self.wind_y})| = {w:.3g} N exceeds the validated {MAX_WIND} N (use force=True / --force)"
+                f"wind |({self.wind_x}, {self.wind_y})| = {w:.3g} N exceeds the validated {MAX_WIND} N (use --force)"
             )
         return self
 

@@ -38,11 +38,12 @@ class ModelSpec:
         path: explicit model folder (model.safetensors + config.json); overrides ``model``.
         env: φ = (g_z m/s², w_x N, w_y N) for continuous SimDiff models (None: Earth).
         env_index: category for categorical SimDiff models (binary setting: 1 = simulated).
-        alpha: adapter strength where the experiment does not sweep it.
-        steps: DDIM steps (None: 50); ddpm_steps: DDPM steps (None: all 1000).
-        guidance: classifier-free guidance scale.
-        env_guidance: environment guidance s_e of continuous SimDiff models (1: off;
-            :mod:`simdiff.diffusion.guidance`).
+        alpha: adapter strength where the experiment does not sweep it (None: the model's ``sampling.json``).
+        steps: DDIM steps; ddpm_steps: DDPM steps (None: the model's, else 50 and 1000).
+        guidance: classifier-free guidance scale (None: the model's ``sampling.json``).
+        env_guidance: environment guidance s_e of continuous SimDiff models (None: the model's ``sampling.json``;
+            :mod:`simdiff.diffusion.guidance`). Every other sampling setting (η, ``edit_t``, foot cleanup) is the
+            model's, so a row samples as ``simdiff generate`` does with that model.
         physdiff: :class:`simdiff.baselines.physdiff.PhysDiffConfig` fields → PhysDiff sampling
             (the row's sampler, steps and φ are filled in by the experiment).
         simulate: simulated finish: each final sample is re-tracked under its φ (Earth for
@@ -61,11 +62,11 @@ class ModelSpec:
     path: str = ""
     env: list[float] | None = None
     env_index: int | None = None
-    alpha: float = 1.0
+    alpha: float | None = None
     steps: int | None = None
     ddpm_steps: int | None = None
-    guidance: float = 2.5
-    env_guidance: float = 1.0
+    guidance: float | None = None
+    env_guidance: float | None = None
     physdiff: dict[str, Any] | None = None
     simulate: bool = False
     alphas: list[float | str] | None = None
@@ -150,7 +151,7 @@ class EnvControlOptions:
         prompts: captions (jumps); seeds: noise seeds per prompt; length: frames per motion.
         gravity: g_z sweep (m/s², no wind); wind: w_x and w_y sweeps (N, Earth gravity).
         combos: unseen combinations φ, each compared with its single-factor parts.
-        alpha: adapter strength of the SimDiff rows.
+        alpha: adapter strength of the SimDiff rows (None: each model's ``sampling.json``).
         filmstrip_frames: frames per filmstrip row (0: no filmstrips).
         resamples: bootstrap resamples of the env_response intervals.
     """
@@ -162,7 +163,7 @@ class EnvControlOptions:
     gravity: list[float] = field(default_factory=lambda: [-1.0, -3.0, -6.0, -9.81, -15.0, -20.0])
     wind: list[float] = field(default_factory=lambda: [-10.0, -5.0, 0.0, 5.0, 10.0])
     combos: list[list[float]] = field(default_factory=lambda: [[-3.0, 7.0, 7.0]])
-    alpha: float = 1.0
+    alpha: float | None = None
     filmstrip_frames: int = 8
     resamples: int = 1000
 
@@ -347,7 +348,7 @@ def check(config: ExperimentConfig, origin: str | os.PathLike[str] = "config") -
             raise SimdiffError(f"{origin}: model {spec.name!r} needs 'model' (a role) or 'path'")
         if spec.model and not spec.path and spec.model not in config.paths:
             raise SimdiffError(f"{origin}: model {spec.name!r} names role {spec.model!r}, which 'paths' does not define")
-        if not 0.0 <= float(spec.env_guidance) < float("inf"):
+        if spec.env_guidance is not None and not 0.0 <= float(spec.env_guidance) < float("inf"):
             raise SimdiffError(f"{origin}: model {spec.name!r} env_guidance must be a finite number ≥ 0, "
                                f"got {spec.env_guidance!r}")
         if spec.samplers is not None:

@@ -55,7 +55,7 @@ def measure(runner: Runner, spec: ModelSpec) -> dict[str, Any]:
     envs = grid(runner)
     captions = [p for p in o.prompts for _ in range(o.seeds)]
     units = [(p, s) for p in o.prompts for s in range(o.seeds)]
-    alpha = spec.alpha if runner.is_simdiff(spec) else None
+    alpha = runner.alpha(spec) if runner.is_simdiff(spec) else None
     generated: dict[tuple[float, ...], np.ndarray] = {}
     seconds = 0.0
     for env in envs if env_aware(runner, spec) else [list(EARTH)]:
@@ -106,7 +106,7 @@ def plan(runner: Runner) -> list[RowPlan]:
         mode = runner.sim_mode(spec)
         if mode == "categorical" and spec.env_index is None:
             raise SimdiffError(f"env_response: {spec.name!r} has categorical adapters; give its 'env_index'")
-        alpha = spec.alpha if mode else None
+        alpha = runner.alpha(spec) if mode else None
         inputs = {"row": "env_response", **runner.method_inputs(spec, "ddim", alpha), "seed": c.seed, "envs": envs,
                   "prompts": o.prompts, "seeds": o.seeds, "length": o.length, "resamples": o.resamples,
                   "projector": {"residual_bound": c.projector.residual_bound}}

@@ -73,7 +73,7 @@ def plan(runner: Runner) -> list[RowPlan]:
             repeats = t.ddpm_repeats if sampler == "ddpm" else t.repeats
             est = runner.motion_seconds(spec, sampler, repeats, t.length / FPS, workers=1)
             est += runner.motion_seconds(spec, "ddim", t.warmup, t.length / FPS, workers=1)
-            inputs = {"row": "timing", **runner.method_inputs(spec, sampler, spec.alpha), "timing": asdict(t),
+            inputs = {"row": "timing", **runner.method_inputs(spec, sampler, runner.alpha(spec) if runner.is_simdiff(spec) else None), "timing": asdict(t),
                       "machine": machine}
             plans.append(RowPlan(method_key(spec, sampler, None), {"method": spec.name, "sampler": sampler}, inputs, est,
                                  lambda r, spec=spec, sampler=sampler: measure(r, spec, sampler)))

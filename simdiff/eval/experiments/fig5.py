@@ -65,7 +65,8 @@ def measure(runner: Runner, spec: ModelSpec, env: list[float] | None, key: str) 
 
     o = runner.config.env_control
     captions = [p for p in o.prompts for _ in range(o.seeds)]
-    fn = runner.generate_fn(spec, "ddim", o.alpha if runner.is_simdiff(spec) else None, env)
+    fn = runner.generate_fn(spec, "ddim", (o.alpha if o.alpha is not None else runner.alpha(spec))
+                           if runner.is_simdiff(spec) else None, env)
     feats, seconds = runner.generate(fn, captions, [o.length] * len(captions), runner.config.seed)
     joints = np.asarray(features_to_joints(feats.double()), dtype=np.float32)
     samples = [{"prompt": c, "seed": i % o.seeds, **motion_stats(j)} for i, (c, j) in enumerate(zip(captions, joints))]
@@ -91,7 +92,7 @@ def plan(runner: Runner) -> list[RowPlan]:
         if mode == "categorical":
             raise SimdiffError(f"fig5 needs continuous adapters (φ); {spec.name!r} is categorical")
         envs = conditions(runner) if mode == "continuous" else [("reference", None)]
-        alpha = o.alpha if mode else None
+        alpha = (o.alpha if o.alpha is not None else runner.alpha(spec)) if mode else None
         for factor, env in envs:
             key = safe(f"{spec.name}_{env_key(env)}" if env is not None else spec.name)
             inputs = {"row": "env_control", **runner.method_inputs(spec, "ddim", alpha, env), "seed": c.seed,
@@ -216,8 +217,9 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     combo_fig = combination_figure(rows, runner.out / "fig5_combination.png") if combos else None
     strips = filmstrips(runner, rows)
     cell = lambda r, k: f"{r['summary'][k]['mean']:+.3f} ± {r['summary'][k]['ci95']:.3f}"  # noqa: E731
+    alpha_text = "the model's" if o.alpha is None else f"{o.alpha:g}"
     lines = [f"Prompts: {', '.join('“' + p + '”' for p in o.prompts)}; {o.seeds} seeds each (same noise for every φ); "
-             f"{o.length} frames; DDIM; SimDiff α = {o.alpha:g}. Apex: peak root height above the median root height of "
+             f"{o.length} frames; DDIM; SimDiff α = {alpha_text}. Apex: peak root height above the median root height of "
              f"the first {STANDING_FRAMES} frames; drift: root displacement first → last frame (m).", "",
              "| Method | factor | φ (g, w_x, w_y) | apex (m) | drift x (m) | drift z (m) | airborne |", "|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -42,7 +42,7 @@ def measure(runner: Runner, spec: ModelSpec | None, env: list[float]) -> dict[st
         feats = [np.asarray(f, dtype=np.float64) for f in items["features"]]
         seconds = 0.0
     else:
-        alpha = spec.alpha if runner.is_simdiff(spec) else None
+        alpha = runner.alpha(spec) if runner.is_simdiff(spec) else None
         out, seconds = runner.generate(runner.generate_fn(spec, "ddim", alpha, env), items["captions"], items["lengths"],
                                        runner.config.seed * 7 + 1)
         out = out.to(torch.float64).cpu().numpy()
@@ -82,7 +82,7 @@ def plan(runner: Runner) -> list[RowPlan]:
                                  {"row": "retrack_gt", "env": env, **data}, track_s,
                                  lambda r, env=env: measure(r, None, env)))
         for spec in c.models:
-            alpha = spec.alpha if runner.is_simdiff(spec) else None
+            alpha = runner.alpha(spec) if runner.is_simdiff(spec) else None
             inputs = {"row": "retrack", **data, **runner.method_inputs(spec, "ddim", alpha, env)}
             plans.append(RowPlan(safe(f"{spec.name}_{env_key(env)}"), {"method": spec.name, "env": env, "alpha": alpha},
                                  inputs, runner.motion_seconds(spec, "ddim", n) + track_s,

@@ -25,7 +25,7 @@ from typing import Any, Callable
 import numpy as np
 import torch
 
-from simdiff.diffusion.config import SAMPLER_STEPS, SamplingConfig
+from simdiff.diffusion.config import SamplingConfig
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ExperimentConfig, ModelSpec
 from simdiff.eval.experiments.provenance import provenance
@@ -246,12 +246,10 @@ class Runner:
 
     def method_inputs(self, spec: ModelSpec, sampler: str, alpha: float | None, env: Any = None) -> dict[str, Any]:
         """Model file, sampler, α, φ and PhysDiff settings of one method row."""
-        out: dict[str, Any] = {"model": _stamp(str(self.config.model_path(spec))), "sampler": sampler,
-                               "steps": spec.sampler_steps(sampler), "guidance": spec.guidance,
-                               "alpha": alpha, "env": None if env is None else [float(v) for v in env],
+        out: dict[str, Any] = {"model": _stamp(str(self.config.model_path(spec))),
+                               "sampling": self.sampling(spec, sampler, alpha).to_dict(),
+                               "env": None if env is None else [float(v) for v in env],
                                "env_index": spec.env_index, "device": self.config.device}
-        if spec.env_guidance != 1.0:  # absent when off: the rows measured before it existed stay current
-            out["env_guidance"] = float(spec.env_guidance)
         if self.backbone_of_simdiff(spec):
             out["backbone_only"] = True  # the folder's SimDiff model, adapters left out
         if spec.physdiff is not None:
@@ -273,7 +271,8 @@ class Runner:
 
         base = {k: v for k, v in (spec.physdiff or {}).items() if k not in ("sampler", "steps", "env", "guidance")}
         cfg = config_from_dict(base, PhysDiffConfig)
-        cfg.sampler, cfg.steps, cfg.guidance = sampler, spec.sampler_steps(sampler), spec.guidance
+        sampling = self.sampling(spec, sampler)
+        cfg.sampler, cfg.steps, cfg.guidance = sampler, sampling.steps, sampling.guidance
         cfg.env = tuple(float(v) for v in (env if env is not None else spec.env or EARTH))
         cfg.residual_bound = self.config.projector.residual_bound
         cfg.project_at = tuple(int(t) for t in cfg.project_at)
@@ -281,7 +280,7 @@ class Runner:
 
     def generate_fn(self, spec: ModelSpec, sampler: str, alpha: float | None = None, env: Any = None) -> GenerateFn:
         """``(captions, lengths, seed) -> (B, T, 263)`` raw features for one method row."""
-        if spec.env_guidance != 1.0 and self.sim_mode(spec) != "continuous":
+        if spec.env_guidance not in (None, 1.0) and self.sim_mode(spec) != "continuous":
             raise SimdiffError(f"model {spec.name!r}: env_guidance {spec.env_guidance:g} needs continuous SimDiff "
                                "adapters (φ does not reach this method)")
         gen = self.model(spec)
@@ -294,13 +293,19 @@ class Runner:
                             projector=self.sim if phys is not None else None, simulate=spec.simulate,
                             finish_projector=self.finish_sim if spec.simulate else None)
 
-    @staticmethod
-    def sampling(spec: ModelSpec, sampler: str, alpha: float | None = None) -> SamplingConfig:
-        """The :class:`SamplingConfig` of one method row: its sampler and steps, guidance, α (``alpha`` when given)
-        and environment guidance."""
-        return SamplingConfig(sampler=sampler, steps=spec.sampler_steps(sampler) or SAMPLER_STEPS[sampler],
-                              guidance=spec.guidance, alpha=spec.alpha if alpha is None else float(alpha),
-                              env_guidance=spec.env_guidance)
+    def sampling(self, spec: ModelSpec, sampler: str, alpha: float | None = None) -> SamplingConfig:
+        """The :class:`SamplingConfig` of one method row: the model folder's ``sampling.json`` with the row's sampler,
+        α (``alpha`` when given) and whatever the method overrides (steps, guidance, environment guidance)."""
+        from simdiff.inference.default import sampling_config
+
+        base = sampling_config(self.config.model_path(spec))
+        return base.updated(sampler=sampler, steps=spec.sampler_steps(sampler),
+                            guidance=spec.guidance, env_guidance=spec.env_guidance,
+                            alpha=spec.alpha if alpha is None else float(alpha))
+
+    def alpha(self, spec: ModelSpec) -> float:
+        """The α a method samples with where the experiment does not sweep it."""
+        return self.sampling(spec, "ddim").alpha
 
     def generate(self, fn: GenerateFn, captions: list[str], lengths: list[int], seed: int) -> tuple[torch.Tensor, float]:
         """Generate in batches of the protocol's size; returns ((N, T, 263) features, seconds)."""

@@ -66,7 +66,7 @@ def plan(runner: Runner) -> list[RowPlan]:
     for spec in c.models:
         for sampler in spec.own_samplers(c.samplers):
             if runner.is_simdiff(spec):
-                pairs = (sim_alphas if spec.alphas is None else alphas(runner, spec.alphas)) or [(spec.alpha, "model")]
+                pairs = (sim_alphas if spec.alphas is None else alphas(runner, spec.alphas)) or [(runner.alpha(spec), "model")]
                 plans += [method_plan(runner, spec, sampler, a, alpha_choice=why) for a, why in pairs]
             else:
                 plans.append(method_plan(runner, spec, sampler, None))
