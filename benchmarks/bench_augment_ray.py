@@ -2,7 +2,7 @@
 
 Usage:
     nice -n 10 python benchmarks/bench_augment_ray.py --corpus /path/to/corpus --clips 16 \
-        --out reports/augment/ray_scaling.json
+        --out ray_scaling.json
 
 The same fixed sample of pairs goes through :func:`simdiff.data.augment.run.augment` once per
 configuration (backend × workers), each in a fresh Python process and a fresh output folder:
@@ -116,7 +116,8 @@ def main() -> int:
     ap.add_argument("--configs", nargs="+", default=[f"{b}:{w}" for b, w in CONFIGS],
                     help="backend:workers to run (default ray:1 ray:2 process:1 process:2)")
     ap.add_argument("--repeats", type=int, default=1, help="runs per configuration, interleaved (default 1)")
-    ap.add_argument("--out", type=Path, default=Path("reports/augment/ray_scaling.json"))
+    ap.add_argument("--out", type=Path, default=Path("ray_scaling.json"),
+                    help="result JSON (default ./ray_scaling.json)")
     ap.add_argument("--one", nargs=4, metavar=("CORPUS", "OUT", "BACKEND", "WORKERS"), help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.one:

@@ -3,7 +3,7 @@
 Run with a Python that has Blender's ``bpy`` module (``pip install bpy`` in its own
 environment; it needs the Python version bpy was built for) and simdiff on PYTHONPATH::
 
-    python scripts/blender_bvh_check.py motion.bvh reference_joints.npy
+    python tests/blender_bvh_check.py motion.bvh reference_joints.npy
 
 Imports the BVH with the importer's defaults (scale 1, forward -Z, up Y), reads every pose
 bone's head in world space each frame, maps Blender's Z-up back to Y-up, and prints the

@@ -120,7 +120,7 @@ def test_stretchy_bones_round_trip(tmp_path: Path) -> None:
     err = np.linalg.norm(_read_back(path) - joints, axis=-1)
     assert err.max() < 1e-5  # the motion's own per-frame bone offsets: exact up to the printed digits
     fixed = np.linalg.norm(_read_back(write_bvh(tmp_path / "fixed.bvh", joints, stretch=False)) - joints, axis=-1)
-    assert fixed.max() > 5e-3  # fixed mean bones cannot follow (what the writer did before)
+    assert fixed.max() > 5e-3  # fixed mean bones (stretch=False) cannot follow
 
 
 def test_generated_sample_round_trip(tmp_path: Path) -> None:

@@ -189,8 +189,8 @@ def test_paired_training_learns_a_response_to_phi_and_resumes_exactly(tmp_path: 
         after = trainer.network.state_dict()
         assert all(torch.equal(after[k], v) for k, v in before.items())  # the backbone stays frozen
         responses[name] = _response(tmp_path / name / "model", ds)
-    # φ alone (same x_t) now moves the prediction the right way (the truth is +0.5; 40 tiny steps learn a part of
-    # it; whether pairs learn it faster than the plain loss is a question for a full training run)
+    # after training, φ alone (same x_t) moves the prediction the right way (the truth is +0.5; 40 tiny steps learn a
+    # part of it; whether pairs learn it faster than the plain loss is a question for a full training run)
     assert 0.04 < responses["pairs"] < 0.6, responses
     # a paired run stopped at a checkpoint and resumed ends bit-identical
     cfg = run_config(6, mode="adapters", sim=True, env_pairs=10.0, batch_size=6, seed=4, save_every=3)

@@ -16,7 +16,7 @@ A mirror ``M<id>`` is not stored: :func:`rebuild_mirror` mirrors ``<id>``'s join
 (``simdiff.motion.mirror.mirror_joints``, as the corpus builders do) and retargets them to the
 canonical skeleton as ``process_joints`` does, with the root scale of the builder's mirror
 (HumanML3D scales the root by a leg-length ratio of the source body, which the canonical
-joints no longer have), measured at pack time by :func:`mirror_scale`.
+joints do not carry), measured at pack time by :func:`mirror_scale`.
 """
 
 from __future__ import annotations

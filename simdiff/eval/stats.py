@@ -1,6 +1,6 @@
 """Intervals for reported numbers: Student-t over replications, a seeded cluster bootstrap.
 
-Every table in ``reports/experiments`` states a mean with a 95 % interval. With R replications
+Every table of ``simdiff evaluate`` (``reports/<name>/``) states a mean with a 95 % interval. With R replications
 (R ≥ 5 in the ``full`` budgets) the normal-theory ``1.96·σ/√R`` of MDM understates the
 uncertainty; we use the Student-t half-width ``t_{0.975, R−1} · s / √R`` with the sample
 standard deviation ``s`` (ddof = 1).

@@ -19,7 +19,7 @@ whose licence is not recorded makes the whole answer ``unknown``, since it could
 An augmented folder (``simdiff data augment``) records its source corpus in
 ``source_corpus.json`` (``{"path": ..., "summary": {...}}``): :func:`provenance_from_corpus` follows
 ``path`` to that corpus's ``manifest.json`` when it still exists, else uses the recorded summary.
-For a folder augmented before this record existed, ``{"path": "<its corpus>"}`` written by hand is enough.
+For a folder without this record, ``{"path": "<its corpus>"}`` written by hand is enough.
 """
 
 from __future__ import annotations

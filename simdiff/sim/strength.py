@@ -9,10 +9,10 @@ and configs are not touched, so Earth, low-gravity and wind rollouts are bit-ide
 
 Why: the gains and limits (:data:`simdiff.sim.humanoid._GAINS`) were tuned at 9.81. The
 tracker's inverse-dynamics feed-forward already knows g (computed under φ's g_z) and asks for up
-to s times the Earth torques, but the servos stayed Earth-strong (hips and knees saturate at
-500 N·m, and the feed-forward offset τ_ff / kp grows with g), the balance layer's COM gain
-(kp_xy = 20 1/s²) falls below the toppling rate g/h of the body (≈ 22 1/s² at −20), and the
-pelvis help was capped at Earth's 300 N·m, so the body sagged and tipped. Scaling kp and kd
+to s times the Earth torques; with Earth-strong servos (hips and knees saturate at 500 N·m, and
+the feed-forward offset τ_ff / kp grows with g), the balance layer's COM gain (kp_xy = 20 1/s²)
+below the toppling rate g/h of the body (≈ 22 1/s² at −20) and the pelvis help capped at
+Earth's 300 N·m, the body sags and tips. Scaling kp and kd
 together keeps τ_ff / kp and the servo lag kd / kp as on Earth; scaling the limits keeps the
 torque headroom.
 
@@ -25,13 +25,13 @@ error 44 / 43 / 44 → 39 / 40 / 39 mm (Earth: 6.29, 41 mm); median residual 47 
 limits alone 0.88 / 0.75 / 0.67.
 
 Version 3 also stiffens the root residual's pelvis-orientation loop (``residual_gains``:
-kp_rot × s, kd_rot × √s). With version 2 the standing clips still tilted back at high g (a
+kp_rot × s, kd_rot × √s). Without it (version 2) standing clips tilt back at high g (a
 Bandai-Namco wave at −18.9: pelvis pitch error 13° against 5° at Earth; pose d_L2 8.4 against
-5.6), so the pose filter rejected half of the plain pairs at g ∈ [−20, −15). Measured on 40
+5.6), so the pose filter rejects half of the plain pairs at g ∈ [−20, −15). Measured on 40
 plain original pairs of that bin drawn from a full augmentation run of the all-source corpus (seed 0): kept 21 → 30,
 median pose d_L2 change −0.84; the price is a larger pelvis torque from the residual, median
 196 → 242 N·m (Earth rollouts of the same clips: 82 N·m), i.e. 0.18 → 0.22 of the weight
-moment m·|g_z|·0.85 m (Earth 0.14); the torque bound itself is unchanged from version 2.
+moment m·|g_z|·0.85 m (Earth 0.14); the torque bound itself is the same in both versions.
 
 The actuator scaling is applied to a rollout's private copy of the model (``rollout`` copies
 it) by writing ``actuator_gainprm``, ``actuator_biasprm`` and ``actuator_forcerange``: the

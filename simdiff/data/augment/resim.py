@@ -14,7 +14,7 @@ Crash safety, per shard: (1) the shard is rewritten with the affected records ma
 deletes their files; (2) the new rollouts' files are written, each atomically; (3) the shard is
 rewritten with the new records. Every write is atomic (temp file + ``os.replace``), so a crash
 at any point leaves a consistent folder, and running the same command again resumes (pending
-records still have the old version). A clip whose source no longer loads keeps its records.
+records still have the old version). A clip whose source fails to load keeps its records.
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ def resimulate_shard(corpus: Path, out: Path, path: Path, projector: Projector, 
         try:
             joints[clip] = load_source_joints(corpus, clip)
         except SimdiffError:
-            continue  # the source no longer loads: its records stay as they are
+            continue  # the source fails to load: its records stay as they are
     targets = [r for r in records if is_stale(r, gravity_below) and r["clip"] in joints]
     if not targets:
         return 0

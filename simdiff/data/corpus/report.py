@@ -17,11 +17,28 @@ import numpy as np
 
 from simdiff.data.corpus.crosscheck import TARGET_M, crosscheck_items
 from simdiff.data.corpus.report_blocks import (
-    FilmstripRenderer, clip_metrics, filmstrips, group_by, hours, open_report, stats, summary_figure, table,
+    FilmstripRenderer,
+    clip_metrics,
+    filmstrips,
+    group_by,
+    hours,
+    open_report,
+    stats,
+    summary_figure,
+    table,
     write_report_files,
 )
 from simdiff.licences import LICENCES
-from simdiff.motion.flight import GROUND_PERCENTILE, LIFT, LIFT_EDGE, MIN_FLIGHT_S, MIN_FRAMES, flight_stats, has_flight
+from simdiff.motion.flight import (
+    GROUND_PERCENTILE,
+    LIFT,
+    LIFT_EDGE,
+    MIN_FLIGHT_S,
+    MIN_FRAMES,
+    flight_stats,
+    has_flight,
+)
+from simdiff.runinfo import header_lines, run_info
 
 SPLITS: tuple[str, ...] = ("train", "val", "test")
 METRICS: tuple[str, ...] = ("penetration", "floating", "sliding", "skate_ratio")
@@ -148,7 +165,7 @@ def write_corpus_report(corpus: str | Path, out: str | Path | None = None, *, re
         row.update(flights[row["id"]])
     by_id = {m["id"]: m for m in metrics}
     counts = manifest.get("counts", {})
-    md = ["# Text–motion corpus: report", "",
+    md = ["# Text–motion corpus: report", "", *header_lines(run_info()), "",
           f"Built by `simdiff data build` (pipeline v{manifest.get('pipeline_version')}, licence set "
           f"`{manifest.get('licence')}`, seed {manifest.get('seed')}, sources {', '.join(manifest.get('sources', []))}). "
           "HumanML3D layout, 20 fps, 22 joints, 263-dim features; every clip has a mirrored `M…` copy.", "",

@@ -1,21 +1,15 @@
-"""Where a report came from: command, git commit, seed, machine, resolved paths."""
+"""Where a report came from: command, git commit, seed, machine (with torch's view of it), time."""
 
 from __future__ import annotations
 
-import datetime as dt
 import os
-import platform
-import subprocess
-import sys
-from pathlib import Path
 from typing import Any
 
 import torch
 
+from simdiff.runinfo import now, run_info
 
-def now() -> str:
-    """UTC time, ISO format, seconds."""
-    return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+__all__ = ["load_average", "now", "provenance"]
 
 
 def load_average() -> list[float] | None:
@@ -27,28 +21,11 @@ def load_average() -> list[float] | None:
 
 
 def provenance(seed: int, device: str, command: list[str] | None = None) -> dict[str, Any]:
-    """Command, git commit (and whether the tree was dirty), seed and machine of this run."""
-    root = Path(__file__).resolve().parents[3]
-
-    def git(*args: str) -> str | None:
-        try:
-            return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, timeout=10,
-                                  check=True).stdout.strip()
-        except (OSError, subprocess.SubprocessError):
-            return None
-
-    status = git("status", "--porcelain", "--untracked-files=no")
+    """:func:`simdiff.runinfo.run_info` plus the working folder, seed, torch version, threads and device."""
+    info = run_info(command)
     dev = torch.device(device)
-    return {
-        "command": " ".join(command if command is not None else sys.argv),
-        "cwd": os.getcwd(),
-        "git_commit": git("rev-parse", "HEAD"),
-        "git_dirty": None if status is None else bool(status),
-        "seed": seed,
-        "machine": {"host": platform.node(), "platform": platform.platform(), "python": platform.python_version(),
-                    "cpus": os.cpu_count(), "torch": torch.__version__, "torch_threads": torch.get_num_threads(),
-                    "device": str(dev),
-                    "device_name": torch.cuda.get_device_name(dev) if dev.type == "cuda" else platform.processor() or "cpu",
-                    "load_avg_start": load_average()},
-        "started": now(),
-    }
+    info["machine"].update({
+        "torch": torch.__version__, "torch_threads": torch.get_num_threads(), "device": str(dev),
+        "device_name": torch.cuda.get_device_name(dev) if dev.type == "cuda" else "cpu",
+        "load_avg_start": load_average()})
+    return {**info, "cwd": os.getcwd(), "seed": seed}

@@ -50,8 +50,8 @@ def phys_err(row: dict[str, Any]) -> float | None:
 
     PhysDiff's sum adds raw floating, which rewards sinking into the floor; floating is scored as
     the distance to the ground truth's floating instead (:func:`simdiff.motion.metrics.phys_err`).
-    The ground-truth row scores penetration + sliding. Rows measured before this rule (no
-    ``phys_err``) give None: they are re-measured, not re-scored.
+    The ground-truth row scores penetration + sliding. Rows without ``phys_err`` (cached rows
+    written by an older version) give None: they are re-measured, not re-scored.
     """
     if row.get("method") == "Ground truth" and "summary" in row:
         s = row["summary"]

@@ -21,7 +21,7 @@ from simdiff.errors import MotionFormatError
 from simdiff.motion.io.resample import resample
 from simdiff.motion.io.rig import RigMotion
 from simdiff.motion.skeleton import BONE_LENGTHS, FPS, JOINT_NAMES, NUM_JOINTS, PARENTS
-from simdiff.motion.io.rigs import (  # noqa: F401  (re-exported: the maps' old home)
+from simdiff.motion.io.rigs import (  # noqa: F401  (re-exported: the joint maps are importable from here too)
     BANDAI_MAP,
     CC_BVH_MAP,
     CMU_ASF_MAP,

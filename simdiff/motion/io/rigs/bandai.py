@@ -42,7 +42,7 @@ BANDAI_MAP: dict[str, Source] = {
     "left_wrist": "Hand_L",
     "right_wrist": "Hand_R",
 }
-"""Bandai-Namco joints -> HumanML3D joints (placement: reports/corpus/NOTES.md)."""
+"""Bandai-Namco joints -> HumanML3D joints (placement: docs/corpus.md)."""
 
 BANDAI: RigSpec = RigSpec(
     "bandai",

@@ -40,11 +40,10 @@ CMU_ASF_MAP: dict[str, Source] = {
 (``head_centre``, ``l/rshoulder_centre``: :data:`simdiff.motion.io.asf_amc.ASF_SITES`)
 -> HumanML3D joints.
 
-Placement (pipeline v3) follows SMPL anatomy, measured in the trunk frame (hip centre ->
+Placement follows SMPL anatomy, measured in the trunk frame (hip centre ->
 neck base = 1, upright frames): pelvis 0.15 up on that line; spine1/2/3 at 0.33/0.56/0.64
 up and within 0.02-0.03 of the line (joints just in front of the vertebrae); head 0.12 above
-and 0.095 in front of the neck base; shoulders level with the line. See
-``reports/corpus/NOTES.md``."""
+and 0.095 in front of the neck base; shoulders level with the line. See ``docs/corpus.md``."""
 
 CMU_ASF: RigSpec = RigSpec("cmu_asf", CMU_ASF_MAP)
 """CMU and HDM05 ASF/AMC (same bone names; the AMC reader adds the sites)."""

@@ -35,7 +35,7 @@ DAZ_MAP: dict[str, Source] = {
     "left_wrist": "lHand",
     "right_wrist": "rHand",
 }
-"""Daz joints -> HumanML3D joints (placement: reports/corpus/NOTES.md)."""
+"""Daz joints -> HumanML3D joints (placement: docs/corpus.md)."""
 
 DAZ: RigSpec = RigSpec(
     "daz",
