@@ -294,14 +294,12 @@ class Runner:
                             finish_projector=self.finish_sim if spec.simulate else None)
 
     def sampling(self, spec: ModelSpec, sampler: str, alpha: float | None = None) -> SamplingConfig:
-        """The :class:`SamplingConfig` of one method row: the model folder's ``sampling.json`` with the row's sampler,
-        α (``alpha`` when given) and whatever the method overrides (steps, guidance, environment guidance)."""
+        """The model folder's ``sampling.json`` with the row's sampler, α and the method's overrides."""
         from simdiff.inference.default import sampling_config
-
-        base = sampling_config(self.config.model_path(spec))
-        return base.updated(sampler=sampler, steps=spec.sampler_steps(sampler),
-                            guidance=spec.guidance, env_guidance=spec.env_guidance,
-                            alpha=spec.alpha if alpha is None else float(alpha))
+        env_guidance = spec.env_guidance if self.sim_mode(spec) == "continuous" else 1.0  # φ-blind: no φ to push
+        return sampling_config(self.config.model_path(spec)).updated(
+            sampler=sampler, steps=spec.sampler_steps(sampler), guidance=spec.guidance,
+            env_guidance=env_guidance, alpha=spec.alpha if alpha is None else float(alpha))
 
     def alpha(self, spec: ModelSpec) -> float:
         """The α a method samples with where the experiment does not sweep it."""
@@ -497,7 +495,6 @@ def _stamp(path: str) -> dict[str, Any]:
     for name in ("model.safetensors", "finest.tar"):
         f = p / name if p.is_dir() else p
         if f.is_file():
-            st = f.stat()
-            out.update(size=st.st_size, mtime_ns=st.st_mtime_ns)
+            out.update(size=f.stat().st_size, mtime_ns=f.stat().st_mtime_ns)
             break
     return out
