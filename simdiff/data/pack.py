@@ -2,7 +2,7 @@
 
 The pack stores the original clips' joints; features and mirrors are rebuilt on unpack (clip codec:
 :mod:`simdiff.data.pack_joints`). On the all-source corpus that is 10x smaller than float16 features
-(36.9 MiB against 378.6 MiB, docs/training_pipeline.md). A pack folder holds::
+(36.9 MiB against 378.6 MiB). A pack folder holds::
 
     pack.json              format, version 2, content "joints", counts, rel_step, the largest
                            rebuild error measured at pack time, sha256 of the index
