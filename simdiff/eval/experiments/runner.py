@@ -297,12 +297,12 @@ class Runner:
         """The model folder's ``sampling.json`` with the row's sampler, α and the method's overrides."""
         from simdiff.inference.default import sampling_config
         env_guidance = spec.env_guidance if self.sim_mode(spec) == "continuous" else 1.0  # φ-blind: no φ to push
+        eta = 0.0 if spec.physdiff is not None else None  # PhysDiff's projection sampler is deterministic DDIM
         return sampling_config(self.config.model_path(spec)).updated(
-            sampler=sampler, steps=spec.sampler_steps(sampler), guidance=spec.guidance,
+            sampler=sampler, steps=spec.sampler_steps(sampler), guidance=spec.guidance, eta=eta,
             env_guidance=env_guidance, alpha=spec.alpha if alpha is None else float(alpha))
 
-    def alpha(self, spec: ModelSpec) -> float:
-        """The α a method samples with where the experiment does not sweep it."""
+    def alpha(self, spec: ModelSpec) -> float:  # the α of a method where the experiment does not sweep it
         return self.sampling(spec, "ddim").alpha
 
     def generate(self, fn: GenerateFn, captions: list[str], lengths: list[int], seed: int) -> tuple[torch.Tensor, float]:
