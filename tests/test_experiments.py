@@ -86,7 +86,7 @@ def test_shipped_configs_are_the_five_experiments_with_relative_paths() -> None:
     t1, t2 = load_config(CONFIGS / "eval_table1.json", "quick"), load_config(CONFIGS / "eval_table2.json", "quick")
     assert t1.protocol == t2.protocol
     assert t1.samplers == ["ddim", "ddpm"] and t1.alphas == [] and t1.ddpm_samples == 4  # SimDiff at the model's α
-    assert t2.alphas == [0.5, 0.925, 1.0] and t2.split == "val"  # α is chosen on val, never on test
+    assert t2.alphas == [0.5, 0.925] and t2.split == "val"  # α is chosen on val, never on test
     shipped = "simdiff/assets/default_model"
     assert all(p == shipped for c in (t1, t2) for p in c.paths.values())  # the reports are the shipped model's
     assert [m.physdiff["project_at"] for m in t1.models if m.physdiff] == [[60, 40, 20, 0]]
