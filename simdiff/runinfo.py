@@ -27,8 +27,8 @@ def _git(*args: str) -> str | None:
 
 
 def run_info(command: list[str] | None = None) -> dict[str, Any]:
-    """Command line, git commit (and whether tracked files differ from it), machine and start time."""
-    status = _git("status", "--porcelain", "--untracked-files=no")
+    """Command line, git commit (and whether tracked files outside ``reports/`` differ from it), machine, start time."""
+    status = _git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!reports")  # reports: the outputs
     return {"command": " ".join(command if command is not None else ["simdiff", *sys.argv[1:]]),
             "git_commit": _git("rev-parse", "HEAD"), "git_dirty": None if status is None else bool(status),
             "machine": {"host": platform.node(), "platform": platform.platform(), "python": platform.python_version(),
