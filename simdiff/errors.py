@@ -16,3 +16,11 @@ class MotionFormatError(SimdiffError):
         super().__init__(f"{where}: {message}")
         self.path = path
         self.line = line
+
+
+class NonFiniteResult(SimdiffError):
+    """A computation produced NaN or infinite values (extreme settings); nothing of it is written or shown."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that the same clean-up runs (temporary files removed, workers stopped)."""

@@ -12,6 +12,8 @@ from __future__ import annotations
 import errno
 import json
 import os
+import shutil
+import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterator, Mapping
@@ -80,11 +82,19 @@ def _temp_name(path: Path) -> Path:
     return path.with_name(f".{path.stem}.tmp{os.getpid()}{path.suffix}")
 
 
+def _check_target(path: Path) -> None:
+    """A target that exists must be a regular file: renaming onto a device (``/dev/full``), a folder or a pipe
+    would replace it."""
+    if path.is_dir():
+        raise SimdiffError(f"cannot write {str(path)!r}: it is a folder")
+    if path.exists() and not path.is_file():
+        raise SimdiffError(f"cannot write {str(path)!r}: it is not a regular file")
+
+
 def check_writable(path: str | Path) -> Path:
     """Fail early (before slow work) when ``path`` cannot be written: creates its folder, probes a temp file."""
     path = ensure_parent(path)
-    if path.is_dir():
-        raise SimdiffError(f"cannot write {str(path)!r}: it is a folder")
+    _check_target(path)
     probe = _temp_name(path)
     try:
         with open(probe, "wb"):
@@ -108,8 +118,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     A :class:`SimdiffError` raised by the writer passes through unchanged.
     """
     path = ensure_parent(path)
-    if path.is_dir():
-        raise SimdiffError(f"cannot write {str(path)!r}: it is a folder")
+    _check_target(path)
     tmp = _temp_name(path)
     try:
         yield tmp
@@ -124,6 +133,35 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         if isinstance(exc, OSError):
             raise write_error(path, exc) from None
         raise
+
+
+@contextmanager
+def output_set(folder: str | Path, last: str | None = None) -> Iterator[Path]:
+    """Write several files as one set: yield a hidden staging folder inside ``folder``.
+
+    When the block succeeds every file written in the staging folder is renamed into ``folder``
+    (``last``, e.g. the index ``generation.json``, after all the others, so its presence means the
+    set is complete); on any exception, Ctrl-C included, the staging folder is removed and
+    ``folder`` gains nothing. Renames need no space, so a full disk fails before the first one.
+    """
+    folder = ensure_dir(folder)
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=".simdiff-partial-", dir=folder))
+    except OSError as exc:
+        raise write_error(folder, exc) from None
+    try:
+        try:
+            yield stage
+        except SimdiffError as exc:  # name the final file, not its staged copy
+            raise SimdiffError(str(exc).replace(str(stage), str(folder))) from None
+        names = sorted(p.name for p in stage.iterdir())
+        if last in names:
+            names.remove(last)
+            names.append(last)
+        for name in names:
+            os.replace(stage / name, folder / name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 def write_bytes(path: str | Path, data: bytes) -> Path:

@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "simdiff"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("simdiff", "simdiff.errors", "simdiff.fsio", "simdiff.licences", "simdiff.runinfo"),
+    ("simdiff", "simdiff.errors", "simdiff.fsio", "simdiff.licences", "simdiff.limits", "simdiff.runinfo"),
     ("simdiff.motion",),
     ("simdiff.sim",),
     ("simdiff.text",),

@@ -87,7 +87,7 @@ def test_augment_cli_narrows_the_draw_and_refuses_it_outside_paired_mode(tmp_pat
                 progress=False)
     assert main(["data", "augment", "--corpus", str(corpus), "--out", str(tmp_path / "c"),
                  "--gravity-range", "-3", "0.5"]) != 0
-    assert "gravity-range -3 0.5" in capsys.readouterr().err
+    assert "argument --gravity-range: 0.5 is outside [-100, -0.1]" in capsys.readouterr().err
 
 
 def test_paired_draws_are_uncorrelated_with_content_but_round_robin_is_not() -> None:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from test_augment_mirrors import CountingProjector, _corpus_with_mirrors

@@ -124,7 +124,7 @@ def test_loop_corpus_adds_train_loops_and_leaves_the_corpus_as_it_was(tmp_path: 
 
 @pytest.mark.parametrize("args, message", [
     (["--types", "swim"], "--types swim: not a motion_type"),
-    (["--frames", "1"], "--frames must be >= 2, got 1"),
+    (["--frames", "1"], "argument --frames: 1 is outside"),
     (["--out-split", "train"], "--out-split 'train': choose a new split name"),
     (["--split", "nope"], "nope.txt: missing"),
 ])

@@ -67,7 +67,7 @@ def test_generate_reports_the_models_provenance(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "m")
     write_provenance(model, Provenance([TrainingData("backbone", "corpus", ["bandai"], 0.5, {"CC-BY-NC-4.0": 0.5}),
                                         TrainingData("adapters", "aug", ["cmu-amc"], 0.1, {"CMU": 0.1})]))
-    argv = ["generate", "a person waves", "--length", "0.4", "--steps", "2", "--model", str(model),
+    argv = ["generate", "a person waves", "--length", "0.5", "--steps", "2", "--model", str(model),
             "--format", "npy", "-q"]
     assert main([*argv, "--out", str(tmp_path / "o")]) == 0, capsys.readouterr().err
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())["model"]
@@ -83,7 +83,7 @@ def test_generate_reports_the_models_provenance(tmp_path: Path, capsys) -> None:
 
 def test_backbone_model_warns_once_and_ignores_phi(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "bb", sim=False)
-    code = main(["generate", "a person walks", "--gravity", "-1.6", "--compare", "gravity=-9.81,-1.6", "--length", "0.3",
+    code = main(["generate", "a person walks", "--gravity", "-1.6", "--compare", "gravity=-9.81,-1.6", "--length", "0.5",
                  "--steps", "1", "--model", str(model), "--out", str(tmp_path / "o"), "--format", "npy,bvh", "-q"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 0
@@ -95,10 +95,10 @@ def test_backbone_model_warns_once_and_ignores_phi(tmp_path: Path, capsys) -> No
 def test_default_output_folder_is_named_after_the_prompt(tiny_model: Path, tmp_path: Path, monkeypatch, capsys) -> None:
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("SIMDIFF_MODEL", str(tiny_model))
-    assert main(["generate", "A person: waves!", "--length", "0.2", "--steps", "1", "--format", "npy",
+    assert main(["generate", "A person: waves!", "--length", "0.5", "--steps", "1", "--format", "npy",
                  "-q"]) == 0
     assert (tmp_path / "out" / "a_person_waves" / "sample0_joints.npy").is_file()
-    assert main(["generate", "A person waves", "--length", "0.2", "--steps", "1", "--format", "npy",
+    assert main(["generate", "A person waves", "--length", "0.5", "--steps", "1", "--format", "npy",
                  "-q"]) == 0  # a second run never overwrites the first
     assert (tmp_path / "out" / "a_person_waves-2" / "generation.json").is_file()
     assert capsys.readouterr().out.split()[-1] == "out/a_person_waves-2/generation.json"
@@ -106,12 +106,12 @@ def test_default_output_folder_is_named_after_the_prompt(tiny_model: Path, tmp_p
 
 @pytest.mark.parametrize("argv, needle", [
     (["   "], "text prompt is empty"),
-    (["walk", "--length", "12"], "--length 12 s is 240 frames"),
-    (["walk", "--gravity", "0"], "gravity must be negative"),
-    (["walk", "--gravity", "nan"], "--gravity must be a finite number, got nan"),
+    (["walk", "--length", "12"], "argument --length: 12 is outside [0.5, 9.8]"),
+    (["walk", "--gravity", "0"], "argument --gravity: 0 is outside [-100, -0.1]"),
+    (["walk", "--gravity", "nan"], "argument --gravity: 'nan' is not a finite number"),
     (["walk", "--wind", "12", "0"], "12 N exceeds"),
-    (["walk", "--steps", "0"], "--steps must be a whole number in 1..1000, got 0"),
-    (["walk", "--guidance", "nan"], "--guidance must be a finite number"),
+    (["walk", "--steps", "0"], "argument --steps: 0 is outside 1..1000"),
+    (["walk", "--guidance", "nan"], "argument --guidance: 'nan' is not a finite number"),
     (["walk", "--compare", "gravity:-1,-2"], "bad --compare 'gravity:-1,-2'"),
     (["walk", "--model", "{tmp}/nowhere"], "nowhere/config.json: model file not found"),
     (["walk", "--model", "{tmp}/corrupt"], "corrupt: cannot load model"),
@@ -152,7 +152,7 @@ def test_help_lists_every_option_with_the_shipped_defaults() -> None:
 
 
 def test_generate_simulate_writes_the_simulated_motion_and_tracking(tiny_model: Path, tmp_path: Path, capsys) -> None:
-    code = main(["generate", "a person jumps", "--gravity", "-3.7", "--length", "0.4", "--steps", "1", "--simulate",
+    code = main(["generate", "a person jumps", "--gravity", "-3.7", "--length", "0.5", "--steps", "1", "--simulate",
                  "--model", str(tiny_model), "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
     captured = capsys.readouterr()
     assert code == 0, captured.err
@@ -164,7 +164,7 @@ def test_generate_simulate_writes_the_simulated_motion_and_tracking(tiny_model: 
     assert sim.ndim == 3 and sim.shape[1:] == (22, 3) and sim.dtype == np.float32 and np.isfinite(sim).all()
     tracking = json.loads((tmp_path / "o" / "sample0_tracking.json").read_text())
     assert tracking["env"] == [-3.7, 0.0, 0.0] and tracking["status"] in ("ok", "fell", "unstable")
-    assert tracking["n_frames"] == 8 and tracking["n_out"] == len(sim) and tracking["wall_s"] > 0
+    assert tracking["n_frames"] == 10 and tracking["n_out"] == len(sim) and tracking["wall_s"] > 0
     assert set(tracking["physics_generated"]) >= {"penetration", "floating", "sliding"}
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
     assert meta["samples"][0]["simulated"]["status"] == tracking["status"] and meta["timings_s"]["simulate"] > 0
@@ -181,7 +181,7 @@ def test_generate_simulate_in_a_worker_equals_in_process(tiny_model: Path, tmp_p
     out = {}
     for workers in ("1", "0"):
         monkeypatch.setenv("SIMDIFF_FINISH_WORKERS", workers)
-        code = main(["generate", "a person walks", "--length", "0.4", "--steps", "1", "--simulate", "--model",
+        code = main(["generate", "a person walks", "--length", "0.5", "--steps", "1", "--simulate", "--model",
                      str(tiny_model), "--out", str(tmp_path / workers), "--format", "npy", "-q"])
         assert code == 0, capsys.readouterr().err
         assert json.loads((tmp_path / workers / "generation.json").read_text())["simulate_workers"] == int(workers)
@@ -198,7 +198,7 @@ def test_a_failed_finish_still_writes_the_generated_motion(tiny_model: Path, tmp
 
     monkeypatch.setenv("SIMDIFF_FINISH_WORKERS", "0")
     monkeypatch.setattr("simdiff.product.pipeline.simulate_finish", broken)
-    code = main(["generate", "a person walks", "--length", "0.4", "--steps", "1", "--simulate", "--model",
+    code = main(["generate", "a person walks", "--length", "0.5", "--steps", "1", "--simulate", "--model",
                  str(tiny_model), "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
     err = capsys.readouterr().err
     assert code != 0 and "the simulator broke (the generated motions and generation.json are written in" in err
@@ -229,9 +229,10 @@ def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path:
     for name in ("root_rot_vel", "root_y", "ric", "rot6d", "contacts"):
         assert np.allclose(on[:, SLICES[name]], off[:, SLICES[name]], atol=1e-5), name
     assert json.loads((tmp_path / "on" / "generation.json").read_text())["foot_lock"] == 1.0
+    capsys.readouterr()
     assert main([*argv, "--foot-lock", "2", "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
-    assert "--foot-lock must be in [0, 1], got 2" in err and err.count("\n") == 1
+    assert "argument --foot-lock: 2 is outside [0, 1]" in err and err.count("\n") == 1
 
 
 def test_generate_env_guidance_changes_only_motions_off_earth(tmp_path: Path, capsys) -> None:
@@ -255,48 +256,58 @@ def test_generate_env_guidance_changes_only_motions_off_earth(tmp_path: Path, ca
     assert np.array_equal(run("given", "--gravity", "-1.6", "--env-guidance", "1"), moon1)
     assert main([*argv, "--env-guidance", "-1", "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
-    assert "--env-guidance must be ≥ 0, got -1" in err and err.count("\n") == 1
+    assert "argument --env-guidance: -1 is outside [0, 10]" in err and err.count("\n") == 1
 
 
 def test_generate_env_guidance_on_a_backbone_is_one_line(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "backbone", sim=False)
-    code = main(["generate", "a person walks", "--length", "0.4", "--steps", "1", "--model", str(model),
+    code = main(["generate", "a person walks", "--length", "0.5", "--steps", "1", "--model", str(model),
                  "--env-guidance", "2", "--format", "npy", "--out", str(tmp_path / "o"), "-q"])
     err = capsys.readouterr().err
     assert code == 2 and "--env-guidance needs a SimDiff model with a continuous Sim Encoder" in err
     assert err.count("\n") == 1
 
 
+def standing_mean(lift: float) -> torch.Tensor:
+    """(263,) feature mean of a still standing pose (synthetic walk, frame 0; lowest joint 0.021 m) raised by
+    ``lift`` metres: with a tiny std every sample is that pose."""
+    from simdiff.motion import synthetic
+
+    pose = synthetic.walk(2)[0].astype(np.float64)
+    mean = torch.zeros(263)
+    mean[3] = float(pose[0, 1] + lift)  # root height
+    rel = pose[1:] - pose[0] * np.array([1.0, 0.0, 1.0])  # ric: x, z relative to the root, y absolute
+    rel[:, 1] += lift
+    mean[4:67] = torch.as_tensor(rel.reshape(-1), dtype=torch.float32)
+    return mean
+
+
 def test_a_sample_that_never_touches_the_floor_is_warned_about(tmp_path: Path, capsys) -> None:
     torch.manual_seed(0)
     config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())
-    mean = torch.zeros(263)
-    mean[3] = 1.5  # root height
-    mean[5:67:3] = 1.2  # every other joint's height: the whole body about a metre up
+    mean = standing_mean(lift=1.2)  # a standing pose, its feet 1.2 m up
     MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 0.01)).save(tmp_path / "m")
-    code = main(["generate", "a person runs", "--length", "0.4", "--steps", "1", "--model", str(tmp_path / "m"),
+    code = main(["generate", "a person runs", "--length", "0.5", "--steps", "1", "--model", str(tmp_path / "m"),
                  "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
     err = capsys.readouterr().err
     assert code == 0
-    assert err.startswith("simdiff: warning: sample 0 never comes within 0.10 m of the floor (lowest joint 1.1")
+    assert err.startswith("simdiff: warning: sample 0 never comes within 0.10 m of the floor (lowest joint 1.2")
     assert len(err.strip().splitlines()) == 1
     rec = json.loads((tmp_path / "o" / "generation.json").read_text())["samples"][0]
     assert rec["touches_floor"] is False and 1.1 < rec["lowest_m"] < 1.3 and rec["glides"] is False
     # the foot cleanup (cleanup 3) drops such a sample onto the floor: no warning, lowest joint at y = 0
-    code = main(["generate", "a person runs", "--length", "0.4", "--steps", "1", "--model", str(tmp_path / "m"),
+    code = main(["generate", "a person runs", "--length", "0.5", "--steps", "1", "--model", str(tmp_path / "m"),
                  "--out", str(tmp_path / "o2"), "--format", "npy", "-q", "--foot-lock", "1"])
     assert code == 0 and capsys.readouterr().err == ""
     rec = json.loads((tmp_path / "o2" / "generation.json").read_text())["samples"][0]
-    assert rec["touches_floor"] is True and rec["lowest_m"] == 0.0
+    assert rec["touches_floor"] is True and abs(rec["lowest_m"]) < 0.01  # on the floor, up to the rigid fit
 
 
 def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
     torch.manual_seed(0)
     config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig())
-    mean = torch.zeros(263)
+    mean = standing_mean(lift=0.05 - 0.021)  # a statue whose feet stay 5 cm above the floor
     mean[1] = 0.1  # root forward velocity 0.1 m/frame = 2 m/s
-    mean[3] = 0.9  # root height
-    mean[4:67] = torch.tensor([0.0, 0.05, 0.0] * 21)  # every joint 5 cm above the floor, fixed: a statue
     MotionGenerator(build_network(config), config, mean=mean, std=torch.full((263,), 1e-4)).save(tmp_path / "m")
     code = main(["generate", "a person runs", "--length", "1", "--steps", "1", "--model", str(tmp_path / "m"),
                  "--out", str(tmp_path / "o"), "--format", "npy", "-q"])
@@ -308,7 +319,7 @@ def test_a_gliding_sample_is_warned_about(tmp_path: Path, capsys) -> None:
 
 def test_generate_reports_an_extrapolated_backbone(tmp_path: Path, capsys) -> None:
     model = save_tiny(tmp_path / "m")
-    argv = ["generate", "a person waves", "--length", "0.4", "--steps", "2", "--model", str(model),
+    argv = ["generate", "a person waves", "--length", "0.5", "--steps", "2", "--model", str(model),
             "--format", "npy", "-q"]
     assert main([*argv, "--out", str(tmp_path / "o")]) == 0, capsys.readouterr().err
     assert "extrapolation" not in json.loads((tmp_path / "o" / "generation.json").read_text())["model"]
@@ -354,7 +365,7 @@ def test_generate_edit_t_from_the_option_or_sampling_json(tmp_path: Path, capsys
     (model / "sampling.json").unlink()
     assert main([*argv, "--edit-t", "1000", "--out", str(tmp_path / "bad2")]) == 2
     err = capsys.readouterr().err
-    assert "--edit-t must be a whole number in 0..999, got 1000" in err and err.count("\n") == 1
+    assert "argument --edit-t: 1000 is outside 0..999" in err and err.count("\n") == 1
 
 
 def test_generate_eta_from_the_option_or_sampling_json(tmp_path: Path, capsys) -> None:
@@ -381,8 +392,8 @@ def test_generate_eta_from_the_option_or_sampling_json(tmp_path: Path, capsys) -
     assert main([*argv, "--sampler", "ddpm", "--out", str(tmp_path / "ddpm")]) == 0
     assert meta("ddpm")["eta"] == 0.0  # the stored η belongs to DDIM
     (model / "sampling.json").unlink()
-    for extra, message in ((("--eta", "1.5"), "--eta must be in [0, 1], got 1.5"),
-                           (("--eta", "nan"), "--eta must be a finite number"),
+    for extra, message in ((("--eta", "1.5"), "argument --eta: 1.5 is outside [0, 1]"),
+                           (("--eta", "nan"), "argument --eta: 'nan' is not a finite number"),
                            (("--eta", "0.5", "--sampler", "ddpm"), "--eta 0.5 is DDIM's noise scale; it needs "
                                                                   "--sampler ddim, not 'ddpm'")):
         assert main([*argv, *extra, "--out", str(tmp_path / "bad")]) == 2

@@ -12,7 +12,7 @@ import torch
 from simdiff.diffusion.config import SamplingConfig
 from simdiff.model import ModelConfig, SimConfig, backbone_preset, build_network
 from simdiff.inference.generator import MotionGenerator
-from simdiff.motion.features import features_to_joints
+from simdiff.motion.rigid import bone_lengths, joints_from_features
 from simdiff.viz.video import write_gif
 from simdiff.product.pipeline import Timer, run_generation, sample_motions
 from simdiff.product.request import GenerationRequest, build_request
@@ -58,10 +58,14 @@ def test_files_shapes_and_metadata(tmp_path: Path) -> None:
     feats = np.load(tmp_path / "sample0_features.npy")
     joints = np.load(tmp_path / "sample0_joints.npy")
     assert feats.shape == (12, 263) and joints.shape == (12, 22, 3) and joints.dtype == np.float32
-    np.testing.assert_allclose(joints, features_to_joints(feats), atol=1e-6)
+    np.testing.assert_array_equal(joints, joints_from_features(feats))  # the rigid fit of the features' positions
+    assert float(np.ptp(bone_lengths(joints), axis=0).max()) < 1e-5
     from simdiff.motion.io.bvh import read_bvh
+    from simdiff.motion.skeleton import JOINT_NAMES
 
-    assert read_bvh(tmp_path / "sample0.bvh").positions.shape[0] == 12
+    rig = read_bvh(tmp_path / "sample0.bvh", scale=1.0)
+    back = rig.positions[:, [rig.index(n) for n in JOINT_NAMES]]
+    assert back.shape[0] == 12 and float(np.abs(back - joints).max()) < 1e-5  # the BVH is the written joints
     from PIL import Image
 
     with Image.open(tmp_path / "sample0.gif") as im:
@@ -87,7 +91,7 @@ def test_sample_k_uses_seed_plus_k_and_env_matters() -> None:
 
 
 def test_compare_same_noise_per_environment(tmp_path: Path) -> None:
-    request = req("a person jumps", 2, length_s=0.4, compare="gravity=-9.81,-1.6", num_samples=1,
+    request = req("a person jumps", 2, length_s=0.5, compare="gravity=-9.81,-1.6", num_samples=1,
                             formats="npy,gif")
     gen = tiny_generator()
     meta, paths = run_generation(gen, request, tmp_path, tmp_path, Timer(), quiet=True)
@@ -103,7 +107,7 @@ def test_compare_same_noise_per_environment(tmp_path: Path) -> None:
     with Image.open(paths[0]) as im:
         assert im.size[0] == width
     # each compared motion equals a plain run under that environment with the same seed
-    earth = sample_motions(gen, req("a person jumps", 2, length_s=0.4), Timer(), quiet=True)[0]
+    earth = sample_motions(gen, req("a person jumps", 2, length_s=0.5), Timer(), quiet=True)[0]
     np.testing.assert_array_equal(np.load(tmp_path / "gravity-9.81_sample0_features.npy"), earth.features)
     # with zero-initialised (fresh) adapters φ has no effect: same noise gives the same motion
     fresh = tiny_generator(active_adapters=False)
@@ -113,7 +117,7 @@ def test_compare_same_noise_per_environment(tmp_path: Path) -> None:
 
 def test_backbone_model_ignores_environment(tmp_path: Path) -> None:
     gen = tiny_generator(sim=False)
-    request = req("walk", 2, gravity=-1.6, length_s=0.3, formats="npy").with_envs(
+    request = req("walk", 2, gravity=-1.6, length_s=0.5, formats="npy").with_envs(
         build_request("walk").envs)
     meta, _ = run_generation(gen, request, tmp_path, tmp_path, Timer(), quiet=True)
     assert meta["environment"] is None and meta["alpha"] is None and meta["samples"][0]["environment"] is None
@@ -121,7 +125,7 @@ def test_backbone_model_ignores_environment(tmp_path: Path) -> None:
 
 
 def test_mp4_output(tmp_path: Path) -> None:
-    request = req("walk", 1, length_s=0.3, formats="mp4")
+    request = req("walk", 1, length_s=0.5, formats="mp4")
     _, paths = run_generation(tiny_generator(), request, tmp_path, tmp_path, Timer(), quiet=True)
     assert [p.name for p in paths] == ["sample0.mp4", "generation.json"]
     assert (tmp_path / "sample0.mp4").stat().st_size > 1000

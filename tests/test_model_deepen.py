@@ -76,7 +76,7 @@ def test_new_layers_receive_gradient(tmp_path) -> None:
 
 @pytest.mark.parametrize("argv_tail, message", [
     (["--after", "7"], "--after 7: the model has layers 0..2"),
-    (["--same"], "must differ from the model"),
+    (["--same"], "is the same folder as --model"),
 ])
 def test_deepen_errors_are_one_line(tmp_path, capsys, argv_tail, message) -> None:
     src = tmp_path / "src"

@@ -10,7 +10,7 @@ from safetensors import safe_open
 
 from simdiff.cli.main import main
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
-from simdiff.model.config import BackboneConfig, ModelConfig, SimConfig
+from simdiff.model.config import BackboneConfig, ModelConfig
 from test_model_deepen import _outputs, _trained_like
 
 pytestmark = pytest.mark.usefixtures("one_torch_thread")
@@ -58,7 +58,7 @@ def test_refusals_are_one_line(tmp_path, capsys) -> None:
     src = tmp_path / "src"
     _trained_like(src, False)
     assert main(["train", "precision", "--model", str(src), "--out", str(src)]) != 0
-    assert "must differ" in capsys.readouterr().err
+    assert "is the same folder as --model" in capsys.readouterr().err
     big = tmp_path / "big"
     config = ModelConfig(backbone=BackboneConfig(latent_dim=32, num_layers=1, num_heads=4, ff_size=48), sim=None)
     from simdiff.model.checkpoint import build_network

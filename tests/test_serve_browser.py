@@ -1,5 +1,6 @@
 """``simdiff serve`` end to end in headless Chromium (Playwright): the page loads, generates,
-regenerates from the prompt and the gravity slider, plays/scrubs and opens an uploaded file.
+regenerates from the prompt and the gravity slider, plays/scrubs and opens an uploaded file; the WebGL view
+shows the skinned body, with the stick figure as a toggle; without WebGL the page falls back to the 2D stick figure.
 
 Skips when Playwright or a Chromium is missing. Chromium: ``$SIMDIFF_CHROMIUM``, else a system
 ``chromium`` (Debian: ``apt-get install chromium``), else Playwright's own download.
@@ -8,6 +9,7 @@ Screenshots go to ``$SIMDIFF_SCREENSHOT_DIR`` when set, else to tmp.
 
 from __future__ import annotations
 
+import io
 import os
 import shutil
 from pathlib import Path
@@ -41,16 +43,26 @@ def chromium_path() -> str | None:
 
 
 @pytest.fixture(scope="module")
-def browser():
+def playwright():
     sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (pip install playwright)")
     with sync_api.sync_playwright() as playwright:
-        exe = chromium_path()
-        try:
-            chromium = playwright.chromium.launch(executable_path=exe, args=["--no-sandbox"])
-        except Exception as exc:  # no browser binary, or it cannot start here
-            pytest.skip(f"no usable Chromium ({exe or 'playwright default'}): {str(exc).splitlines()[0]}")
-        yield chromium
-        chromium.close()
+        yield playwright
+
+
+def launch(playwright, *args: str):
+    exe = chromium_path()
+    try:
+        # software WebGL (SwiftShader) where there is no GPU: newer Chromium builds ask for it by name
+        return playwright.chromium.launch(executable_path=exe, args=["--no-sandbox", "--enable-unsafe-swiftshader", *args])
+    except Exception as exc:  # no browser binary, or it cannot start here
+        pytest.skip(f"no usable Chromium ({exe or 'playwright default'}): {str(exc).splitlines()[0]}")
+
+
+@pytest.fixture(scope="module")
+def browser(playwright):
+    chromium = launch(playwright)
+    yield chromium
+    chromium.close()
 
 
 @pytest.fixture(scope="module")
@@ -90,8 +102,29 @@ def wait_for_new_motion(page, after_id: int) -> dict:
     return page.evaluate(STATE)
 
 
+def wait_for_body(page) -> dict:
+    """The viewer's numbers once the body of the motion on screen is shown."""
+    page.wait_for_function(f"{STATE}.body === 'ready'", timeout=TIMEOUT_MS)
+    return page.evaluate("window.simdiffViewer.debug()")
+
+
+def view_pixels(page, path: Path) -> dict[str, int]:
+    """Save a screenshot of the page to ``path``; count the 3D view's pixels in the stick figure's left-limb blue
+    and in the body's skin tones."""
+    from PIL import Image
+
+    page.evaluate("window.simdiffPlayer._dirty = true")
+    page.wait_for_timeout(300)  # a frame or two
+    page.screenshot(path=str(path))
+    shot = np.asarray(Image.open(io.BytesIO(page.locator("#view").screenshot())).convert("RGB")).astype(int)
+    r, g, b = shot[..., 0], shot[..., 1], shot[..., 2]
+    blue = (abs(r - 0x2F) < 30) & (abs(g - 0x6F) < 30) & (abs(b - 0xD0) < 30)
+    skin = (r > g + 10) & (g > b + 5) & (b > 70) & (r - b > 25)
+    return {"blue": int(blue.sum()), "skin": int(skin.sum())}
+
+
 def skeleton_pixels(page) -> int:
-    """Canvas pixels in the left-limb blue: the skeleton was drawn."""
+    """2D view (no WebGL): canvas pixels in the left-limb blue, the skeleton was drawn."""
     return page.evaluate("""() => {
         const c = document.getElementById('view');
         const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
@@ -115,7 +148,7 @@ def test_viewer_generates_regenerates_plays_and_opens(browser, server, tmp_path)
     first = wait_for_new_motion(page, 0)
     assert first["generation_id"] == 1 and first["frames"] == 120 and first["source"] == "generate"
     assert first["params"]["gravity"] == pytest.approx(-9.81) and first["error"] is None
-    assert skeleton_pixels(page) > 50
+    assert first["view"] == "webgl" and wait_for_body(page)["skinnedMeshes"] == 1
 
     # type a prompt, press Generate
     page.fill("#prompt", "a person jumps on the spot")
@@ -166,7 +199,7 @@ def test_viewer_generates_regenerates_plays_and_opens(browser, server, tmp_path)
     page.fill("#seconds", "12")
     page.click("#generate")
     page.wait_for_function(f"{STATE}.status === 'error'", timeout=TIMEOUT_MS)
-    assert "seconds must be in [0.05, 9.8], got 12" in page.text_content("#error")
+    assert "seconds must be in [0.5, 9.8], got 12" in page.text_content("#error")
     assert page.evaluate(f"{STATE}.frames") == 60
     page.fill("#seconds", "6")
 
@@ -183,6 +216,65 @@ def test_viewer_generates_regenerates_plays_and_opens(browser, server, tmp_path)
     page.mouse.down()
     page.mouse.move(960, 380, steps=4)  # orbit a little
     page.mouse.up()
-    assert skeleton_pixels(page) > 50
-    page.screenshot(path=str(screenshot_dir(tmp_path) / "viewer.png"))
+    viewer = wait_for_body(page)  # an opened motion has its body too
+    assert viewer["skinnedMeshes"] == 1 and viewer["bones"] == 22 and viewer["boneErrorMm"] < 50
+    assert view_pixels(page, screenshot_dir(tmp_path) / "viewer.png")["skin"] > 1000
     assert problems == []
+
+
+def test_body_with_stick_figure_toggle_and_no_outside_requests(browser, server, tmp_path):
+    page = browser.new_page(viewport={"width": 1280, "height": 760})
+    problems: list[str] = []
+    requests: list[str] = []
+    page.on("pageerror", lambda exc: problems.append(f"page error: {exc}"))
+    page.on("console", lambda msg: problems.append(f"console: {msg.text}") if msg.type == "error" else None)
+    page.on("request", lambda request: requests.append(request.url))
+    page.goto(server.url)
+    first = wait_for_new_motion(page, 0)
+    viewer = wait_for_body(page)
+    assert viewer == {**viewer, "renderer": "webgl", "skinnedMeshes": 1, "bones": 22, "body": "ready", "stick": False}
+    assert viewer["boneErrorMm"] < 1.0  # the body's bones sit on the joints the stick figure draws
+
+    page.click("#play")  # pause, then look at the first, a middle and the last frame
+    for frame in (0, first["frames"] // 2, first["frames"] - 1):
+        page.fill("#scrub", str(frame))
+        viewer = page.evaluate("window.simdiffViewer.debug()")
+        assert viewer["frame"] == frame and viewer["boneErrorMm"] < 1.0, viewer
+    folder = screenshot_dir(tmp_path)
+    body_only = view_pixels(page, folder / "viewer_body.png")
+    assert body_only["skin"] > 1000 and body_only["blue"] < 20, body_only
+
+    page.check("#stick")
+    assert page.evaluate(f"{STATE}.stick") is True and page.evaluate("window.simdiffViewer.debug().stick") is True
+    with_stick = view_pixels(page, folder / "viewer_body_stick.png")
+    assert with_stick["blue"] > 50 and with_stick["skin"] > 500, with_stick
+    page.uncheck("#stick")
+    assert page.evaluate("window.simdiffViewer.debug().stick") is False
+
+    # a new motion replaces the body (one skinned mesh in the scene, never two)
+    page.fill("#seconds", "2")
+    page.click("#generate")
+    second = wait_for_new_motion(page, first["generation_id"])
+    viewer = wait_for_body(page)
+    assert second["frames"] == 40 and viewer["skinnedMeshes"] == 1 and viewer["boneErrorMm"] < 1.0
+
+    assert requests and all(url.startswith(server.url) for url in requests), requests
+    assert any("/static/vendor/three/" in url for url in requests) and any(url.endswith(".glb") for url in requests)
+    assert problems == []
+
+
+def test_without_webgl_the_page_draws_the_stick_figure(playwright, server, tmp_path):
+    chromium = launch(playwright, "--disable-3d-apis", "--disable-webgl")
+    try:
+        page = chromium.new_page(viewport={"width": 1000, "height": 700})
+        errors: list[str] = []
+        page.on("pageerror", lambda exc: errors.append(f"page error: {exc}"))
+        page.goto(server.url)
+        state = wait_for_new_motion(page, 0)
+        assert state["view"] == "2d" and state["body"] is None and page.is_hidden("#stick")
+        assert skeleton_pixels(page) > 50
+        assert "No WebGL" in page.text_content("#model-info")
+        page.screenshot(path=str(screenshot_dir(tmp_path) / "viewer_2d.png"))
+        assert errors == []
+    finally:
+        chromium.close()

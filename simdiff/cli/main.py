@@ -11,11 +11,14 @@ from __future__ import annotations
 import argparse
 import importlib
 import pkgutil
+import signal
 import sys
+import threading
 from typing import Sequence
 
 from simdiff import __version__
-from simdiff.errors import SimdiffError
+from simdiff.cli.options import UsageError
+from simdiff.errors import SimdiffError, Terminated
 
 def command_group(subparsers: argparse._SubParsersAction, name: str, help: str) -> argparse._SubParsersAction:
     """Return the sub-subparsers of group ``name`` (e.g. ``data``), creating it once.
@@ -34,7 +37,9 @@ def command_group(subparsers: argparse._SubParsersAction, name: str, help: str) 
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the full argument parser by discovering every command module."""
-    parser = argparse.ArgumentParser(
+    from simdiff.cli.options import Parser
+
+    parser = Parser(
         prog="simdiff",
         description="Physically plausible text-to-motion under gravity and wind, and the HumanML3D toolchain.",
     )
@@ -51,15 +56,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point: parse, dispatch, and turn user errors into one-line messages."""
+    """Entry point: parse, dispatch, and turn user errors into one-line messages.
+
+    SIGTERM is raised as :class:`~simdiff.errors.Terminated` (a ``KeyboardInterrupt``), so Ctrl-C and a kill
+    both remove partial output and stop workers; exit codes 130 and 143 as a shell reports them.
+    """
     parser = build_parser()
-    args = parser.parse_args(argv)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
     try:
+        args, extra = parser.parse_known_args(argv)
+        if extra:  # named here so that the hint points at the subcommand's own help
+            sub = " ".join(str(v) for v in (args.command, getattr(args, f"{args.command}_command", None)) if v)
+            raise UsageError(f"unrecognized arguments: {' '.join(extra)} (see simdiff {sub} --help)")
         return int(args.func(args) or 0)
     except SimdiffError as exc:
         print(f"simdiff: error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("simdiff: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print("simdiff: interrupted", file=sys.stderr)
         return 130
@@ -71,6 +92,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"simdiff: error: {where}{reason(exc)}", file=sys.stderr)
         return 1
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

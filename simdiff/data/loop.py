@@ -14,7 +14,6 @@ the capture's own continuation. All positions in metres, Y-up, 20 fps,
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -174,11 +173,12 @@ def loop_corpus(corpus: str | Path, types: Sequence[str], frames: int, split: st
         raise SimdiffError(f"--frames must be >= 2, got {frames}")
     if "/" in out_split or out_split in ("train", "val", "test", "train_val", "all"):
         raise SimdiffError(f"--out-split {out_split!r}: choose a new split name (the corpus's own are kept)")
-    manifest, split_path = root / "manifest.json", root / f"{split}.txt"
-    for path in (manifest, split_path):
-        if not path.is_file():
-            raise SimdiffError(f"{path}: missing (a corpus of `simdiff data build`)")
-    clips = {c["id"]: c for c in json.loads(manifest.read_text(encoding="utf-8")).get("clips", [])}
+    from simdiff.data.manifest import LOOP_CLIP_KEYS, manifest_path, read_manifest
+
+    manifest, split_path = manifest_path(root), root / f"{split}.txt"
+    clips = {c["id"]: c for c in read_manifest(root, LOOP_CLIP_KEYS)["clips"]}
+    if not split_path.is_file():
+        raise SimdiffError(f"{split_path}: missing (a corpus of `simdiff data build`)")
     known = {c.get("motion_type") for c in clips.values()}
     if unknown := sorted(set(types) - known):
         raise SimdiffError(f"--types {' '.join(unknown)}: not a motion_type of {manifest} ({', '.join(sorted(map(str, known)))})")

@@ -19,6 +19,14 @@ SAMPLER_STEPS: dict[str, int] = {"ddim": 50, "ddpm": 1000}
 """Each sampler's steps when a configuration switches to it without giving them."""
 MAX_STEPS: int = 1000
 """Diffusion steps the models are trained with (the most a sampler can take)."""
+GUIDANCE_RANGE: tuple[float, float] = (0.0, 20.0)
+"""Classifier-free guidance scales accepted (the shipped model samples at 3; a bound against typing slips)."""
+ALPHA_RANGE: tuple[float, float] = (-2.0, 4.0)
+"""Adapter strengths accepted (0: backbone only, 1: as trained)."""
+ENV_GUIDANCE_RANGE: tuple[float, float] = (0.0, 10.0)
+"""Environment guidance scales accepted (1: off)."""
+MAX_SEED: int = 2**32 - 1
+"""Largest ``--seed`` a command accepts (numpy's seed range)."""
 
 
 @dataclass(frozen=True)
@@ -55,9 +63,9 @@ class SamplingConfig:
         if self.eta and self.sampler != "ddim":
             raise SimdiffError(f"--eta {self.eta:g} is DDIM's noise scale; it needs --sampler ddim, "
                                f"not {self.sampler!r}")
-        set_(self, "guidance", _number("--guidance", self.guidance, 0.0))
-        set_(self, "alpha", _number("--alpha", self.alpha))
-        set_(self, "env_guidance", _number("--env-guidance", self.env_guidance, 0.0))
+        set_(self, "guidance", _number("--guidance", self.guidance, *GUIDANCE_RANGE))
+        set_(self, "alpha", _number("--alpha", self.alpha, *ALPHA_RANGE))
+        set_(self, "env_guidance", _number("--env-guidance", self.env_guidance, *ENV_GUIDANCE_RANGE))
         set_(self, "edit_t", _whole("--edit-t", self.edit_t, 0, 999))
         set_(self, "foot_lock", _number("--foot-lock", self.foot_lock, 0.0, 1.0))
 
@@ -118,7 +126,7 @@ def _number(name: str, value: object, lo: float | None = None, hi: float | None 
 
 def _whole(name: str, value: object, lo: int, hi: int) -> int:
     """``value`` as an int in [lo, hi], else a one-line :class:`SimdiffError` naming ``name``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value != int(value) \
-            or not lo <= value <= hi:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+            or value != int(value) or not lo <= value <= hi:
         raise SimdiffError(f"{name} must be a whole number in {lo}..{hi}, got {value!r}")
     return int(value)

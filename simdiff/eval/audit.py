@@ -186,13 +186,19 @@ def audit_motion(joints: np.ndarray, env: Environment = Environment(), *, name: 
                dynamic_ncols=True)
     metrics = {k: float(v) for k, v in physics_metrics(joints).items()}
     bar.update()
-    summary, series = reference_residual(joints, env)
-    bar.update()
-    tracking, out = None, None
-    if track:
-        from simdiff.sim.project import project
+    try:
+        summary, series = reference_residual(joints, env)
+        bar.update()
+        tracking, out = None, None
+        if track:
+            from simdiff.sim.project import project
 
-        out, info = project(joints, env, residual=residual, normalizer=normalizer, force=force)
+            out, info = project(joints, env, residual=residual, normalizer=normalizer, force=force)
+    except np.linalg.LinAlgError as exc:  # a degenerate pose (joints coinciding) has no body fit
+        bar.close()
+        raise SimdiffError(f"{name}: the humanoid cannot be fitted to these joints ({exc}; do joints coincide?)") \
+            from None
+    if track:
         tracking = info.to_dict()
         tracking.pop("env", None)
         tracking.pop("feasibility", None)  # the Earth-gravity screen; ``reference`` has it under φ

@@ -15,11 +15,11 @@ from torch import Tensor, nn
 
 from simdiff.diffusion.config import SamplingConfig
 from simdiff.diffusion.sampling import X0Hook, sample
-from simdiff.errors import SimdiffError
+from simdiff.errors import NonFiniteResult, SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
 from simdiff.model.condition import Condition
 from simdiff.model.config import ModelConfig
-from simdiff.motion.skeleton import MAX_FRAMES
+from simdiff.motion.skeleton import MAX_FRAMES, MIN_GENERATE_FRAMES
 
 
 @dataclass
@@ -108,12 +108,12 @@ class MotionGenerator:
 
         Args:
             texts: B captions.
-            lengths: frames per motion (one int for all, or B ints), each in [1, 196].
+            lengths: frames per motion (one int for all, or B ints), each in [10, 196].
             config: the sampling configuration (:mod:`simdiff.diffusion.guidance` for how φ enters); its
                 ``foot_lock`` > 0 applies :func:`simdiff.motion.foot_lock.clean_feet` to the final sample.
             env: φ = (g_z, w_x, w_y) as (3,) for all or (B, 3); SimDiff continuous models.
             env_index: environment category (int or B ints); SimDiff categorical models.
-            seed: noise seed (None: nondeterministic).
+            seed: noise seed in 0..2⁶³−1 (None: nondeterministic).
             batched_cfg: the conditional and unconditional passes as one batched forward.
             text_embeddings: (B, text_dim) precomputed text vectors instead of encoding ``texts``.
             x0_hook, hook_timesteps: replace x̂₀ at chosen t (PhysDiff projection).
@@ -125,9 +125,12 @@ class MotionGenerator:
         lens = torch.tensor([lengths] * b if isinstance(lengths, int) else list(lengths), dtype=torch.long)
         if lens.numel() != b:
             raise SimdiffError(f"got {lens.numel()} lengths for {b} texts")
-        bad = [int(n) for n in lens if not 1 <= int(n) <= MAX_FRAMES]
+        bad = [int(n) for n in lens if not MIN_GENERATE_FRAMES <= int(n) <= MAX_FRAMES]
         if bad:
-            raise SimdiffError(f"motion length must be 1..{MAX_FRAMES} frames (9.8 s at 20 fps), got {bad[0]}")
+            raise SimdiffError(f"motion length must be {MIN_GENERATE_FRAMES}..{MAX_FRAMES} frames (0.5..9.8 s at "
+                               f"20 fps), got {bad[0]}")
+        if seed is not None and not 0 <= int(seed) < 2**63:  # torch.Generator's range
+            raise SimdiffError(f"seed must be in 0..2**63-1, got {seed}")
         continuous = self.config.sim is not None and self.config.sim.mode == "continuous"
         if config.env_guidance != 1.0 and not continuous:
             raise SimdiffError("--env-guidance needs a SimDiff model with a continuous Sim Encoder; "
@@ -141,10 +144,12 @@ class MotionGenerator:
         x = sample(self.network, config, cond, frames, nfeats=self.config.backbone.nfeats, batched_cfg=batched_cfg,
                    generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps, progress=progress)
         features = (x * self.std + self.mean) * mask[..., None]
-        if config.foot_lock and frames >= 2:  # one frame has no step to correct
+        _check_finite(features, config, env)
+        if config.foot_lock:
             from simdiff.motion.foot_lock import clean_feet
 
             features = clean_feet(features, lens, config.foot_lock) * mask[..., None]
+            _check_finite(features, config, env)
             x = torch.where(mask[..., None], (features - self.mean) / self.std, x)
         return Generation(features=features, normalized=x, lengths=lens)
 
@@ -170,3 +175,11 @@ class MotionGenerator:
             raise SimdiffError(f"env_index must be 1 or {b} integers")
         return {"env_index": idx.expand(b).to(self.device)}
 
+
+
+def _check_finite(features: Tensor, config: SamplingConfig, env: object) -> None:
+    """Refuse a sample with nan or inf (extreme guidance or φ): callers write nothing of it."""
+    if not bool(torch.isfinite(features).all()):
+        phi = "" if env is None else f", φ {[round(float(v), 4) for v in torch.as_tensor(env).flatten()[:3]]}"
+        raise NonFiniteResult(f"sampling gave non-finite values (guidance {config.guidance:g}, alpha {config.alpha:g}, "
+                           f"env guidance {config.env_guidance:g}{phi}); try settings nearer the model's defaults")

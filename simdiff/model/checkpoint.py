@@ -16,7 +16,7 @@ from torch import Tensor, nn
 from simdiff.errors import SimdiffError
 from simdiff.fsio import atomic_save_tensors
 from simdiff.model.backbone import MDMBackbone
-from simdiff.model.config import BackboneConfig, ModelConfig, config_from_dict
+from simdiff.model.config import BackboneConfig, ModelConfig, check_model_config, config_from_dict
 from simdiff.model.simdiff_net import SimDiffNet
 
 WEIGHTS_NAME = "model.safetensors"
@@ -90,9 +90,15 @@ def read_config(folder: str | os.PathLike[str]) -> ModelConfig:
     path = Path(folder) / CONFIG_NAME
     if not path.is_file():
         raise SimdiffError(f"{path}: no such file (expected a model folder with {CONFIG_NAME} and {WEIGHTS_NAME})")
-    with open(path, encoding="utf-8") as f:
-        data = json.load(f)
-    return config_from_dict(data, ModelConfig)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise SimdiffError(f"{path}: not a UTF-8 text file") from None
+    except json.JSONDecodeError as exc:
+        raise SimdiffError(f"{path}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+    except OSError as exc:
+        raise SimdiffError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    return check_model_config(config_from_dict(data, ModelConfig, str(path)), str(path))
 
 
 def load_pretrained(folder: str | os.PathLike[str], device: torch.device | str = "cpu") -> tuple[nn.Module, ModelConfig, dict[str, Tensor]]:
@@ -104,16 +110,70 @@ def load_pretrained(folder: str | os.PathLike[str], device: torch.device | str =
     from simdiff.model.shards import INDEX_NAME, load_sharded
 
     if path.is_file():
-        tensors = load_file(str(path), device="cpu")
+        tensors = read_tensors(path)
     elif (Path(folder) / INDEX_NAME).is_file():
-        tensors = load_sharded(folder)
+        try:
+            tensors = load_sharded(folder)
+        except SimdiffError:
+            raise
+        except Exception as exc:  # a corrupt shard: one line naming the folder
+            raise SimdiffError(f"{Path(folder) / INDEX_NAME}: cannot read the weight shards ({_first_line(exc)})") from None
     else:
         raise SimdiffError(f"{path}: no such file")
     network = build_network(config)
+    check_weights(folder, network.state_dict(), tensors)
+    check_finite(path, tensors)
     own = set(network.state_dict())
     extra = {k: v.float() if v.is_floating_point() else v for k, v in tensors.items() if k not in own}
     network.load_state_dict({k: v for k, v in tensors.items() if k in own}, strict=True)
     return network.to(device), config, extra
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def read_tensors(path: str | os.PathLike[str]) -> dict[str, Tensor]:
+    """All tensors of safetensors file ``path`` on the CPU.
+
+    Raises:
+        SimdiffError: the file is missing, truncated or not safetensors (a header claiming more bytes than the file
+            holds included); one line naming the file.
+    """
+    try:
+        return load_file(str(path), device="cpu")
+    except Exception as exc:  # safetensors raises its own SafetensorError, OSError, or MemoryError on a huge header
+        raise SimdiffError(f"{Path(path).parent}: cannot load model: {Path(path).name} is not a readable safetensors "
+                           f"file ({_first_line(exc)})") from None
+
+
+def check_finite(path: str | os.PathLike[str], tensors: Mapping[str, Tensor]) -> None:
+    """Refuse weights holding NaN or infinite values (sampling would give nothing but NaN)."""
+    for key, value in tensors.items():
+        if value.is_floating_point() and not bool(torch.isfinite(value).all()):
+            what = "NaN" if bool(torch.isnan(value).any()) else "infinite"
+            raise SimdiffError(f"{path}: weight {key} has {what} values")
+
+
+EXTRA_PREFIXES: tuple[str, ...] = ("normalizer.",)
+"""Tensors a model file holds beside the network's weights (the feature Mean/Std)."""
+
+
+def check_weights(folder: str | os.PathLike[str], expected: dict[str, Tensor], tensors: dict[str, Tensor]) -> None:
+    """Refuse weights that do not match ``config.json``'s network: a tensor missing, one left over, or one of another
+    shape (a config saying 2 layers beside 8-layer weights would otherwise load and generate nonsense)."""
+    where = f"{folder}: config.json does not match {WEIGHTS_NAME}"
+    missing = [k for k in expected if k not in tensors]
+    if missing:
+        raise SimdiffError(f"{where}: {len(missing)} weight(s) the config describes are absent, e.g. {missing[0]!r}")
+    extra = [k for k in tensors if k not in expected and not k.startswith(EXTRA_PREFIXES)]
+    if extra:
+        raise SimdiffError(f"{where}: {len(extra)} weight(s) the config does not describe, e.g. {extra[0]!r}")
+    for k, v in expected.items():
+        if tuple(tensors[k].shape) != tuple(v.shape):
+            raise SimdiffError(f"{where}: {k!r} is {tuple(tensors[k].shape)} in the file, {tuple(v.shape)} by the "
+                               "config")
 
 
 def export_backbone(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> Path:

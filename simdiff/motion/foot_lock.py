@@ -75,7 +75,7 @@ def lock_feet(features: torch.Tensor, lengths: torch.Tensor | None = None, stren
     f[:, :-1, 2] += dz
     # Joint velocities at row t-1 (the step t-1 -> t of every joint, in the frame of yaw(t-1)): the same shift.
     vx, vz = yaw_rotate(half[:, :-1], shift[..., 0], shift[..., 1])
-    vel = f[:, :-1, SLICES["vel"]].reshape(b, t - 1, -1, 3)
+    vel = f[:, :-1, SLICES["vel"]].reshape(b, t - 1, -1, 3).clone()  # a copy: with T = 2 the reshape is a view
     vel[..., 0] += vx[..., None]
     vel[..., 2] += vz[..., None]
     f[:, :-1, SLICES["vel"]] = vel.reshape(b, t - 1, -1)

@@ -17,6 +17,10 @@ MAX_FRAMES: int = 196
 MIN_FRAMES: int = 40
 """Shortest clip kept by MDM's loader (2 s)."""
 
+MIN_GENERATE_FRAMES: int = 10
+"""Shortest motion ``generate``, ``sample`` and the viewer make (0.5 s): the features' velocities, the foot cleanup
+and the BVH need several frames, and the model saw no clip shorter than :data:`MIN_FRAMES`."""
+
 JOINT_NAMES: tuple[str, ...] = (
     "pelvis", "left_hip", "right_hip", "spine1", "left_knee", "right_knee", "spine2",
     "left_ankle", "right_ankle", "spine3", "left_foot", "right_foot", "neck",

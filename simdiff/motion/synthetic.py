@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from simdiff.motion import quaternion as Q
 from simdiff.motion.kinematics import forward_kinematics
 from simdiff.motion.skeleton import CANONICAL_OFFSETS, FPS, NUM_JOINTS
 

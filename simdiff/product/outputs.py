@@ -1,4 +1,5 @@
-"""Files ``simdiff generate`` writes: joints/features ``.npy``, BVH, stick video and ``generation.json``."""
+"""Files ``simdiff generate`` writes: joints/features ``.npy``, BVH, glTF (``.glb``), stick video and
+``generation.json``."""
 
 from __future__ import annotations
 
@@ -55,12 +56,14 @@ def write_motion(stem: Path, joints: np.ndarray, features: np.ndarray, formats: 
     """Write one motion next to ``stem`` (a path without suffix).
 
     Args:
-        stem: e.g. ``out/sample0`` → ``sample0_joints.npy``, ``sample0_features.npy``, ``sample0.bvh``.
+        stem: e.g. ``out/sample0`` → ``sample0_joints.npy``, ``sample0_features.npy``, ``sample0.bvh``,
+            ``sample0.glb``.
         joints: (T, 22, 3) float32 positions in metres, Y-up.
         features: (T, 263) float32 un-normalised HumanML3D features (one row per joint frame).
-        formats: kinds to write; ``npy`` (joints + features) and ``bvh`` are handled here.
+        formats: kinds to write; ``npy`` (joints + features), ``bvh`` and ``glb`` (skinned body on the motion's
+            own mean skeleton, :func:`simdiff.motion.rigid.fit`) are handled here.
     Returns:
-        kind → written path (``joints``, ``features``, ``bvh``).
+        kind → written path (``joints``, ``features``, ``bvh``, ``glb``).
     """
     written: dict[str, Path] = {}
     if "npy" in formats:
@@ -72,6 +75,11 @@ def write_motion(stem: Path, joints: np.ndarray, features: np.ndarray, formats: 
         from simdiff.motion.io.bvh_writer import write_bvh
 
         written["bvh"] = write_bvh(stem.with_name(stem.name + ".bvh"), joints, fps=fps)
+    if "glb" in formats:
+        from simdiff.motion.io.gltf_writer import write_glb
+        from simdiff.motion.rigid import fit
+
+        written["glb"] = write_glb(stem.with_name(stem.name + ".glb"), fit(joints, None), fps=fps)
     return written
 
 

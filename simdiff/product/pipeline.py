@@ -19,6 +19,7 @@ import numpy as np
 
 from simdiff import __version__
 from simdiff.errors import SimdiffError
+from simdiff.fsio import output_set
 from simdiff.motion.skeleton import FPS
 from simdiff.product.outputs import env_label, render_video, write_metadata, write_motion
 from simdiff.product.request import GenerationRequest
@@ -29,7 +30,7 @@ if TYPE_CHECKING:
     from simdiff.product.finisher import Finisher
 
 FEATURES_NOTE = ("(T, 263) float32 un-normalised HumanML3D features, one row per joint frame as the model "
-                 "samples them (MDM convention); joints = simdiff.motion.features.features_to_joints(features)")
+                 "samples them (MDM convention); joints = simdiff.motion.rigid.joints_from_features(features)")
 
 
 @dataclass
@@ -96,7 +97,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
     """
     from tqdm.auto import tqdm
 
-    from simdiff.motion.features import features_to_joints
+    from simdiff.motion.rigid import joints_from_features
 
     simdiff_model = bool(generator.is_simdiff)
     envs: list[Environment | None] = list(request.envs) if simdiff_model else [None]
@@ -125,7 +126,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
     samples = []
     with timer.stage("decode"):
         for (c, k), f in zip(runs, features):
-            joints = np.asarray(features_to_joints(f), dtype=np.float32)
+            joints = joints_from_features(f)
             samples.append(Sample(c, k, request.seed + k, envs[c], f, joints))
     return samples
 
@@ -160,6 +161,8 @@ def write_outputs(samples: list[Sample], request: GenerationRequest, out_dir: Pa
             written.update(write_motion(stem, s.joints, s.features, [f for f in request.formats if f == "npy"]))
         with timer.stage("write_bvh"):
             written.update(write_motion(stem, s.joints, s.features, [f for f in request.formats if f == "bvh"]))
+        with timer.stage("write_glb"):
+            written.update(write_motion(stem, s.joints, s.features, [f for f in request.formats if f == "glb"]))
         if s.simulated is not None:
             with timer.stage("write_simulated"):
                 written.update(write_simulated(stem, s.simulated, list(request.formats)))
@@ -246,7 +249,8 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "edit_t": request.sampling.edit_t if simdiff_model else None,
         "foot_cleanup": CLEANUP_VERSION if request.sampling.foot_lock else None,
         "features_layout": FEATURES_NOTE,
-        "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order",
+        "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order; forward kinematics of "
+                         "rotations on one fixed skeleton per motion (bone lengths constant)",
         "samples": records,
         "videos": [p.name for p in videos],
         "threads": _torch_threads(),
@@ -310,6 +314,19 @@ def warm_simulator() -> threading.Thread:
     return thread
 
 
+def previous_outputs(out_dir: Path) -> set[str]:
+    """Names of the files an earlier ``generate`` listed in ``out_dir/generation.json`` (none when unreadable): a new
+    run into the same folder removes those it does not replace, so the folder holds one run."""
+    import json
+
+    try:
+        meta = json.loads((out_dir / "generation.json").read_text(encoding="utf-8"))
+        names = {n for rec in meta["samples"] for n in rec["files"].values()} | set(meta.get("videos", []))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return set()
+    return {n for n in names if isinstance(n, str) and n == Path(n).name and not n.startswith(".")}
+
+
 def run_generation(generator, request: GenerationRequest, out_dir: Path, model_dir: Path, timer: Timer,
                    quiet: bool = False, simulate: bool = False,
                    force: bool = False, finisher: Finisher | None = None) -> tuple[dict, list[Path]]:
@@ -326,13 +343,20 @@ def run_generation(generator, request: GenerationRequest, out_dir: Path, model_d
             simulate_samples(generator, samples, timer, force, finisher)
         except SimdiffError as exc:  # the generated motions are written all the same, then the error is raised
             failure = exc
-    files, videos = write_outputs(samples, request, out_dir, timer, quiet)
-    meta = metadata(request, generator, model_dir, samples, files, videos, timer)
-    if simulate:  # where the finish ran: its CPU seconds are the worker's (in each sample's tracking), not this process's
-        meta["simulate_workers"] = finisher.workers if finisher is not None else 0
-    if failure is not None:
-        meta["simulate_error"] = str(failure)
-    meta_path = write_metadata(out_dir / "generation.json", meta)
+    earlier = previous_outputs(out_dir)
+    with output_set(out_dir, last="generation.json") as stage:  # every file appears together, or none
+        files, videos = write_outputs(samples, request, stage, timer, quiet)
+        meta = metadata(request, generator, model_dir, samples, files, videos, timer)
+        if simulate:  # where the finish ran: its CPU seconds are the worker's (in each sample's tracking)
+            meta["simulate_workers"] = finisher.workers if finisher is not None else 0
+        if failure is not None:
+            meta["simulate_error"] = str(failure)
+        write_metadata(stage / "generation.json", meta)
+    meta_path = out_dir / "generation.json"
+    files = [{kind: out_dir / p.name for kind, p in written.items()} for written in files]
+    videos = [out_dir / p.name for p in videos]
+    for name in earlier - {p.name for written in files for p in written.values()} - {p.name for p in videos}:
+        (out_dir / name).unlink(missing_ok=True)  # an earlier run's samples that this run did not replace
     if failure is not None:
         raise SimdiffError(f"{failure} (the generated motions and generation.json are written in {out_dir})")
     paths = {p for written in files for p in written.values()} | set(videos)

@@ -8,9 +8,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from simdiff.diffusion.config import SamplingConfig
+from simdiff.diffusion.config import MAX_SEED, SamplingConfig
 from simdiff.errors import SimdiffError
-from simdiff.motion.skeleton import FPS, MAX_FRAMES
+from simdiff.motion.skeleton import FPS, MAX_FRAMES, MIN_GENERATE_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, Environment
 
 MAX_SAMPLES: int = 64
@@ -19,8 +19,9 @@ MAX_COMPARE: int = 8
 """Most environments in one ``--compare`` video."""
 COMPARE_KEYS: tuple[str, ...] = ("gravity", "wind_x", "wind_y")
 """Environment components ``--compare`` can vary."""
-FORMATS: tuple[str, ...] = ("npy", "bvh", "gif", "mp4")
-"""Output kinds: ``npy`` = joints + features, ``bvh``, and the ``gif``/``mp4`` stick video."""
+FORMATS: tuple[str, ...] = ("npy", "bvh", "glb", "gif", "mp4")
+"""Output kinds: ``npy`` = joints + features, ``bvh``, ``glb`` (glTF binary, skinned body), and the ``gif``/``mp4``
+stick video."""
 DEFAULT_FORMATS: tuple[str, ...] = ("npy", "bvh", "gif")
 VIDEO_FORMATS: tuple[str, ...] = ("gif", "mp4")
 MAX_PROMPT_CHARS: int = 500
@@ -33,7 +34,7 @@ class GenerationRequest:
 
     Attributes:
         text: the prompt (stripped, non-empty).
-        frames: motion length in frames at 20 fps, 1..196.
+        frames: motion length in frames at 20 fps, 10..196.
         envs: the environments φ to generate under: one, or several for ``--compare``.
         compare: the φ component varied across ``envs`` (``gravity``, ``wind_x``, ``wind_y``) or None.
         seed: noise seed of sample 0; sample k uses ``seed + k`` (the same under every environment).
@@ -82,16 +83,16 @@ def frames_from(length_s: float | None = None, default: int = 120) -> int:
     """Frames at 20 fps from ``--length SECONDS`` (``default`` frames when None).
 
     Raises:
-        SimdiffError: non-finite, or outside 1..196 frames (0.05..9.8 s).
+        SimdiffError: non-finite, or outside 10..196 frames (0.5..9.8 s).
     """
     if length_s is None:
         return default
     if not math.isfinite(length_s):
         raise SimdiffError(f"--length must be a number of seconds, got {length_s}")
     n = int(round(length_s * FPS))
-    if not 1 <= n <= MAX_FRAMES:
-        raise SimdiffError(f"--length {length_s:g} s is {n} frames; it must be 1..{MAX_FRAMES} frames "
-                           f"({1 / FPS:g}..{MAX_FRAMES / FPS:g} s at {FPS} fps)")
+    if not MIN_GENERATE_FRAMES <= n <= MAX_FRAMES:
+        raise SimdiffError(f"--length {length_s:g} s is {n} frames; it must be {MIN_GENERATE_FRAMES}..{MAX_FRAMES} "
+                           f"frames ({MIN_GENERATE_FRAMES / FPS:g}..{MAX_FRAMES / FPS:g} s at {FPS} fps)")
     return n
 
 
@@ -174,8 +175,8 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
                   sampling: SamplingConfig = SamplingConfig(), compare: str | None = None,
                   formats: str | None = None, force: bool = False) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
-    if seed < 0:
-        raise SimdiffError(f"--seed must be ≥ 0, got {seed}")
+    if not 0 <= seed <= MAX_SEED:
+        raise SimdiffError(f"--seed must be in 0..{MAX_SEED}, got {seed}")
     if not 1 <= num_samples <= MAX_SAMPLES:
         raise SimdiffError(f"--num-samples must be 1..{MAX_SAMPLES}, got {num_samples}")
     spec = parse_compare(compare) if compare is not None else None

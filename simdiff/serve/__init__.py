@@ -6,7 +6,12 @@
 
 from simdiff.serve.params import GenerateParams, parse_generate
 from simdiff.serve.server import ViewerServer
-from simdiff.serve.service import ListedMotion, ModelUnavailable, MotionService, read_listed
+from simdiff.serve.service import (
+           ListedMotion,
+           ModelUnavailable,
+           MotionService,
+           read_listed,
+)
 
 __all__ = ["GenerateParams", "ListedMotion", "ModelUnavailable", "MotionService", "ViewerServer", "parse_generate",
            "read_listed"]

@@ -1,24 +1,27 @@
 """Validated parameters of one generation request (the viewer's sliders and prompt box).
 
 Ranges match the ``simdiff generate`` CLI: gravity g_z ∈ [−20, −1] m/s², |wind| ≤ 10 N,
-adapter strength α ∈ [0, 2], length ≤ 9.8 s at 20 fps.
+adapter strength α ∈ [0, 2], length 0.5 .. 9.8 s at 20 fps.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
-from typing import Any, Mapping
+from typing import Any
 
 from simdiff.errors import SimdiffError
+from simdiff.motion.skeleton import FPS, MAX_FRAMES, MIN_GENERATE_FRAMES
 from simdiff.product.request import MAX_PROMPT_CHARS, check_text
-from simdiff.motion.skeleton import FPS, MAX_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND
 
 ALPHA_RANGE: tuple[float, float] = (0.0, 2.0)
 """Adapter strength α bounds (0 = backbone only, 1 = trained strength)."""
 MAX_SECONDS: float = MAX_FRAMES / FPS
 """Longest motion in seconds (9.8 s)."""
+MIN_SECONDS: float = MIN_GENERATE_FRAMES / FPS
+"""Shortest motion in seconds (10 frames at 20 fps)."""
 MAX_STEPS: int = 200
 """Most DDIM steps a request from the page may ask for (the default is 50): one request holds the
 model for at most about 4× a default generation, so a queue of them drains in bounded time."""
@@ -72,8 +75,8 @@ class GenerateParams:
 
     @property
     def frames(self) -> int:
-        """Motion length in frames at 20 fps (1..196)."""
-        return max(1, min(MAX_FRAMES, round(self.seconds * FPS)))
+        """Motion length in frames at 20 fps (10..196)."""
+        return max(round(MIN_SECONDS * FPS), min(MAX_FRAMES, round(self.seconds * FPS)))
 
     def as_dict(self) -> dict[str, Any]:
         """Plain JSON-able values."""
@@ -84,16 +87,28 @@ def limits() -> dict[str, Any]:
     """The accepted ranges, for the page's sliders (units: m/s², N, s)."""
     return {
         "gravity": list(GRAVITY_RANGE), "wind": MAX_WIND, "alpha": list(ALPHA_RANGE), "seconds": MAX_SECONDS,
-        "fps": FPS, "steps": MAX_STEPS, "guidance": list(GUIDANCE_RANGE), "text": MAX_TEXT,
+        "min_seconds": MIN_SECONDS, "fps": FPS, "steps": MAX_STEPS, "guidance": list(GUIDANCE_RANGE), "text": MAX_TEXT,
         "env_guidance": list(ENV_GUIDANCE_RANGE), "edit_t": [0, 999],
     }
 
 
+def _show(value: Any, limit: int = 40) -> str:
+    """``repr(value)`` cut to ``limit`` characters (messages stay one short line)."""
+    text = repr(value) if not isinstance(value, int) or abs(value) < 10**30 else f"a {len(str(abs(value)))}-digit integer"
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
 def _number(body: Mapping[str, Any], key: str, default: float) -> float:
     value = body.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise SimdiffError(f"{key} must be a finite number, got {value!r}")
-    return float(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SimdiffError(f"{key} must be a finite number, got {_show(value)}")
+    try:
+        number = float(value)
+    except OverflowError:
+        number = math.inf
+    if not math.isfinite(number):
+        raise SimdiffError(f"{key} must be a finite number, got {_show(value)}")
+    return number
 
 
 def _integer(body: Mapping[str, Any], key: str, default: int | None) -> int | None:
@@ -103,13 +118,14 @@ def _integer(body: Mapping[str, Any], key: str, default: int | None) -> int | No
     if isinstance(value, float) and value.is_integer():
         value = int(value)
     if isinstance(value, bool) or not isinstance(value, int):
-        raise SimdiffError(f"{key} must be an integer, got {value!r}")
+        raise SimdiffError(f"{key} must be an integer, got {_show(value)}")
     return value
 
 
 def _check_range(key: str, value: float, low: float, high: float, unit: str = "") -> None:
     if not low <= value <= high:
-        raise SimdiffError(f"{key} must be in [{low:g}, {high:g}]{unit}, got {value:g}")
+        shown = f"{value:g}" if isinstance(value, float) or abs(value) < 10**30 else _show(value)
+        raise SimdiffError(f"{key} must be in [{low:g}, {high:g}]{unit}, got {shown}")
 
 
 def parse_generate(body: Any) -> GenerateParams:
@@ -126,10 +142,15 @@ def parse_generate(body: Any) -> GenerateParams:
     known = set(GenerateParams.__dataclass_fields__)
     unknown = sorted(set(body) - known)
     if unknown:
-        raise SimdiffError(f"unknown field {unknown[0]!r} (known: {', '.join(sorted(known))})")
+        raise SimdiffError(f"unknown field {_show(unknown[0])} (known: {', '.join(sorted(known))})")
     text = body.get("text")
     if not isinstance(text, str) or not text.strip():
-        raise SimdiffError(f"text must be a non-empty prompt, got {str(text)[:40]!r}")
+        raise SimdiffError(f"text must be a non-empty prompt, got {_show(text)}")
+    if not text.isascii():
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError:
+            raise SimdiffError("text must be valid Unicode (it holds a lone surrogate escape)") from None
     text = check_text(text)
     defaults = GenerateParams(text=text)
     gravity = _number(body, "gravity", defaults.gravity)
@@ -139,14 +160,13 @@ def parse_generate(body: Any) -> GenerateParams:
         wind[key] = _number(body, key, 0.0)
         _check_range(key, wind[key], -MAX_WIND, MAX_WIND, " N")
     seconds = _number(body, "seconds", defaults.seconds)
-    if not 1.0 / FPS <= seconds <= MAX_SECONDS:
-        raise SimdiffError(f"seconds must be in [{1.0 / FPS:g}, {MAX_SECONDS:g}], got {seconds:g}")
+    _check_range("seconds", seconds, MIN_SECONDS, MAX_SECONDS)
     seed = _integer(body, "seed", 0)
     if seed is None or not 0 <= seed < 2**63:
-        raise SimdiffError(f"seed must be a non-negative integer, got {seed!r}")
+        raise SimdiffError(f"seed must be a non-negative integer below 2**63, got {_show(seed)}")
     simulate = body.get("simulate", False)
     if not isinstance(simulate, bool):
-        raise SimdiffError(f"simulate must be true or false, got {simulate!r}")
+        raise SimdiffError(f"simulate must be true or false, got {_show(simulate)}")
     sampling: dict[str, Any] = {}
     for key, (low, high) in {"steps": (1, MAX_STEPS), "edit_t": (0, 999)}.items():
         value = _integer(body, key, None)

@@ -7,7 +7,13 @@ from typing import Any
 import numpy as np
 
 from simdiff.errors import SimdiffError
-from simdiff.motion.skeleton import FPS, JOINT_NAMES, KINEMATIC_CHAIN, NUM_JOINTS, PARENTS
+from simdiff.motion.skeleton import (
+    FPS,
+    JOINT_NAMES,
+    KINEMATIC_CHAIN,
+    NUM_JOINTS,
+    PARENTS,
+)
 
 DECIMALS: int = 4
 """Joint coordinates are rounded to 0.1 mm to keep responses small."""

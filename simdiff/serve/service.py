@@ -6,21 +6,25 @@ module holds the state (one model, one lock, the files named on the command line
 
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 import threading
 import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any
 
 import numpy as np
 
 from simdiff import __version__
 from simdiff.diffusion.config import SamplingConfig
-from simdiff.errors import SimdiffError
+from simdiff.errors import NonFiniteResult, SimdiffError
+from simdiff.motion.skeleton import FPS
 from simdiff.serve.params import GenerateParams, limits
 from simdiff.serve.payload import motion_payload, skeleton_info
+from simdiff.serve.wire import BodyCache
 
 DEFAULT_PROMPT: str = "a person walks forward"
 UPLOAD_SUFFIXES: tuple[str, ...] = (".npy", ".bvh", ".json", ".txt")
@@ -31,6 +35,17 @@ Progress = Callable[[Iterable[Any]], Iterable[Any]]
 
 MAX_QUEUE: int = 4
 """Generation requests that may wait behind the running one before the API answers 429."""
+CANCEL_POLL_S: float = 0.1
+"""How often a queued generation request checks whether its client went away."""
+MAX_OPEN_FRAMES: int = 12_000
+"""Longest motion an upload or listed file may have (10 minutes at 20 fps): bounds the answer (about 6 MB of
+JSON) and the memory it takes to build it. Longer files are refused with :class:`MotionTooLong` (413)."""
+UPLOADS_AT_ONCE: int = 2
+"""Uploads read (parsed) at the same time; more are refused with :class:`UploadsBusy` (503)."""
+MAX_NAME_BYTES: int = 255
+"""Longest upload file name in UTF-8 bytes (a file system's limit)."""
+MAX_BODIES: int = 4
+"""Motions whose skinned body ``GET /api/body/<n>.glb`` still answers (see :class:`~simdiff.serve.wire.BodyCache`)."""
 
 
 class ModelUnavailable(SimdiffError):
@@ -50,6 +65,18 @@ class QueueFull(SimdiffError):
                          "try again in a moment")
         self.waiting = waiting
         self.limit = limit
+
+
+class GenerationCancelled(SimdiffError):
+    """The client went away: its queued or running generation was dropped (nothing is answered)."""
+
+
+class UploadsBusy(SimdiffError):
+    """:data:`UPLOADS_AT_ONCE` uploads are being read already (the API answers 503)."""
+
+
+class MotionTooLong(SimdiffError):
+    """An opened motion has more than :data:`MAX_OPEN_FRAMES` frames (the API answers 413)."""
 
 
 @dataclass(frozen=True)
@@ -112,6 +139,9 @@ class MotionService:
         self.max_queue = max_queue
         self._admit = threading.Lock()
         self._pending = 0  # running + waiting generation requests
+        self._request = threading.local()  # the handler thread's ``cancelled`` check (see generate)
+        self._uploads = threading.BoundedSemaphore(UPLOADS_AT_ONCE)
+        self.bodies = BodyCache(MAX_BODIES)
 
     # -- model -------------------------------------------------------------------------------
 
@@ -131,7 +161,7 @@ class MotionService:
 
             config = self._generator.config if self._generator is not None else read_config(self.model_dir)
             status["kind"] = self._kind(config)
-        except Exception as exc:  # unreadable config.json: reported, the page shows it
+        except Exception as exc:  # noqa: BLE001 (unreadable config.json: reported, the page shows it)
             status["error"] = f"{self.model_dir}: cannot read config.json: {exc}".splitlines()[0]
             return status
         status["env"] = status["kind"] == "simdiff"
@@ -193,15 +223,21 @@ class MotionService:
             "skeleton": skeleton_info(),
         }
 
-    def generate(self, params: GenerateParams) -> dict[str, Any]:
+    def generate(self, params: GenerateParams, cancelled: Callable[[], bool] | None = None) -> dict[str, Any]:
         """``POST /api/generate``: one motion from the prompt and φ; requests run one at a time.
 
         At most ``max_queue`` requests wait behind the running one; the answer's ``meta`` gives the
         request's ``queue_position`` (requests ahead when it arrived) and ``waited_s``.
 
+        Args:
+            params: the validated request.
+            cancelled: polled while the request waits (every :data:`CANCEL_POLL_S`) and at every sampler
+                step; True drops the request (the server passes "the client closed its connection").
         Raises:
             QueueFull: ``max_queue`` requests are already waiting.
             ModelUnavailable: no loadable model.
+            GenerationCancelled: ``cancelled()`` turned True.
+            NonFiniteResult: the sampler produced NaN or infinite values.
             SimdiffError: the model rejected the request.
         """
         with self._admit:
@@ -210,9 +246,11 @@ class MotionService:
             position = self._pending  # requests ahead of this one
             self._pending += 1
         queued = time.perf_counter()
+        self._request.cancelled = cancelled
         try:
             return self._generate_admitted(params, position, queued)
         finally:
+            self._request.cancelled = None
             with self._admit:
                 self._pending -= 1
 
@@ -220,23 +258,52 @@ class MotionService:
         """``{pending, limit}``: generation requests running or waiting, and how many may wait."""
         return {"pending": self._pending, "limit": self.max_queue}
 
-    def _generate_admitted(self, params: GenerateParams, position: int, queued: float) -> dict[str, Any]:
-        from simdiff.motion.features import features_to_joints
+    def _check_cancelled(self, when: str) -> None:
+        cancelled = getattr(self._request, "cancelled", None)
+        if cancelled is not None and cancelled():
+            raise GenerationCancelled(f"the client went away {when}: generation dropped")
 
-        with self._lock:
+    def _wait_turn(self) -> None:
+        """Take the model lock, giving up when the request is cancelled while it waits."""
+        while not self._lock.acquire(timeout=CANCEL_POLL_S):
+            self._check_cancelled("while queued")
+        try:
+            self._check_cancelled("while queued")
+        except GenerationCancelled:
+            self._lock.release()
+            raise
+
+    def _steps(self, steps: Iterable[Any]) -> Iterator[Any]:
+        """The sampler's timesteps through ``progress``, checking for cancellation before each step."""
+        for step in self._progress(steps) if self._progress is not None else steps:
+            self._check_cancelled("during sampling")
+            yield step
+
+    def _generate_admitted(self, params: GenerateParams, position: int, queued: float) -> dict[str, Any]:
+        from simdiff.motion.rigid import joints_from_features
+
+        self._wait_turn()
+        try:
             generator = self._load_locked()
             uses_env = generator.is_simdiff
             start = time.perf_counter()
             waited = start - queued
             config = self.sampling(params)
-            out = generator.generate([params.text], params.frames, config,
-                                     env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
-                                     seed=params.seed, progress=self._progress)
+            try:
+                out = generator.generate([params.text], params.frames, config,
+                                         env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
+                                         seed=params.seed, progress=self._steps)
+            except GenerationCancelled:
+                raise
             elapsed = time.perf_counter() - start
             self._count += 1
             number = self._count
+        finally:
+            self._lock.release()
         features = out.clips()[0].detach().cpu().numpy().astype(np.float32)
-        joints = features_to_joints(features)
+        _check_finite(features)
+        joints = joints_from_features(features)  # the joints every command writes
+        _check_finite(joints)
         from simdiff.product.pipeline import floor_contact
 
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
@@ -249,49 +316,151 @@ class MotionService:
             from simdiff.serve.payload import DECIMALS
             from simdiff.sim.env import Environment
 
+            self._check_cancelled("before the simulation")
             env = Environment(params.gravity, params.wind_x, params.wind_y) if uses_env else None
             sim = simulate_finish(np.asarray(joints), env, normalizer=normalizer_of(generator))
+            _check_finite(sim.joints)
             meta["simulated"] = sim.tracking
             meta["generated_joints"] = np.round(np.asarray(joints, dtype=np.float64), DECIMALS).tolist()
             meta["elapsed_s"] = round(time.perf_counter() - start, 3)
-            return motion_payload(sim.joints, meta)
-        return motion_payload(joints, meta)
+            return self._answer(sim.joints, meta)
+        return self._answer(joints, meta)
+
+    def _answer(self, joints: np.ndarray, meta: dict[str, Any]) -> dict[str, Any]:
+        """:func:`motion_payload` plus ``body``: where the page gets the motion's skinned body (:meth:`body`)."""
+        payload = motion_payload(joints, meta)
+        payload["body"] = f"/api/body/{self.bodies.add(np.asarray(payload['joints']))}.glb"
+        return payload
+
+    def body(self, number: int) -> bytes | None:
+        """``GET /api/body/<number>.glb``: the skinned body of an answer, built from its joints as sent; None when
+        it is not among the last :data:`MAX_BODIES` answers."""
+        return self.bodies.glb(number)
 
     def open_listed(self, index: int) -> dict[str, Any]:
-        """``GET /api/files/<index>``: a motion named on the command line."""
+        """``GET /api/files/<index>``: a motion named on the command line.
+
+        Raises:
+            SimdiffError: no such index.
+            MotionTooLong: the file has more than :data:`MAX_OPEN_FRAMES` frames.
+        """
         if not 0 <= index < len(self.files):
             raise SimdiffError(f"no listed file {index} (there are {len(self.files)})")
         item = self.files[index]
-        return motion_payload(item.joints, {"source": "file", "name": item.name, "path": str(item.path)})
+        _check_frames(item.name, int(item.joints.shape[0]))
+        return self._answer(item.joints, {"source": "file", "name": item.name, "path": str(item.path)})
 
-    def open_upload(self, name: str, data: bytes) -> dict[str, Any]:
-        """``POST /api/open``: read an uploaded motion file (written to a temporary folder first).
+    @staticmethod
+    def upload_name(name: str) -> str:
+        """The name an upload is read under (its base name), checked before its bytes are read.
+
+        Raises:
+            SimdiffError: no name, control characters (NUL, newline), over :data:`MAX_NAME_BYTES`, or an
+                unsupported extension.
+        """
+        if any(ord(c) < 32 or ord(c) == 127 for c in name):
+            raise SimdiffError("upload name must not contain control characters (NUL, newline, ...)")
+        base = Path(name.replace("\\", "/")).name.strip()
+        if not base or base in (".", ".."):
+            raise SimdiffError(f"upload needs a file name, got {name[:40]!r}")
+        try:
+            size = len(base.encode("utf-8"))
+        except UnicodeEncodeError:
+            raise SimdiffError("upload name is not valid text") from None
+        if size > MAX_NAME_BYTES:
+            raise SimdiffError(f"upload name {base[:24]!r}... is {size} bytes long; the limit is {MAX_NAME_BYTES}")
+        suffix = Path(base).suffix.lower()
+        if suffix not in UPLOAD_SUFFIXES:
+            raise SimdiffError(f"{base}: unsupported file type {suffix or '(none)'!r}; open "
+                               ".npy joints (T, 22, 3) or features (T, 263), .bvh, or DeepMimic .txt/.json")
+        return base
+
+    def open_upload(self, name: str, data: bytes | bytearray | memoryview) -> dict[str, Any]:
+        """``POST /api/open``: read an uploaded motion file (written to a temporary folder, then
+        :meth:`open_upload_file`).
 
         Args:
             name: the file's name on the user's machine (its extension picks the reader).
             data: the file's bytes.
         Raises:
-            SimdiffError: unsupported type or unreadable file; the message names ``name``, not the temp path.
+            SimdiffError, MotionTooLong, UploadsBusy: see :meth:`upload_name` and :meth:`open_upload_file`.
         """
-        from simdiff.motion.io import load_joints
-
-        base = Path(name.replace("\\", "/")).name.strip()
-        suffix = Path(base).suffix.lower()
-        if not base or base in (".", ".."):
-            raise SimdiffError(f"upload needs a file name, got {name!r}")
-        if suffix not in UPLOAD_SUFFIXES:
-            raise SimdiffError(f"{base}: unsupported file type {suffix or '(none)'!r}; open "
-                               ".npy joints (T, 22, 3) or features (T, 263), .bvh, or DeepMimic .txt/.json")
-        if not data:
-            raise SimdiffError(f"{base}: empty file")
+        base = self.upload_name(name)
         with tempfile.TemporaryDirectory(prefix="simdiff-serve-") as tmp:
             path = Path(tmp) / base
             path.write_bytes(data)
-            try:
-                joints = load_joints(path)
-            except SimdiffError as exc:
-                raise SimdiffError(str(exc).replace(str(path), base)) from None
-            except Exception as exc:  # a reader tripping over garbage is still bad user input
-                detail = str(exc).replace(str(path), base).splitlines()
-                raise SimdiffError(f"{base}: cannot read: {type(exc).__name__}: {detail[0] if detail else ''}") from None
-        return motion_payload(joints, {"source": "upload", "name": base, "bytes": len(data)})
+            return self.open_upload_file(base, path)
+
+    def open_upload_file(self, name: str, path: Path) -> dict[str, Any]:
+        """Read an upload already written to ``path`` (named ``name``, from :meth:`upload_name`, in a temporary
+        folder): at most :data:`UPLOADS_AT_ONCE` at a time, since a reader can take several times the file's size.
+
+        Raises:
+            SimdiffError: empty or unreadable file; the message names ``name``, never ``path``.
+            MotionTooLong: more than :data:`MAX_OPEN_FRAMES` frames (from a ``.npy`` or ``.bvh`` header before
+                the file is parsed, else after).
+            UploadsBusy: :data:`UPLOADS_AT_ONCE` uploads are being read already.
+        """
+        from simdiff.motion.io import load_joints
+
+        size = path.stat().st_size
+        if not size:
+            raise SimdiffError(f"{name}: empty file")
+
+        def clean(text: str) -> str:
+            return text.replace(str(path), name).replace(str(path.parent), "")
+
+        if not self._uploads.acquire(blocking=False):
+            raise UploadsBusy(f"the server is busy reading {UPLOADS_AT_ONCE} other uploads; try again in a moment")
+        try:
+            _check_frames(name, _frames_in_header(path))
+            joints = load_joints(path)
+        except MotionTooLong:
+            raise
+        except SimdiffError as exc:
+            raise SimdiffError(clean(str(exc))) from None
+        except Exception as exc:  # noqa: BLE001 (a reader tripping over garbage is bad input)
+            detail = clean(str(exc)).splitlines()
+            raise SimdiffError(f"{name}: cannot read: {type(exc).__name__}: {detail[0] if detail else ''}") from None
+        finally:
+            self._uploads.release()
+        _check_frames(name, int(joints.shape[0]))
+        return self._answer(joints, {"source": "upload", "name": name, "bytes": size})
+
+
+def _check_finite(values: Any) -> None:
+    if not np.all(np.isfinite(np.asarray(values))):
+        raise NonFiniteResult("the sampler produced non-finite values with these settings; try other settings "
+                              "(fewer steps, lower guidance) or another seed")
+
+
+def _check_frames(name: str, frames: int | None) -> None:
+    if frames is not None and frames > MAX_OPEN_FRAMES:
+        raise MotionTooLong(f"{name}: {frames} frames ({frames / FPS:.0f} s at {FPS} fps) is over the viewer's "
+                            f"limit of {MAX_OPEN_FRAMES} frames ({MAX_OPEN_FRAMES / FPS:.0f} s)")
+
+
+def _frames_in_header(path: Path) -> int | None:
+    """Frames at 20 fps that a ``.npy`` or ``.bvh`` file declares in its header (None: not known before parsing)."""
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".npy":
+            with path.open("rb") as handle:
+                version = np.lib.format.read_magic(handle)
+                read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+                shape = read(handle)[0]
+            return int(shape[0]) if len(shape) else None
+        if suffix == ".bvh":
+            frames = None
+            with path.open("r", encoding="utf-8", errors="replace") as handle:
+                for number, line in enumerate(handle):
+                    words = line.split()
+                    if words[:1] == ["Frames:"] and len(words) == 2:
+                        frames = int(words[1])
+                    elif words[:2] == ["Frame", "Time:"] and len(words) == 3 and frames is not None:
+                        return math.ceil(frames * float(words[2]) * FPS)
+                    elif number > 100_000:
+                        return None
+    except (ValueError, OSError, OverflowError):
+        return None  # the reader names what is wrong
+    return None

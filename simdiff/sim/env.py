@@ -27,6 +27,11 @@ GRAVITY_RANGE: tuple[float, float] = (-20.0, -1.0)
 """Validated gravity range (m/s²)."""
 MAX_WIND: float = 10.0
 """Validated wind magnitude bound (N)."""
+MIN_FORCED_GRAVITY: float = -100.0
+MAX_GRAVITY: float = -0.1
+"""Gravity bounds (m/s²) even with ``--force``: beyond them the simulator and the model give no motion."""
+MAX_FORCED_WIND: float = 200.0
+"""Wind component bound (N) even with ``--force``."""
 
 
 @dataclass(frozen=True)
@@ -47,7 +52,7 @@ class Environment:
         """Check the validated ranges g_z ∈ [−20, −1] and |w| ≤ 10 N.
 
         Args:
-            force: skip the range check (values must still be finite, gravity < 0).
+            force: widen the check to g_z ∈ [−100, −0.1] and |w_x|, |w_y| ≤ 200 N.
         Returns:
             self, for chaining.
         Raises:
@@ -58,6 +63,10 @@ class Environment:
             raise SimdiffError(f"environment values must be finite, got {self}")
         if self.gravity >= 0:
             raise SimdiffError(f"gravity must be negative (m/s², Earth -9.81), got {self.gravity}")
+        if not MIN_FORCED_GRAVITY <= self.gravity <= MAX_GRAVITY:
+            raise SimdiffError(f"gravity {self.gravity:g} m/s² is outside [{MIN_FORCED_GRAVITY:g}, {MAX_GRAVITY:g}]")
+        if max(abs(self.wind_x), abs(self.wind_y)) > MAX_FORCED_WIND:
+            raise SimdiffError(f"wind ({self.wind_x:g}, {self.wind_y:g}) N has a component beyond ±{MAX_FORCED_WIND:g} N")
         if force:
             return self
         lo, hi = GRAVITY_RANGE

@@ -238,7 +238,6 @@ def _geoms(body: str, offs: dict[str, np.ndarray], cfg: HumanoidConfig) -> list[
     """Geoms of one body, in that body's frame (world-aligned at rest)."""
     g = group_of(body)
     m = _MASSES[g]
-    side = 1.0 if body.startswith("L_") else -1.0
     children = [c for c, p in BODY_PARENT.items() if p == body]
     z = np.zeros(3)
     if body == "Pelvis":

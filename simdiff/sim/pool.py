@@ -6,6 +6,12 @@ instead of stopping the batch. The local process pool is kept alive across calls
 with :meth:`ProjectionPool.close` or use the pool as a context manager); each worker caps
 its BLAS / OpenMP / torch threads to one (:func:`limit_threads`) before its first task.
 
+Stopping: workers ignore SIGINT (a Ctrl-C reaches the whole process group; only the parent acts
+on it) and are terminated by the parent (:func:`stop_workers`); :func:`stop_signals` makes SIGTERM
+raise :class:`Interrupted` like Ctrl-C; a worker that dies (killed, out of memory) turns the
+pool's ``BrokenProcessPool`` into one-line :class:`WorkerDied`; :func:`stopped` prints the one
+line a command ends with and gives its exit status.
+
 A *projector* (:data:`Projector`) is any callable ``(motions, envs) -> iterable of
 (rollout | None, info)`` in input order; a :class:`ProjectionPool`'s :meth:`~ProjectionPool.imap`
 is one, the augmentation and the PhysDiff baseline take any (tests inject fakes).
@@ -13,17 +19,22 @@ is one, the augmentation and the PhysDiff baseline take any (tests inject fakes)
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
+import signal
 import sys
+import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.limits import MAX_WORKERS
 from simdiff.sim.retarget.config import RetargetConfig
 from simdiff.sim.env import Environment
 from simdiff.sim.fallback import FallbackConfig
@@ -63,6 +74,7 @@ class PoolConfig:
     retime: RetimeConfig | None = None
     tracker_config: PDTrackerConfig | None = None
     fallback: FallbackConfig | None = None
+
 
 
 Result = tuple[np.ndarray | None, Any]
@@ -108,9 +120,135 @@ def exit_with_parent(parent: int, period_s: float = 1.0) -> None:
 
 
 def worker_init(threads: int, parent: int) -> None:
-    """Pool initializer: :func:`limit_threads` and :func:`exit_with_parent`. Pass ``(n, os.getpid())``."""
+    """Pool initializer: ignore SIGINT, :func:`limit_threads`, :func:`exit_with_parent`. Pass ``(n, os.getpid())``."""
+    _quiet_worker()
     limit_threads(threads)
     exit_with_parent(parent)
+
+
+def worker_init_quiet(parent: int) -> None:
+    """Pool initializer of a pool that needs no thread caps: ignore SIGINT and :func:`exit_with_parent`."""
+    _quiet_worker()
+    exit_with_parent(parent)
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT (Ctrl-C) or SIGTERM stopped a command (``signum``); its exit status is 128 + signum."""
+
+    def __init__(self, signum: int = signal.SIGINT) -> None:
+        super().__init__(signum)
+        self.signum = int(signum)
+
+
+class WorkerDied(SimdiffError):
+    """A worker process of a pool died (killed by a signal, out of memory, crashed)."""
+
+
+def note_progress(exc: BaseException, progress: str) -> None:
+    """Attach ``"N of M items done"`` to an :class:`Interrupted` / :class:`WorkerDied` for :func:`stopped`."""
+    exc.progress = progress  # type: ignore[attr-defined]
+
+
+def stopped(exc: BaseException, resumable: bool = True) -> int:
+    """Print the one line a command stopped by ``exc`` ends with (stderr); returns its exit status.
+
+    ``KeyboardInterrupt`` / :class:`Interrupted`: ``simdiff: interrupted; N of M clips done, run the
+    same command again to resume`` and 128 + the signal (130 for SIGINT, 143 for SIGTERM);
+    :class:`WorkerDied`: ``simdiff: error: a worker process died (…); …`` and 1.
+    """
+    progress = getattr(exc, "progress", None)
+    again = "run the same command again to resume" if resumable else "run the same command again"
+    tail = f"{progress}, {again}" if progress else again
+    if isinstance(exc, WorkerDied):
+        print(f"simdiff: error: {exc}; {tail}", file=sys.stderr)
+        return 1
+    signum = getattr(exc, "signum", signal.SIGINT)
+    how = "interrupted" if signum == signal.SIGINT else f"stopped by {signal.Signals(signum).name}"
+    print(f"simdiff: {how}; {tail}", file=sys.stderr)
+    return 128 + signum
+
+
+@contextlib.contextmanager
+def stop_signals() -> Iterator[None]:
+    """While inside (main thread only): SIGTERM raises :class:`Interrupted` (SIGTERM), as Ctrl-C raises
+    ``KeyboardInterrupt``, so that a command stopped by a scheduler cleans up as after a Ctrl-C."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def on_term(signum: int, frame: object) -> None:
+        raise Interrupted(signum)
+
+    old = signal.signal(signal.SIGTERM, on_term)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+@contextlib.contextmanager
+def workers_starting() -> Iterator[None]:
+    """Wrap the calls that start worker processes (main thread only): SIGINT and SIGTERM are blocked, and a child
+    (spawned or forked) inherits the blocked mask, so neither signal can reach a starting worker before its
+    initializer (:func:`_quiet_worker`) sets what they do there; in the parent a signal that arrives meanwhile is
+    delivered when the block ends, so a Ctrl-C or a SIGTERM in this window is not lost."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _quiet_worker() -> None:
+    """In a worker: Ctrl-C is the parent's business; SIGTERM (from the parent) ends it silently."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})  # blocked by workers_starting
+
+
+def _processes(executor: ProcessPoolExecutor) -> list[Any]:
+    return list((getattr(executor, "_processes", None) or {}).values())
+
+
+def stop_workers(executor: ProcessPoolExecutor, processes: Sequence[Any] = ()) -> None:
+    """Terminate ``executor``'s worker processes now (their running tasks are lost) and shut it down."""
+    procs = list(processes) or _processes(executor)
+    for p in _processes(executor) + procs:
+        if p.is_alive():
+            p.terminate()
+    executor.shutdown(wait=True, cancel_futures=True)
+    for p in procs:
+        p.join(timeout=5)
+
+
+def worker_died(processes: Sequence[Any]) -> WorkerDied:
+    """A :class:`WorkerDied` naming how a worker among ``processes`` (those of a broken pool) ended."""
+    for p in processes:
+        p.join(timeout=2)
+    codes = [p.exitcode for p in processes if p.exitcode not in (None, 0)]
+    # the pool terminates (SIGTERM) its other workers once one died: name the first other cause
+    code = next((c for c in codes if c != -signal.SIGTERM), codes[0] if codes else None)
+    if code is None:
+        how = "unknown cause"
+    elif code < 0:
+        try:
+            how = f"signal {-code}, {signal.Signals(-code).name}"
+        except ValueError:
+            how = f"signal {-code}"
+    else:
+        how = f"exit status {code}"
+    return WorkerDied(f"a worker process died ({how})")
+
+
+def results_or_died(results: Iterator[Any], processes: Sequence[Any]) -> Iterator[Any]:
+    """``results`` of an executor's ``map``, a ``BrokenProcessPool`` turned into :class:`WorkerDied`."""
+    try:
+        yield from results
+    except BrokenProcessPool:
+        raise worker_died(processes) from None
 
 
 @functools.lru_cache(maxsize=1)
@@ -158,8 +296,11 @@ class ProjectionPool:
     def __init__(self, config: PoolConfig = PoolConfig()) -> None:
         if config.backend not in ("process", "ray", "serial"):
             raise SimdiffError(f"unknown pool backend {config.backend!r} (process, ray, serial)")
+        if not 0 <= config.workers <= MAX_WORKERS:
+            raise SimdiffError(f"workers must be 0 (one per CPU core) to {MAX_WORKERS}, got {config.workers}")
         self.cfg = config
         self._executor: ProcessPoolExecutor | None = None
+        self._procs: list[Any] = []  # the executor's worker processes, to tell how one died
 
     def __enter__(self) -> "ProjectionPool":
         return self
@@ -203,13 +344,26 @@ class ProjectionPool:
 
             self._executor = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
                                                  initializer=worker_init, initargs=(1, os.getpid()))
-        return self._executor.map(_run_one, tasks, chunksize=1)
+        starting = len(_processes(self._executor)) < workers  # the workers start on the first tasks submitted
+        try:
+            with workers_starting() if starting else contextlib.nullcontext():
+                results = self._executor.map(_run_one, tasks, chunksize=1)
+        except BrokenProcessPool:  # a worker died while idle, between two calls
+            raise worker_died(self._procs) from None
+        self._procs = _processes(self._executor) or self._procs
+        return results_or_died(results, self._procs)
 
     def close(self) -> None:
         """Shut the worker processes down (a later call starts new ones)."""
         if self._executor is not None:
             self._executor.shutdown(wait=True, cancel_futures=True)
             self._executor = None
+
+    def terminate(self) -> None:
+        """Stop the worker processes now, their running tasks lost (after Ctrl-C); a later call starts new ones."""
+        if self._executor is not None:
+            executor, self._executor = self._executor, None
+            stop_workers(executor, self._procs)
 
     def _map_ray(self, tasks: list, workers: int) -> list:
         try:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
 from typing import Callable, Protocol, Sequence, runtime_checkable
 
 import torch
@@ -55,6 +57,12 @@ def load_text_encoder(name: str = "minilm", device: torch.device | str = "cpu", 
         return CLIPTextEncoder.from_file(weights, device=device)
     text_dim(name)
     raise AssertionError("unreachable")
+
+
+def check_weights_option(path: str | os.PathLike[str] | None, flag: str = "--clip-weights") -> None:
+    """Refuse a text-encoder weights option naming nothing on disk (one line naming the option and the path)."""
+    if path is not None and not Path(path).exists():
+        raise SimdiffError(f"{flag} {path}: no such file or folder (a local CLIP ViT-B/32 weights file)")
 
 
 class EncoderCache:

@@ -220,7 +220,7 @@ def _read_state(path: Path) -> dict[str, Tensor]:
     try:
         raw = torch.load(str(path), map_location="cpu", weights_only=True)
     except Exception as exc:  # noqa: BLE001 - pickle / zip errors of a damaged or foreign file
-        raise SimdiffError(f"{path}: not a CLIP state dict readable with weights_only=True ({type(exc).__name__})") from None
+        raise SimdiffError(f"{path}: not a CLIP state dict of plain tensors ({type(exc).__name__})") from None
     raw = raw.get("state_dict", raw) if isinstance(raw, dict) else raw
     if not isinstance(raw, dict):
         raise SimdiffError(f"{path}: holds a {type(raw).__name__}, not a state dict")

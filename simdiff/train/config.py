@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from simdiff.errors import SimdiffError
 from simdiff.model.config import ModelConfig
@@ -123,3 +125,97 @@ class RunConfig:
 
     model: ModelConfig = field(default_factory=ModelConfig)
     train: TrainConfig = field(default_factory=TrainConfig)
+
+
+MAX_CROP_FRAMES: int = 196
+"""Longest crop window (``train.crop.max_frames``): the dataset's padded length."""
+
+
+def read_run_config(path: str | os.PathLike[str]) -> RunConfig:
+    """Read and check a run config file (``train --config``, a run folder's ``train_config.json``).
+
+    Raises:
+        SimdiffError: unreadable or invalid JSON, not an object, an unknown key, a value of the wrong type or out of
+            range; one line naming the file and the key.
+    """
+    import json
+
+    from simdiff.model.config import config_from_dict
+
+    path = Path(path)
+    if not path.is_file():
+        raise SimdiffError(f"{path}: no such config file")
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise SimdiffError(f"{path}: not a UTF-8 text file") from None
+    except json.JSONDecodeError as exc:
+        raise SimdiffError(f"{path}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+    except OSError as exc:
+        raise SimdiffError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    config = config_from_dict(data, RunConfig, str(path))
+    check_train_config(config.train, str(path))
+    return config
+
+
+def check_train_config(tc: TrainConfig, where: str = "train_config.json") -> TrainConfig:
+    """Refuse training settings that a run would accept silently and then misuse; returns ``tc``.
+
+    Messages are one line ``where: train.key = value …``.
+    """
+    from simdiff.model.config import json_value
+
+    def bad(key: str, value: object, why: str) -> SimdiffError:
+        return SimdiffError(f"{where}: train.{key} = {json_value(value)} {why}")
+
+    def whole(key: str, lo: int, hi: int | None = None) -> None:
+        value = _get(tc, key)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise bad(key, value, "is not a whole number")
+        if value < lo or (hi is not None and value > hi):
+            raise bad(key, value, f"is outside {lo}..{hi}" if hi is not None else f"must be ≥ {lo}")
+
+    def number(key: str, lo: float, hi: float = math.inf, *, below: bool = False) -> None:
+        value = _get(tc, key)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise bad(key, value, "is not a finite number")
+        if value < lo or value > hi or (below and value == hi):
+            span = f"[{lo:g}, {hi:g}{')' if below else ']'}" if math.isfinite(hi) else f"≥ {lo:g}"
+            raise bad(key, value, f"is outside {span}")
+
+    whole("steps", 1)
+    whole("batch_size", 1)
+    whole("seed", 0, 2**32 - 1)
+    whole("save_every", 0)
+    whole("keep_checkpoints", 1)
+    whole("log_every", 1)
+    number("cond_mask_prob", 0.0, 1.0)
+    if not isinstance(tc.ema, bool):
+        raise bad("ema", tc.ema, "is not true or false")
+    number("ema_decay", 0.0, 1.0)
+    number("optim.lr", 0.0, 1.0)
+    number("optim.weight_decay", 0.0)
+    number("optim.grad_clip", 0.0)
+    betas = tc.optim.betas
+    if (not isinstance(betas, (list, tuple)) or len(betas) != 2
+            or not all(isinstance(b, (int, float)) and not isinstance(b, bool) and 0 <= b < 1 for b in betas)):
+        raise bad("optim.betas", betas, "must be two numbers in [0, 1)")
+    if tc.optim.lr_schedule not in LR_SCHEDULES:
+        raise bad("optim.lr_schedule", tc.optim.lr_schedule, f"is not one of {', '.join(LR_SCHEDULES)}")
+    for key in ("position", "velocity", "foot_contact"):
+        number(f"losses.{key}", 0.0)
+    whole("crop.max_frames", 0, MAX_CROP_FRAMES)
+    if not isinstance(tc.crop.trim_padding, bool):
+        raise bad("crop.trim_padding", tc.crop.trim_padding, "is not true or false")
+    number("env_pairs", 0.0)
+    number("env_pairs_drift", 0.0)
+    number("cross_twins", 0.0, 1.0)
+    if not isinstance(tc.cross_match, str):
+        raise bad("cross_match", tc.cross_match, "is not a string")
+    return tc
+
+
+def _get(obj: object, dotted: str) -> object:
+    for part in dotted.split("."):
+        obj = getattr(obj, part)
+    return obj

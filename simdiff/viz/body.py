@@ -5,7 +5,10 @@ humanoid states with the simulator's IK (:func:`simdiff.sim.retarget.ik_sequence
 humanoid states ``(T, nq)`` (a rollout's qpos sampled at the frame rate) used as they are.
 Each frame sets qpos, runs ``mj_forward`` and renders the humanoid of
 :mod:`simdiff.sim.humanoid` on a checkered floor under a shadow-casting sun, seen by a
-camera that follows the smoothed root.
+camera that follows the smoothed root horizontally. Side-by-side panels share one camera
+(azimuth, elevation, distance, look-at height), fitted to the whole render so that every geom
+and joint of every frame stays in the image (:func:`body_view`,
+:func:`simdiff.viz.camera.fit_body_camera`).
 
 The visual extras (skybox, floor texture, materials, lights, offscreen buffer size) are added
 to a copy of the simulation MJCF by :func:`render_mjcf`; the simulation model is unchanged
@@ -24,7 +27,7 @@ from __future__ import annotations
 
 import functools
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterator, Sequence
 
@@ -34,6 +37,7 @@ from simdiff.errors import SimdiffError
 from simdiff.fsio import atomic_path
 from simdiff.motion.skeleton import FPS, NUM_JOINTS
 from simdiff.viz._checks import ANIMATION_SUFFIXES, as_captions, output_path, positive_float, positive_int
+from simdiff.viz.camera import BodyCamera, camera_path, fit_body_camera, geom_boxes, join_boxes, point_boxes
 from simdiff.viz.gl import _gl_context, gl_backend
 from simdiff.viz.video import write_video
 
@@ -82,37 +86,6 @@ class BodyStyle:
     sun_dir: tuple[float, float, float] = (0.35, 0.45, -1.0)
     reflectance: float = 0.0
     captions: bool = True
-
-
-@dataclass(frozen=True)
-class BodyCamera:
-    """A camera that follows the root.
-
-    Attributes:
-        distance: camera to look-at point (m).
-        azimuth: viewing direction in the ground plane (degrees, MuJoCo convention: 90 looks
-            along world +y). The character faces world +x (HumanML3D +Z) at rest, so the
-            default 120 sees it from its front right.
-        elevation: degrees, negative looks down.
-        height: look-at height above the floor (m) when ``follow_height`` is off.
-        follow_height: the look-at point also follows the root height (jumps, crawls).
-        smooth_s: Gaussian smoothing of the root path (s), so that gait sway does not shake
-            the image.
-        fovy: vertical field of view (degrees).
-    """
-
-    distance: float = 3.4
-    azimuth: float = 120.0
-    elevation: float = -14.0
-    height: float = 0.85
-    follow_height: bool = False
-    smooth_s: float = 0.5
-    fovy: float = 45.0
-
-
-# --------------------------------------------------------------------------------------
-# OpenGL backend
-# --------------------------------------------------------------------------------------
 
 
 # --------------------------------------------------------------------------------------
@@ -226,19 +199,6 @@ def motion_qpos(motion: np.ndarray, model=None) -> np.ndarray:
     return q
 
 
-def camera_path(qpos: np.ndarray, fps: float, camera: BodyCamera = BodyCamera()) -> np.ndarray:
-    """(T, 3) world look-at points: the root path, Gaussian-smoothed over ``camera.smooth_s``."""
-    from scipy.ndimage import gaussian_filter1d
-
-    root = np.asarray(qpos, dtype=np.float64)[:, :3].copy()
-    sigma = camera.smooth_s * fps
-    if sigma > 0 and len(root) > 1:
-        root = gaussian_filter1d(root, sigma, axis=0, mode="nearest")
-    if not camera.follow_height:
-        root[:, 2] = camera.height
-    return root
-
-
 # --------------------------------------------------------------------------------------
 # the renderer
 # --------------------------------------------------------------------------------------
@@ -254,7 +214,8 @@ class BodyRenderer:
 
     Args:
         width, height: image size in pixels.
-        style: :class:`BodyStyle`; camera: :class:`BodyCamera` (distance, angles, fov).
+        style: :class:`BodyStyle`; camera: :class:`BodyCamera` (distance, angles, fov) used as
+            given by every render of this renderer (no fitting here: see :func:`body_view`).
         backend: ``"egl"`` / ``"osmesa"``; default :func:`gl_backend`.
     """
 
@@ -265,6 +226,7 @@ class BodyRenderer:
         self.width = positive_int(width, "width")
         self.height = positive_int(height, "height")
         self.style = style
+        self.camera = camera
         self.mj = mujoco
         self._ctx = None
         self._con = None
@@ -275,6 +237,9 @@ class BodyRenderer:
         self._ctx = _gl_context(backend, self.width, self.height)
         self._con = mujoco.MjrContext(self.model, mujoco.mjtFontScale.mjFONTSCALE_150.value)
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN.value, self._con)
+        # a farther or wider view sees more floor: widen the sun's shadow map with it (floor outside is speckled)
+        reach = camera.distance * max(1.0, self.width / self.height) / BodyCamera.distance
+        self._con.shadowClip = float(self._con.shadowClip * max(1.0, reach))
         self.scene = mujoco.MjvScene(self.model, maxgeom=500)
         self.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = bool(style.shadows)
         self.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = style.reflectance > 0
@@ -361,7 +326,20 @@ class _Clip:
     color: tuple[float, float, float]
 
 
-def _clips(motions, captions, fps: float, style: BodyStyle, camera: BodyCamera) -> list[_Clip]:
+def body_view(motions, captions=None, fps: float = FPS, size: tuple[int, int] = (640, 480),
+              style: BodyStyle = BodyStyle(), camera: BodyCamera = BodyCamera()) -> tuple[list[_Clip], BodyCamera]:
+    """The panels of a render and the one camera they share.
+
+    Every panel is seen with the same azimuth, elevation, distance and look-at height (so
+    sizes and heights compare across panels); only the horizontal look-at point follows each
+    panel's own smoothed root. With ``camera.fit`` the distance and look-at height are those of
+    :func:`simdiff.viz.camera.fit_body_camera`: every geom of every frame of every panel lies
+    inside the ``size`` image with ``camera.margin`` to spare.
+
+    Returns:
+        (clips, camera): per motion its qpos (T, nq), look-at path (T, 3), caption and colour;
+        and the camera used.
+    """
     from simdiff.sim.humanoid import load_model
 
     if isinstance(motions, np.ndarray) or hasattr(motions, "detach"):
@@ -371,14 +349,29 @@ def _clips(motions, captions, fps: float, style: BodyStyle, camera: BodyCamera) 
         raise SimdiffError("motions is an empty list; give at least one (T, 22, 3) or (T, nq) array")
     captions = as_captions(captions, len(motions))
     model = load_model()
-    out = []
-    for i, (m, c) in enumerate(zip(motions, captions)):
+    qs = []
+    for i, m in enumerate(motions):
         try:
-            q = motion_qpos(m, model)
+            qs.append(motion_qpos(m, model))
         except SimdiffError as exc:
             raise SimdiffError(f"motion {i}: {exc}") from None
-        out.append(_Clip(q, camera_path(q, fps, camera), c, style.colors[i % len(style.colors)]))
-    return out
+    if camera.fit:  # the humanoid's geoms and, for joint motions, the joints themselves stay in view
+        from simdiff.sim.humanoid import hml_to_world
+
+        camera = replace(camera, follow_height=False)
+        paths = [camera_path(q, fps, camera) for q in qs]
+        boxes = [geom_boxes(model, q) for q in qs]
+        for i, m in enumerate(motions):
+            m = np.asarray(m.detach().cpu().numpy() if hasattr(m, "detach") else m, dtype=np.float64)
+            if m.ndim == 3:
+                boxes[i] = join_boxes(boxes[i], point_boxes(hml_to_world(m)))
+        camera, shifts = fit_body_camera(boxes, paths, camera, size[0] / size[1])
+    else:
+        shifts = [np.zeros(3)] * len(qs)
+    out = []
+    for i, (q, c, s) in enumerate(zip(qs, captions, shifts)):
+        out.append(_Clip(q, camera_path(q, fps, camera) + s, c, style.colors[i % len(style.colors)]))
+    return out, camera
 
 
 def _panel(renderer: BodyRenderer, clip: _Clip, t: int, fps: float) -> np.ndarray:
@@ -402,7 +395,7 @@ def body_frames(motions, captions: Sequence[str] | None = None, fps: float = FPS
         progress: show a tqdm bar on stderr.
     """
     fps = positive_float(fps, "fps")
-    clips = _clips(motions, captions, fps, style, camera)
+    clips, camera = body_view(motions, captions, fps, size, style, camera)
     n = max(len(c.qpos) for c in clips)
     from tqdm.auto import tqdm
 
@@ -454,7 +447,7 @@ def body_filmstrip(motions, captions: Sequence[str] | None = None, fps: float = 
     """(rows·H, n_frames·W, 3) uint8 grid: one row per motion, ``n_frames`` evenly spaced frames."""
     fps = positive_float(fps, "fps")
     n_frames = positive_int(n_frames, "n_frames")
-    clips = _clips(motions, captions, fps, style, camera)
+    clips, camera = body_view(motions, captions, fps, size, style, camera)
     from tqdm.auto import tqdm
 
     rows = []

@@ -8,6 +8,7 @@ redraw the moving artists (blitting), which keeps a 120-frame GIF at a few secon
 from __future__ import annotations
 
 import textwrap
+from dataclasses import replace
 from pathlib import Path
 from typing import Iterator, Sequence
 
@@ -20,7 +21,7 @@ from simdiff.motion.skeleton import FPS
 from simdiff.viz._checks import (
     ANIMATION_SUFFIXES, IMAGE_SUFFIXES, as_captions, as_motions, output_path, positive_float, positive_int,
 )
-from simdiff.viz.camera import auto_height
+from simdiff.viz.camera import auto_height, choose_azim
 from simdiff.viz.panel import DEFAULT_STYLE, StickPanel, Style
 from simdiff.viz.video import write_video
 
@@ -60,6 +61,7 @@ class AnimationScene:
     def __init__(self, motions: list[np.ndarray], captions: list[str], fps: float = FPS,
                  panel_size: tuple[float, float | None] = (3.2, None), dpi: int = 100, style: Style = DEFAULT_STYLE) -> None:
         n = len(motions)
+        style = shared_view(motions, style)
         pw, ph = panel_size
         ph = auto_height(motions, pw, style.elev, style.azim) + LABEL_STRIP if ph is None else ph
         strip = min(LABEL_STRIP, 0.2 * ph)
@@ -159,7 +161,8 @@ def render_filmstrip(motions: Sequence[np.ndarray] | np.ndarray, path: str | Pat
     fps = positive_float(fps, "fps")
     path = output_path(path, IMAGE_SUFFIXES)
     cw, ch = cell_size
-    ch = auto_height(motions, cw, DEFAULT_STYLE.elev, DEFAULT_STYLE.azim) + LABEL_STRIP if ch is None else ch
+    style = shared_view(motions, DEFAULT_STYLE)
+    ch = auto_height(motions, cw, style.elev, style.azim) + LABEL_STRIP if ch is None else ch
     strip = min(LABEL_STRIP, 0.2 * ch)
     width = cw * n_frames
     texts = [_wrap(c, width, max_lines=2) for c in captions]
@@ -176,7 +179,7 @@ def render_filmstrip(motions: Sequence[np.ndarray] | np.ndarray, path: str | Pat
         for c, t in enumerate(filmstrip_indices(motion.shape[0], n_frames)):
             ax = fig.add_axes((c / n_frames, bottom + strip / height, 1.0 / n_frames, (ch - strip) / height),
                               projection="3d")
-            StickPanel(ax, motion).set_frame(int(t))
+            StickPanel(ax, motion, style=style).set_frame(int(t))
             fig.text((c + 0.5) / n_frames, bottom + 0.03 / height, f"{t / fps:.2f} s", ha="center", va="bottom",
                      fontsize=7.5, color="#555555")
         if r > 0:
@@ -184,6 +187,14 @@ def render_filmstrip(motions: Sequence[np.ndarray] | np.ndarray, path: str | Pat
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=dpi, facecolor="white")
     return path
+
+
+def shared_view(motions: Sequence[np.ndarray], style: Style) -> Style:
+    """``style`` with one azimuth for every panel (the first motion's, :func:`~simdiff.viz.camera.choose_azim`), so
+    side-by-side motions are seen from the same side: per-motion choices mirrored an Earth jump and its Moon twin."""
+    if style.azim is not None:
+        return style
+    return replace(style, azim=choose_azim(np.asarray(motions[0])))
 
 
 def _rule(y: float):

@@ -19,6 +19,11 @@ from simdiff.fsio import atomic_path
 
 PALETTE_COLOURS: int = 96
 """Colours in the shared GIF palette (GIF allows 256)."""
+MAX_GIF_FPS: float = 50.0
+"""Fastest GIF: 2-centisecond frames (browsers slow 1-centisecond GIF frames down)."""
+MIN_GIF_FPS: float = 0.01
+MAX_GIF_BYTES: int = 1 << 30
+"""Most RGB frame data a GIF is built from (one shared palette needs every frame before the first is written)."""
 PALETTE_SAMPLES: int = 12
 """Frames (evenly spaced) the GIF palette is computed from."""
 
@@ -46,7 +51,16 @@ def write_gif(frames: Iterable[np.ndarray], path: str | Path, fps: float, colour
 
     if not 2 <= colours <= 256:
         raise SimdiffError(f"GIF palette size must be 2..256, got {colours}")
-    stack = [np.ascontiguousarray(f, dtype=np.uint8) for f in frames]
+    if not MIN_GIF_FPS <= fps <= MAX_GIF_FPS:  # GIF delays are whole centiseconds, at most 655.35 s
+        raise SimdiffError(f"{str(path)!r}: a GIF plays at {MIN_GIF_FPS:g}..{MAX_GIF_FPS:g} fps, got {fps:g}; "
+                           "write an .mp4 instead")
+    stack, size = [], 0
+    for f in frames:
+        stack.append(np.ascontiguousarray(f, dtype=np.uint8))
+        size += stack[-1].nbytes
+        if size > MAX_GIF_BYTES:
+            raise SimdiffError(f"{str(path)!r}: a GIF of this many frames needs more than {MAX_GIF_BYTES >> 20} MiB; "
+                               "write an .mp4 instead")
     if not stack:
         raise SimdiffError(f"no frames to write to {str(path)!r}")
     picks = np.unique(np.linspace(0, len(stack) - 1, min(PALETTE_SAMPLES, len(stack))).round().astype(int))
@@ -55,6 +69,7 @@ def write_gif(frames: Iterable[np.ndarray], path: str | Path, fps: float, colour
     images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE) for f in stack]
     with atomic_path(path) as tmp:
         images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=1000.0 / fps, loop=0)
+        check_video(tmp, len(images), path, fps)
     return len(images)
 
 
@@ -72,7 +87,7 @@ def write_mp4(frames: Iterable[np.ndarray], path: str | Path, fps: float) -> int
                     h, w = frame.shape[:2]
                     writer = imageio_ffmpeg.write_frames(
                         str(tmp), (w, h), fps=fps, codec="libx264", pix_fmt_out="yuv420p",
-                        macro_block_size=1, quality=7, ffmpeg_log_level="error",
+                        macro_block_size=1, quality=7, ffmpeg_log_level="quiet",  # failures: check_video
                     )
                     writer.send(None)  # start ffmpeg
                 writer.send(frame)
@@ -82,7 +97,31 @@ def write_mp4(frames: Iterable[np.ndarray], path: str | Path, fps: float) -> int
                 writer.close()
         if count == 0:
             raise SimdiffError(f"no frames to write to {str(path)!r}")
+        check_video(tmp, count, path, fps)
     return count
+
+
+def check_video(written: Path, frames: int, target: str | Path, fps: float) -> None:
+    """Read back the video just written to ``written`` and check it holds ``frames`` frames at ``fps`` (an encoder
+    that hit a full disk can exit cleanly with a truncated file); else one :class:`SimdiffError` naming ``target``.
+    GIF merges repeated frames into one longer frame, so there the total duration is what is checked."""
+    try:
+        if written.suffix.lower() == ".gif":
+            from PIL import Image, ImageSequence
+
+            with Image.open(written) as image:
+                total_ms = sum(float(f.info.get("duration", 0)) for f in ImageSequence.Iterator(image))
+            found = int(round(total_ms * fps / 1000.0))
+        else:
+            import imageio_ffmpeg
+
+            found = int(imageio_ffmpeg.count_frames_and_secs(str(written))[0])
+    except (OSError, RuntimeError, ValueError) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise SimdiffError(f"cannot write {str(target)!r}: the written video does not open ({first[:120]})") from None
+    if abs(found - frames) > max(1, frames // 100):  # GIF stores whole milliseconds per frame
+        raise SimdiffError(f"cannot write {str(target)!r}: the written video holds {found} of {frames} frames "
+                           "(disk full?)")
 
 
 def write_video(frames: Iterable[np.ndarray], path: str | Path, fps: float) -> int:

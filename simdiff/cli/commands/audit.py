@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from simdiff.cli.options import add_environment_options
+from simdiff.cli.options import FPS_OPTION, add_environment_options, real
 
 from simdiff.errors import SimdiffError
 
@@ -28,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("files", nargs="+", type=Path, metavar="FILE", help="motion files")
     add_environment_options(p)
-    p.add_argument("--residual", type=float, default=0.5, metavar="R",
+    p.add_argument("--residual", type=real(0.0, 1e6), default=0.5, metavar="R",
                    help="tracking: root residual bound as a fraction of m·g; 0 = strict (default 0.5)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR",
                    help="write DIR/<name>_audit.png, <name>_audit.json and <name>_rollout.npy")
@@ -38,7 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-track", dest="track", action="store_false",
                    help="skip the simulator (metrics and inverse-dynamics residual only)")
     p.add_argument("--asf", type=Path, default=None, help="ASF skeleton for AMC inputs")
-    p.add_argument("--fps", type=float, default=None, help="source frame rate when the file does not say")
+    p.add_argument("--fps", type=FPS_OPTION, default=None, help="source frame rate in Hz, overriding the file's own (BVH Frame Time; AMC: CMU_data.csv, a _120 name, else 120; .npy: 20)")
     p.add_argument("--stats", type=Path, default=None, metavar="DIR",
                    help="Mean.npy/Std.npy for d_L2 (default: $SIMDIFF_STATS, else the statistics shipped with simdiff)")
     p.add_argument("--force", action="store_true", help="allow φ outside the validated ranges")
@@ -46,28 +46,42 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from simdiff.eval.audit import audit_motion, plot_audit
-    from simdiff.fsio import check_writable, ensure_dir, save_npy, write_json
-    from simdiff.motion.io import load_joints
+    from simdiff.fsio import check_writable
     from simdiff.sim.env import Environment
-    from simdiff.sim.residual import ResidualConfig
 
     if args.residual < 0:
         raise SimdiffError(f"--residual must be ≥ 0, got {args.residual}")
     if args.render and args.out is None:
         raise SimdiffError("--render needs --out DIR")
     env = Environment(args.gravity, float(args.wind[0]), float(args.wind[1])).validate(force=args.force)
-    for path in args.files:  # fail on a missing file before any slow work
-        if not path.is_file():
-            raise SimdiffError(f"motion file not found: {str(path)!r}")
+    from simdiff.motion.io import check_regular_file
+
+    for path in args.files:  # fail on a missing file, a folder or a device before any slow work
+        check_regular_file(path)
     normalizer = None
     if args.track:
         from simdiff.cli.commands.track import _normalizer
 
         normalizer = _normalizer(args.stats)
-    if args.out is not None:
-        ensure_dir(args.out)
+    if args.out is None:
+        return _audit_all(args, env, normalizer)
+    from simdiff.cli.commands.track import check_unique_outputs
+    from simdiff.data.writer import cleaned_on_failure
+
+    check_unique_outputs(args.files, args.out, "_audit.json")
+    done: list[Path] = []
+    with cleaned_on_failure(args.out, keep=lambda: bool(done)):  # a run that audits nothing leaves no folder
         check_writable(args.out / f"{args.files[0].stem}_audit.json")
+        return _audit_all(args, env, normalizer, done)
+
+
+def _audit_all(args: argparse.Namespace, env, normalizer, done: list[Path] | None = None) -> int:
+    """Audit every file in turn; ``done`` collects the files audited (their outputs written)."""
+    from simdiff.eval.audit import audit_motion, plot_audit
+    from simdiff.fsio import save_npy, write_json
+    from simdiff.motion.io import load_joints
+    from simdiff.sim.residual import ResidualConfig
+
     for path in args.files:
         joints = load_joints(path, asf=args.asf, fps=args.fps)
         audit = audit_motion(joints, env, name=path.name, residual=ResidualConfig(max_force=args.residual),
@@ -89,6 +103,8 @@ def run(args: argparse.Namespace) -> int:
             for key in ("plot", "rollout", "render"):
                 if key in record:
                     print(f"  wrote {record[key]}")
+        if done is not None:
+            done.append(path)
     return 0
 
 

@@ -6,6 +6,10 @@ import argparse
 from pathlib import Path
 
 from simdiff.cli.main import command_group
+from simdiff.cli.options import SEED, WORKERS, integer
+
+MIN_CAPTIONS, MAX_CAPTIONS = 2, 10
+"""--captions range (as :data:`simdiff.data.corpus.build.MAX_CAPTIONS`)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -31,9 +35,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        help="all (default, research use) or permissive (no CC BY-NC, no CC BY-SA)")
     build.add_argument("--sources", nargs="+", choices=list(SOURCES), default=list(SOURCES), metavar="SOURCE",
                        help=f"source families (default all: {' '.join(SOURCES)})")
-    build.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    build.add_argument("--seed", type=int, default=0, help="seed for captions and split order (default 0)")
-    build.add_argument("--captions", type=int, default=3, metavar="N", help="generated captions per clip (default 3, min 2)")
+    build.add_argument("--workers", type=WORKERS, default=2,
+                       help="worker processes, 0..64 (0: one per CPU core; default 2)")
+    build.add_argument("--seed", type=SEED, default=0, help="seed for captions and split order, 0..2^32-1 (default 0)")
+    build.add_argument("--captions", type=integer(MIN_CAPTIONS, MAX_CAPTIONS), default=3, metavar="N",
+                       help=f"generated captions per clip, {MIN_CAPTIONS}..{MAX_CAPTIONS} (default 3)")
     build.add_argument("--no-mirror", action="store_true", help="do not write mirrored M<id> clips")
     build.add_argument("--quiet", action="store_true", help="no progress bar")
     build.set_defaults(func=run_build)
@@ -48,21 +54,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     report.add_argument("corpus", type=Path, help="corpus folder written by `simdiff data build`")
     report.add_argument("--out", type=Path, default=None, help="report folder (default CORPUS/report)")
-    report.add_argument("--seed", type=int, default=0, help="seed for the clips shown in filmstrips")
+    report.add_argument("--seed", type=SEED, default=0, help="seed for the clips shown in filmstrips, 0..2^32-1")
     report.add_argument("--no-crosscheck", action="store_true", help="skip the comparison of copies")
     report.set_defaults(func=run_report)
 
 
 def run_build(args: argparse.Namespace) -> int:
     from simdiff.data.corpus.build import CorpusConfig, build
-    from simdiff.errors import SimdiffError
+    from simdiff.sim.pool import WorkerDied, stop_signals, stopped
 
-    if args.captions < 2:
-        raise SimdiffError(f"--captions must be >= 2, got {args.captions}")
     cfg = CorpusConfig(shared=args.shared, out=args.out, licence=args.licence, sources=tuple(args.sources),
                        workers=args.workers, seed=args.seed, captions=args.captions, mirror=not args.no_mirror,
                        progress=not args.quiet)
-    result = build(cfg)
+    try:
+        with stop_signals():  # SIGTERM as Ctrl-C: workers stopped, finished items kept for the rerun
+            result = build(cfg)
+    except (KeyboardInterrupt, WorkerDied) as exc:
+        return stopped(exc)
     originals = [c for c in result.clips if c["mirror_of"] is None]
     hours = sum(c["seconds"] for c in result.clips) / 3600
     hours0 = sum(c["seconds"] for c in originals) / 3600

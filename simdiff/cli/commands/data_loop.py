@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from simdiff.cli.options import integer, real
+from simdiff.motion.skeleton import MAX_FRAMES, MIN_GENERATE_FRAMES
 from simdiff.cli.main import command_group
 
 
@@ -27,10 +29,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     loop.add_argument("corpus", type=Path, help="a corpus folder of `simdiff data build`")
     loop.add_argument("--types", nargs="+", default=["run"], metavar="TYPE",
                       help="motion types to loop (default: run)")
-    loop.add_argument("--frames", type=int, default=120, help="length of each loop in frames at 20 fps (default 120)")
+    loop.add_argument("--frames", type=integer(MIN_GENERATE_FRAMES, MAX_FRAMES), default=120, help="length of each loop in frames at 20 fps (default 120)")
     loop.add_argument("--split", default="train", help="split whose clips are looped (default train)")
     loop.add_argument("--out-split", default="", help="name of the new split file (default <split>_loop)")
-    loop.add_argument("--max-error", type=float, default=MAX_ERROR,
+    loop.add_argument("--max-error", type=real(0.0, 10.0, above=True), default=MAX_ERROR,
                       help=f"largest period mismatch kept, mean joint distance in metres (default {MAX_ERROR})")
     loop.add_argument("--quiet", action="store_true", help="no progress bar")
     loop.set_defaults(func=run_loop)

@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from simdiff.cli.options import MAX_TRAIN_BATCH, SEED, integer, real
 from simdiff.cli.main import command_group
 
 
@@ -16,11 +17,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                      "Guo et al.'s contrastive loss on the train split (best epoch on val). Resumable.")
     t.add_argument("--corpus", type=Path, required=True, help="HumanML3D-layout corpus")
     t.add_argument("--out", type=Path, required=True, help="output folder (model.safetensors + config.json, checkpoint/)")
-    t.add_argument("--epochs", type=int, default=30, help="passes over the train split (default 30)")
-    t.add_argument("--batch-size", type=int, default=32, help="pairs per step (default 32)")
-    t.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate (default 1e-3)")
-    t.add_argument("--embed-dim", type=int, default=256, help="shared embedding size (default 256; T2M 512)")
-    t.add_argument("--seed", type=int, default=0, help="seed (default 0)")
+    t.add_argument("--epochs", type=integer(1, 10_000), default=30, help="passes over the train split (default 30)")
+    t.add_argument("--batch-size", type=integer(2, MAX_TRAIN_BATCH), default=32, help="pairs per step (default 32)")
+    t.add_argument("--lr", type=real(0.0, 1.0, above=True), default=1e-3, help="Adam learning rate (default 1e-3)")
+    t.add_argument("--embed-dim", type=integer(8, 4096), default=256, help="shared embedding size (default 256; T2M 512)")
+    t.add_argument("--seed", type=SEED, default=0, help="seed (default 0)")
     t.add_argument("--device", default="cpu", help="torch device (default cpu)")
     t.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     t.set_defaults(func=run_train)
@@ -78,6 +79,9 @@ def run_train(args: argparse.Namespace) -> int:
     from simdiff.eval.evaluator import EvaluatorConfig
     from simdiff.eval.train_evaluator import EvaluatorTrainConfig, train_evaluator
 
+    from simdiff.inference.device import torch_device
+
+    device = torch_device(args.device)
     state = args.out / "checkpoint" / "state.json"
     config = EvaluatorTrainConfig(evaluator=EvaluatorConfig(embed_dim=args.embed_dim), epochs=args.epochs,
                                   batch_size=args.batch_size, lr=args.lr, seed=args.seed)
@@ -91,7 +95,7 @@ def run_train(args: argparse.Namespace) -> int:
         from simdiff.model.checkpoint import atomic_write_json
 
         atomic_write_json(data, state)
-    summary = train_evaluator(args.corpus, args.out, config, device=args.device, progress=not args.no_progress)
+    summary = train_evaluator(args.corpus, args.out, config, device=device, progress=not args.no_progress)
     last = summary["history"][-1] if summary["history"] else {}
     val = last.get("val")
     tail = f", val top-1 {val['top1']:.3f} top-3 {val['top3']:.3f}" if val else ""
@@ -135,6 +139,11 @@ def run_all(args: argparse.Namespace) -> int:
     from simdiff.eval.experiments import ORDER, config_path, plan_experiment, run_all as run
     from simdiff.eval.experiments.report import duration
 
+    unknown = [k for k in args.only or [] if k not in ORDER]
+    if unknown:
+        from simdiff.errors import SimdiffError
+
+        raise SimdiffError(f"--only {unknown[0]}: unknown experiment; choose from {' '.join(ORDER)}")
     overrides = _overrides(args)
     if args.dry_run:
         total = 0.0

@@ -9,8 +9,13 @@ from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from simdiff.diffusion.config import SAMPLER_STEPS, SAMPLERS, SamplingConfig
+from simdiff.cli.options import SEED, integer, real
+from simdiff.diffusion.config import (ALPHA_RANGE, ENV_GUIDANCE_RANGE, GUIDANCE_RANGE, MAX_STEPS, SAMPLER_STEPS,
+                                      SAMPLERS, SamplingConfig)
 from simdiff.inference.default import DEFAULT_MODEL_DIR, SAMPLING_NAME, sampling_config
+from simdiff.motion.skeleton import FPS, MAX_FRAMES, MIN_GENERATE_FRAMES
+from simdiff.product.request import MAX_SAMPLES
+from simdiff.sim.env import MAX_FORCED_WIND, MAX_GRAVITY, MIN_FORCED_GRAVITY
 
 if TYPE_CHECKING:
     from simdiff.product.finisher import Finisher
@@ -53,9 +58,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("text", metavar="TEXT", help='what the person does, e.g. "a person jumps forward"')
     env = p.add_argument_group("environment φ")
-    env.add_argument("--gravity", type=float, metavar="G",
+    env.add_argument("--gravity", type=real(MIN_FORCED_GRAVITY, MAX_GRAVITY), metavar="G",
                      help="vertical gravity in m/s², negative (default -9.81 Earth; Mars -3.7, Moon -1.6)")
-    env.add_argument("--wind", type=float, nargs=2, metavar=("X", "Y"),
+    env.add_argument("--wind", type=real(-MAX_FORCED_WIND, MAX_FORCED_WIND), nargs=2, metavar=("X", "Y"),
                      help="horizontal wind force in newtons along +X and +Z (the character's left and "
                           "forward at frame 0) (default 0 0)")
     env.add_argument("--compare", metavar="SPEC",
@@ -65,31 +70,32 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="simulated finish: re-track each final sample in the simulator under φ and write the "
                           "simulated motion and its tracking result beside it")
     env.add_argument("--force", action="store_true",
-                     help="allow environments outside the trained range (gravity -20..-1 m/s², |wind| <= 10 N)")
+                     help="allow environments outside the trained range (gravity -20..-1 m/s², |wind| <= 10 N), up to "
+                          f"gravity {MIN_FORCED_GRAVITY:g} m/s² and wind ±{MAX_FORCED_WIND:g} N")
     smp = p.add_argument_group("sampling (defaults: the model's sampling.json; shown: the shipped model's)")
     cfg = shipped_sampling()
-    smp.add_argument("--length", type=float, metavar="SECONDS", help="motion length in seconds, up to 9.8 (default 6)")
-    smp.add_argument("--seed", type=int, default=0, metavar="S", help="noise seed; sample K uses seed+K (default 0)")
-    smp.add_argument("--num-samples", type=int, default=1, metavar="K", help="samples to generate (default 1)")
+    smp.add_argument("--length", type=real(MIN_GENERATE_FRAMES / FPS, MAX_FRAMES / FPS), metavar="SECONDS", help="motion length in seconds, up to 9.8 (default 6)")
+    smp.add_argument("--seed", type=SEED, default=0, metavar="S", help="noise seed; sample K uses seed+K (default 0)")
+    smp.add_argument("--num-samples", type=integer(1, MAX_SAMPLES), default=1, metavar="K", help="samples to generate (default 1)")
     smp.add_argument("--sampler", choices=SAMPLERS, help=f"diffusion sampler (default {cfg.sampler})")
-    smp.add_argument("--steps", type=int, metavar="N",
+    smp.add_argument("--steps", type=integer(1, MAX_STEPS), metavar="N",
                      help=f"diffusion steps, 1..1000 (default {cfg.steps}; {SAMPLER_STEPS['ddpm']} with a "
                           "--sampler switched to ddpm)")
-    smp.add_argument("--eta", type=float, metavar="E",
+    smp.add_argument("--eta", type=real(0.0, 1.0), metavar="E",
                      help=f"DDIM's noise scale in [0, 1]: 0 deterministic, 1 fresh noise at every step (default "
                           f"{cfg.eta:g})")
-    smp.add_argument("--guidance", type=float, metavar="W",
+    smp.add_argument("--guidance", type=real(*GUIDANCE_RANGE), metavar="W",
                      help=f"classifier-free guidance scale on the text, 1 = off (default {cfg.guidance:g})")
-    smp.add_argument("--alpha", type=float, metavar="A",
+    smp.add_argument("--alpha", type=real(*ALPHA_RANGE), metavar="A",
                      help=f"strength of the environment adapters, 0 = ignore φ (default {cfg.alpha:g})")
-    smp.add_argument("--foot-lock", type=float, metavar="S",
+    smp.add_argument("--foot-lock", type=real(0.0, 1.0), metavar="S",
                      help="foot cleanup, strength 0..1: move the root so the feet the motion marks planted do not "
                           "slide, lift swinging feet that drag along the floor 2 cm clear of it, and lower a motion "
                           f"that never comes within 0.10 m of the floor onto it (0 = off; default {cfg.foot_lock:g})")
-    smp.add_argument("--env-guidance", type=float, metavar="S",
+    smp.add_argument("--env-guidance", type=real(*ENV_GUIDANCE_RANGE), metavar="S",
                      help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off "
                           f"(default {cfg.env_guidance:g})")
-    smp.add_argument("--edit-t", type=int, metavar="T",
+    smp.add_argument("--edit-t", type=integer(0, MAX_STEPS - 1), metavar="T",
                      help="under another gravity than Earth's, the motion follows its Earth motion (same seed) down "
                           f"to denoising timestep T (0-999), then continues under φ (default {cfg.edit_t})")
     out = p.add_argument_group("output")
@@ -148,7 +154,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _generate(args: argparse.Namespace, request: GenerationRequest, start: float, finisher: Finisher | None) -> int:
     """Load the model, sample (the finish in ``finisher``'s process when given), write and report."""
-    import time
 
     from simdiff.errors import SimdiffError
     from simdiff.product.outputs import fresh_dir, prepare_out_dir, slug
@@ -168,20 +173,35 @@ def _generate(args: argparse.Namespace, request: GenerationRequest, start: float
             print(f"simdiff: warning: {env.as_tuple()} is outside the trained range (gravity {lo:g}..{hi:g} m/s², "
                   f"|wind| <= {MAX_WIND:g} N); the motion is an extrapolation", file=sys.stderr)
             break
-    out_dir = prepare_out_dir(args.out if args.out is not None else fresh_dir(Path("out") / slug(request.text)))
+    out_dir = args.out if args.out is not None else fresh_dir(Path("out") / slug(request.text))
+    created = not out_dir.exists()
+    out_dir = prepare_out_dir(out_dir)
+    try:
+        return _generate_into(args, request, start, finisher, folder, out_dir)
+    except BaseException:
+        if created:  # a failed run leaves no empty folder behind
+            try:
+                out_dir.rmdir()
+            except OSError:
+                pass
+        raise
+
+
+def _generate_into(args: argparse.Namespace, request: GenerationRequest, start: float, finisher: Finisher | None,
+                   folder: Path, out_dir: Path) -> int:
+    """:func:`_generate` once the output folder exists."""
+    import time
+
+    from simdiff.errors import SimdiffError
     from simdiff.fsio import check_writable
 
     check_writable(out_dir / "generation.json")  # a read-only folder fails now, not after sampling
 
-    import torch
-
     from simdiff.inference.default import load_default
+    from simdiff.inference.device import torch_device
     from simdiff.product.pipeline import Timer, describe_env, run_generation
 
-    try:
-        device = torch.device(args.device)
-    except (RuntimeError, ValueError):
-        raise SimdiffError(f"unknown --device {args.device!r}; use cpu or cuda") from None
+    device = torch_device(args.device)
     timer = Timer()
     _note(args, f"loading model {folder}")
     with timer.stage("load_model"):

@@ -25,25 +25,43 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import sys
+
     from simdiff.cli.feedback import slow_notice
+    from simdiff.errors import SimdiffError
     from simdiff.motion.io import load_joints
     from simdiff.motion.metrics import never_touches, physics_metrics
 
-    rows = []
+    rows, failed = [], 0
     for i, path in enumerate(args.files):
-        with slow_notice(f"reading {path} ({i + 1}/{len(args.files)})"):
-            joints = load_joints(path, asf=args.asf)
-            values = physics_metrics(joints)
+        try:
+            with slow_notice(f"reading {path} ({i + 1}/{len(args.files)})"):
+                joints = load_joints(path, asf=args.asf)
+                try:
+                    values = physics_metrics(joints)
+                except SimdiffError as exc:  # e.g. too few frames: name the file
+                    raise SimdiffError(f"{path}: {exc}") from None
+        except SimdiffError as exc:  # one line per bad file; the good files are still measured
+            failed += 1
+            print(f"simdiff: error: {exc}", file=sys.stderr)
+            continue
         rows.append({"file": str(path), "frames": int(joints.shape[0]), **{k: float(v) for k, v in values.items()},
                      "never_touch": int(never_touches(joints)[0])})
-    if args.json:
+    _print_rows(rows, args.json)
+    return 2 if failed else 0
+
+
+def _print_rows(rows: list[dict], as_json: bool) -> None:
+    """The metrics as a table (or one JSON object per file)."""
+    if as_json:
         for row in rows:
             print(json.dumps(row))
-        return 0
+        return
+    if not rows:
+        return
     keys = [k for k in rows[0] if k not in ("file",)]
     width = max(len("file"), *(len(r["file"]) for r in rows))
     print("file".ljust(width) + "".join(f"{k:>16}" for k in keys))
     for row in rows:
         cells = "".join(f"{row[k]:>16d}" if isinstance(row[k], int) else f"{row[k]:>16.3f}" for k in keys)
         print(row["file"].ljust(width) + cells)
-    return 0

@@ -7,6 +7,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from simdiff.cli.options import integer
+from simdiff.diffusion.config import MAX_STEPS
+from simdiff.errors import Terminated
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
@@ -18,12 +21,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("files", nargs="*", type=Path, metavar="FILE",
                    help="motions to open: .npy joints (T, 22, 3) or features (T, 263), .bvh, .amc, DeepMimic .txt/.json")
-    p.add_argument("--port", type=int, default=8765, help="TCP port (default 8765; 0 picks a free one)")
+    p.add_argument("--port", type=integer(0, 65535), default=8765, help="TCP port (default 8765; 0 picks a free one)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 exposes it to the network)")
     p.add_argument("--model", type=Path, help="model folder (default: $SIMDIFF_MODEL, else the shipped model)")
-    p.add_argument("--steps", type=int, help="DDIM sampling steps (default 50; fewer is faster, rougher)")
-    p.add_argument("--queue", type=int, default=4, metavar="N",
+    p.add_argument("--steps", type=integer(1, MAX_STEPS), help="DDIM sampling steps (default 50; fewer is faster, rougher)")
+    p.add_argument("--queue", type=integer(1, 64), default=4, metavar="N",
                    help="generation requests that may wait behind the running one; more get 429 (default 4)")
     p.add_argument("--device", default="cpu", help="torch device for generation (default cpu)")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser tab")
@@ -36,8 +39,9 @@ def build_server(args: argparse.Namespace):  # -> simdiff.serve.ViewerServer (im
     Raises:
         SimdiffError: bad port or device, unreadable file, address in use.
     """
-    import torch
     from tqdm.auto import tqdm
+
+    from simdiff.inference.device import torch_device
 
     from simdiff.errors import SimdiffError
     from simdiff.serve import MotionService, ViewerServer, read_listed
@@ -49,10 +53,7 @@ def build_server(args: argparse.Namespace):  # -> simdiff.serve.ViewerServer (im
         raise SimdiffError(f"--queue must be ≥ 0, got {args.queue}")
     if args.steps is not None and not 1 <= args.steps <= MAX_STEPS:
         raise SimdiffError(f"--steps must be 1..{MAX_STEPS}, got {args.steps}")
-    try:
-        torch.device(args.device)
-    except RuntimeError:
-        raise SimdiffError(f"unknown device {args.device!r}") from None
+    torch_device(args.device)
 
     def files_progress(items):
         return tqdm(items, desc="reading files", unit="file", leave=False, disable=len(items) < 2)
@@ -80,8 +81,9 @@ def run(args: argparse.Namespace) -> int:
         webbrowser.open(server.url)
     try:
         server.serve_forever()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # the usual way to stop it: one line, and the status a shell expects
         print("simdiff serve: stopped", file=sys.stderr)
+        return 143 if isinstance(exc, Terminated) else 130
     finally:
         server.server_close()
     return 0

@@ -8,9 +8,12 @@ import math
 import os
 from pathlib import Path
 
-from simdiff.cli.options import add_environment_options
-
+from simdiff.cli.options import FPS_OPTION, WORKERS, add_environment_options, real
 from simdiff.errors import SimdiffError
+
+MAX_RESIDUAL: float = 10.0
+"""Largest --residual (fraction of m·g; 0.5 is the default, 1 holds the body up at any gravity)."""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
@@ -25,8 +28,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("files", nargs="+", type=Path, metavar="FILE", help="motion files")
     add_environment_options(p)
-    p.add_argument("--residual", type=float, default=0.5, metavar="R",
-                   help="root residual bound as a fraction of m·g (torque bound 600·R N·m); 0 = strict (default 0.5)")
+    p.add_argument("--residual", type=real(0.0, MAX_RESIDUAL), default=0.5, metavar="R",
+                   help="root residual bound as a fraction of m·g, 0..10 (torque bound 600·R N·m); 0 = strict (default 0.5)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="write each rollout as DIR/<name>.npy joints")
     p.add_argument("--json", action="store_true", help="print one JSON object per motion")
     p.add_argument("--stats", type=Path, default=None, metavar="DIR",
@@ -34,9 +37,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="allow φ outside the validated ranges")
     p.add_argument("--follow-flights", action="store_true",
                    help="let flights last as long as gravity makes them (the rollout may be longer than the input)")
-    p.add_argument("--fps", type=float, default=None, help="source frame rate when the file does not say")
-    p.add_argument("--workers", type=int, default=1, metavar="N",
-                   help="motions tracked in parallel processes; 0 = one per CPU core (default 1); results do not depend on N")
+    p.add_argument("--asf", type=Path, default=None, metavar="FILE",
+                   help="ASF skeleton for AMC inputs (default: SS.asf beside each or in ../asf/)")
+    p.add_argument("--fps", type=FPS_OPTION, default=None,
+                   help="source frame rate in Hz, overriding the file's own (BVH Frame Time; AMC: CMU_data.csv, a _120 name, else 120; .npy: 20)")
+    p.add_argument("--workers", type=WORKERS, default=1, metavar="N",
+                   help="motions tracked in parallel processes, 0..64; 0 = one per CPU core (default 1); "
+                        "results do not depend on N")
     p.set_defaults(func=run)
 
 
@@ -65,22 +72,29 @@ def run(args: argparse.Namespace) -> int:
     from simdiff.motion.io import load_joints
     from simdiff.sim.env import Environment
     from simdiff.sim.flight import FlightConfig
-    from simdiff.sim.pool import PoolConfig, ProjectionPool
+    from simdiff.sim.pool import PoolConfig, ProjectionPool, WorkerDied, note_progress, stop_signals, stopped
     from simdiff.sim.residual import ResidualConfig
 
-    if args.residual < 0:
-        raise SimdiffError(f"--residual must be ≥ 0, got {args.residual}")
-    if args.workers < 0:
-        raise SimdiffError(f"--workers must be ≥ 0 (0 = one per CPU core), got {args.workers}")
     env = Environment(args.gravity, float(args.wind[0]), float(args.wind[1])).validate(force=args.force)
     stats = _stats_dir(args.stats)
     _normalizer(stats)  # a bad --stats fails here, before any slow work
     if args.out is not None:
+        check_unique_outputs(args.files, args.out, ".npy")
+    files, motions, n_bad = [], [], 0
+    for path in args.files:  # a bad file is one line; the others are still tracked
+        try:
+            motions.append(np.asarray(load_joints(path, asf=args.asf, fps=args.fps), dtype=np.float32))
+            files.append(path)
+        except SimdiffError as exc:
+            n_bad += 1
+            _failed(path, str(exc), args.json)
+    if not motions:
+        return 2
+    if args.out is not None:
         from simdiff.fsio import check_writable, ensure_dir
 
         ensure_dir(args.out)
-        check_writable(args.out / f"{args.files[0].stem}.npy")
-    motions = [np.asarray(load_joints(path, fps=args.fps), dtype=np.float32) for path in args.files]
+        check_writable(args.out / f"{files[0].stem}.npy")
     pool = ProjectionPool(PoolConfig(workers=args.workers, residual=ResidualConfig(max_force=args.residual),
                                      stats_dir=str(stats), force=args.force,
                                      flight=FlightConfig() if args.follow_flights else None))
@@ -89,24 +103,64 @@ def run(args: argparse.Namespace) -> int:
         return tqdm(results, total=len(motions), desc=f"tracking ({pool_workers(args.workers, len(motions))} workers)",
                     unit="motion", leave=False, dynamic_ncols=True)
 
-    results = pool.map(motions, env, progress=progress)
-    n_ok = n_err = 0
-    for path, (out, info) in zip(args.files, results):
-        if isinstance(info, str):  # the pool turns a failed motion into its error message
-            n_err += 1
-            print(f"{path.name}: ERROR {info}" if not args.json else json.dumps({"file": str(path), "error": info}))
-            continue
-        n_ok += info.success
-        written = None
-        if args.out is not None:
-            from simdiff.fsio import save_npy
+    n_ok = n_err = done = 0
+    try:
+        with stop_signals():  # SIGTERM as Ctrl-C: stop the workers, one line, exit 143
+            for path, (out, info) in zip(files, progress(pool.imap(motions, [env] * len(motions)))):
+                done += 1
+                if isinstance(info, str):  # the pool turns a failed motion into its error message
+                    n_err += 1
+                    _failed(path, f"{path}: cannot be tracked ({plain_error(info)})", args.json)
+                    continue
+                n_ok += info.success
+                written = None
+                if args.out is not None:
+                    from simdiff.fsio import save_npy
 
-            written = save_npy(args.out / f"{path.stem}.npy", out.astype(np.float32))
-        _report(path, info, written, args.json)
+                    written = save_npy(args.out / f"{path.stem}.npy", out.astype(np.float32))
+                _report(path, info, written, args.json)
+    except (KeyboardInterrupt, WorkerDied) as exc:
+        pool.terminate()
+        note_progress(exc, f"{done} of {len(motions)} motions done")
+        return stopped(exc, resumable=False)
+    finally:
+        pool.close()
     if not args.json:
         print(f"tracked {n_ok}/{len(args.files)} under g={env.gravity} wind=({env.wind_x}, {env.wind_y}) N "
-              f"residual={args.residual}" + (f"; {n_err} failed" if n_err else ""))
-    return 1 if n_err else 0
+              f"residual={args.residual}" + (f"; {n_err + n_bad} failed" if n_err + n_bad else ""))
+    return 2 if n_err + n_bad else 0
+
+
+def plain_error(message: str) -> str:
+    """A worker's ``"<ExceptionClass>: text"`` message without the Python class name."""
+    head, sep, rest = message.partition(": ")
+    if sep and head.isidentifier():
+        return rest.strip() or "unknown failure"
+    return message.strip() or "unknown failure"
+
+
+def _failed(path: Path, message: str, as_json: bool) -> None:
+    """One line for a motion that could not be read or tracked (JSON on stdout with --json, else stderr)."""
+    import sys
+
+    from tqdm.auto import tqdm
+
+    if as_json:
+        print(json.dumps({"file": str(path), "error": message}))
+    else:
+        tqdm.write(f"simdiff: error: {message}", file=sys.stderr)  # above a running progress bar
+
+
+def check_unique_outputs(files: list[Path], out: Path, suffix: str) -> None:
+    """Refuse inputs that would be written to the same ``out/<stem><suffix>`` (the second would overwrite the
+    first)."""
+    seen: dict[str, Path] = {}
+    for path in files:
+        name = f"{path.stem}{suffix}"
+        if name in seen:
+            raise SimdiffError(f"{seen[name]} and {path} would both be written to {out / name}: "
+                               f"give inputs with different file names")
+        seen[name] = path
 
 
 def pool_workers(requested: int, n_tasks: int) -> int:

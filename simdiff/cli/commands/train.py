@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from simdiff.cli.options import MAX_TRAIN_BATCH, SEED, WORKERS, integer, real
 from simdiff.cli.main import command_group
 
 
@@ -18,29 +19,30 @@ def _common(p: argparse.ArgumentParser) -> None:
     data.add_argument("--data", type=Path, nargs="+",
                       help="HumanML3D-layout directory (new_joint_vecs/, texts/, Mean.npy, Std.npy, <split>.txt); "
                            "several folders are read as one dataset")
-    data.add_argument("--synthetic", type=int, metavar="N", help="train on N synthetic clips (smoke tests only)")
+    data.add_argument("--synthetic", type=integer(1, 100_000), metavar="N", help="train on N synthetic clips (smoke tests only)")
     p.add_argument("--split", default="train", help="split file name under --data (default: train)")
     p.add_argument("--source", type=Path, default=None,
                    help="augmented --data only: also train on this source corpus's clips as env_index 0 (binary setting)")
     p.add_argument("--out", type=Path, required=True, help="run folder: checkpoints/, model/ (resumes if it has checkpoints)")
     p.add_argument("--config", type=Path, help="a run config JSON (see configs/); flags below override it")
-    p.add_argument("--steps", type=int, help="total optimiser steps")
-    p.add_argument("--batch-size", type=int, help="global batch size")
-    p.add_argument("--lr", type=float, help="AdamW learning rate (default 1e-4)")
+    p.add_argument("--steps", type=integer(1, 10_000_000), help="total optimiser steps")
+    p.add_argument("--batch-size", type=integer(1, MAX_TRAIN_BATCH),
+                   help=f"global batch size, 1..{MAX_TRAIN_BATCH}")
+    p.add_argument("--lr", type=real(0.0, 1.0, above=True), help="AdamW learning rate (default 1e-4)")
     p.add_argument("--lr-schedule", choices=["constant", "cosine"],
                    help="constant (MDM, the default) or cosine: from --lr down to 0 at --steps")
-    p.add_argument("--seed", type=int, help="seed for init, data order, noise, dropout (default 10)")
+    p.add_argument("--seed", type=SEED, help="seed for init, data order, noise, dropout (default 10)")
     p.add_argument("--ema", action=argparse.BooleanOptionalAction, default=None, help="keep and export an EMA of the weights")
-    p.add_argument("--ema-decay", type=float, help="EMA decay (default 0.9999)")
-    p.add_argument("--save-every", type=int, help="checkpoint period in steps")
+    p.add_argument("--ema-decay", type=real(0.0, 1.0), help="EMA decay (default 0.9999)")
+    p.add_argument("--save-every", type=integer(1, 10_000_000), help="checkpoint period in steps")
     p.add_argument("--device", default="cpu", help="torch device, e.g. cpu, cuda, cuda:1 (default: cpu)")
     p.add_argument("--clip-weights", help="local CLIP ViT-B/32 weights file (with --text-encoder clip)")
     p.add_argument("--text-table", type=Path,
                    help="precomputed caption embeddings (`simdiff train text-table`) instead of loading the text "
                         "encoder's weights (a GPU machine without them)")
-    p.add_argument("--max-minutes", type=float, default=0.0,
+    p.add_argument("--max-minutes", type=real(0.0, 1e6), default=0.0,
                    help="stop at the first checkpoint after this much wall clock (0 = run to --steps); resumable")
-    p.add_argument("--loader-workers", type=int, default=0,
+    p.add_argument("--loader-workers", type=WORKERS, default=0,
                    help="processes that build batches ahead of the training loop (0: none; same batches either way)")
     p.add_argument("--no-resume", action="store_true", help="refuse to continue an existing run folder")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -69,11 +71,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="warm start: begin from this SimDiff model folder's Sim Encoder and Motion Adapters (same "
                         "sim config) instead of zero-initialised adapters")
     a.add_argument("--sim-mode", choices=["continuous", "categorical"], help="φ as (g_z, w_x, w_y) floats or a category")
-    a.add_argument("--num-categories", type=int, help="number of environment categories (categorical)")
-    a.add_argument("--env-pairs", type=float, metavar="WEIGHT",
+    a.add_argument("--num-categories", type=integer(1, 1024), help="number of environment categories (categorical)")
+    a.add_argument("--env-pairs", type=real(0.0, 1e3), metavar="WEIGHT",
                    help="weight of the paired φ-difference loss on twin clips (a paired augmentation; 0 = off, "
                         "the paper's loss); see TrainConfig.env_pairs")
-    a.add_argument("--env-pairs-drift", type=float, metavar="WEIGHT",
+    a.add_argument("--env-pairs-drift", type=real(0.0, 1e3), metavar="WEIGHT",
                    help="weight of the twins' mean root-velocity (drift) term, with --env-pairs (0 = off); see "
                         "TrainConfig.env_pairs_drift")
     a.add_argument("--targets", choices=["simulated", "source-anchored", "source-anchored-pairs"],
@@ -94,7 +96,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     a.add_argument("--pair-twins", choices=["all", "wind"],
                    help="which twins the per-frame paired loss (--env-pairs) compares: all (default) or only those "
                         "whose phi differ in wind; see TrainConfig.pair_twins")
-    a.add_argument("--cross-twins", type=float, metavar="P",
+    a.add_argument("--cross-twins", type=real(0.0, 1.0), metavar="P",
                    help="share of paired twins (needs --env-pairs) noised from each other's motion, the target "
                         "staying their own: phi then edits the motion x_t shows; see TrainConfig.cross_twins")
     a.add_argument("--cross-match", metavar="REGEX",
@@ -113,7 +115,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                      "MODEL's; extrapolation.json records the recipe.")
     _model_and_out(x, "the fine-tuned model folder (SimDiff or backbone-only)")
     x.add_argument("--parent", type=Path, required=True, help="the model folder it was fine-tuned from")
-    x.add_argument("--lam", type=float, required=True, metavar="LAMBDA", help="extrapolation factor (e.g. 2)")
+    x.add_argument("--lam", type=real(-10.0, 10.0), required=True, metavar="LAMBDA", help="extrapolation factor (e.g. 2)")
     x.set_defaults(func=run_extrapolate)
     dp = group.add_parser("deepen", help="insert identity layers into a model's backbone (same output, more depth)",
                           description="Write MODEL with one new transformer layer after each listed backbone layer. "
@@ -123,9 +125,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                       "(`train backbone --init`). Adapters keep their inputs; new adapter slots are "
                                       "zero. deepening.json records the recipe.")
     _model_and_out(dp, "model folder (SimDiff or backbone-only)")
-    dp.add_argument("--after", type=int, nargs="+", metavar="LAYER",
+    dp.add_argument("--after", type=integer(0, 255), nargs="+", metavar="LAYER",
                     help="old layer indices each followed by a new layer (default: every layer, doubling the depth)")
-    dp.add_argument("--seed", type=int, default=0, help="seed of the new layers' input-side weights (default 0)")
+    dp.add_argument("--seed", type=SEED, default=0, help="seed of the new layers' input-side weights (default 0)")
     dp.set_defaults(func=run_deepen)
     pr = group.add_parser("precision", help="store a model's weights as float16 (half the file) or float32",
                           description="Write MODEL with its network weights stored as DTYPE (float16: half the "
@@ -138,15 +140,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run_export(args: argparse.Namespace) -> int:
+    from simdiff.cli.paths import check_separate
     from simdiff.model.checkpoint import export_backbone
 
+    check_separate(args.out, model=args.model)
     print(f"wrote {export_backbone(args.model, args.out)}")
     return 0
 
 
 def run_deepen(args: argparse.Namespace) -> int:
+    from simdiff.cli.paths import check_separate
     from simdiff.model.deepen import deepen_model
 
+    check_separate(args.out, model=args.model)
     print(f"wrote {deepen_model(args.model, args.out, args.after, args.seed)}")
     return 0
 
@@ -158,39 +164,37 @@ def _model_and_out(parser: argparse.ArgumentParser, model_help: str) -> None:
 
 
 def run_precision(args: argparse.Namespace) -> int:
+    from simdiff.cli.paths import check_separate
     from simdiff.model.precision import convert_precision
 
+    check_separate(args.out, model=args.model)
     print(f"wrote {convert_precision(args.model, args.out, args.dtype)}")
     return 0
 
 
 def run_extrapolate(args: argparse.Namespace) -> int:
+    from simdiff.cli.paths import check_separate
     from simdiff.model.extrapolate import extrapolate_backbone
 
+    check_separate(args.out, model=args.model, parent=args.parent)
     print(f"wrote {extrapolate_backbone(args.model, args.parent, args.lam, args.out)}")
     return 0
 
 
 def _run_config(args: argparse.Namespace):
-    import json
-
     from simdiff.errors import SimdiffError
     from simdiff.model.checkpoint import read_config
-    from simdiff.model.config import PRESETS, SimConfig, backbone_preset, config_from_dict
+    from simdiff.model.config import PRESETS, SimConfig, backbone_preset, check_model_config
     from simdiff.text.base import text_dim
-    from simdiff.train.config import RunConfig
+    from simdiff.train.config import RunConfig, check_train_config, read_run_config
 
     if args.config is not None:
-        if not args.config.is_file():
-            raise SimdiffError(f"{args.config}: no such config file")
-        try:
-            config = config_from_dict(json.loads(args.config.read_text()), RunConfig)
-        except json.JSONDecodeError as exc:
-            raise SimdiffError(f"{args.config}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+        config, where = read_run_config(args.config), str(args.config)
     elif (args.out / "train_config.json").is_file():  # continuing a run: start from its config
-        config = config_from_dict(json.loads((args.out / "train_config.json").read_text()), RunConfig)
+        where = str(args.out / "train_config.json")
+        config = read_run_config(where)
     else:
-        config = RunConfig()
+        config, where = RunConfig(), "the options"
     tc = config.train
     tc.mode = args.mode
     for flag, field in (("steps", "steps"), ("batch_size", "batch_size"), ("seed", "seed"), ("ema", "ema"),
@@ -236,12 +240,15 @@ def _run_config(args: argparse.Namespace):
         raise SimdiffError(f"train.pair_twins {tc.pair_twins!r}: choose from {', '.join(DRIFT_PAIRS)}")
     if tc.twin_frames != "equal" and args.mode != "adapters":
         raise SimdiffError(f"twin frames {tc.twin_frames!r} are for `simdiff train adapters`")
-    if tc.steps < 1 or tc.batch_size < 1:
-        raise SimdiffError("--steps and --batch-size must be positive")
-    if args.loader_workers < 0:
-        raise SimdiffError(f"--loader-workers must be >= 0, got {args.loader_workers}")
-    if args.max_minutes < 0:
-        raise SimdiffError(f"--max-minutes must be >= 0, got {args.max_minutes}")
+    import math  # the same bounds as the options, for values that come from a config file
+
+    if not (isinstance(tc.steps, int) and tc.steps >= 1):
+        raise SimdiffError(f"train.steps (--steps) must be a whole number ≥ 1, got {tc.steps!r}")
+    if not (isinstance(tc.batch_size, int) and 1 <= tc.batch_size <= MAX_TRAIN_BATCH):
+        raise SimdiffError(f"train.batch_size (--batch-size) must be 1..{MAX_TRAIN_BATCH}, got {tc.batch_size!r}")
+    lr = tc.optim.lr
+    if not (isinstance(lr, (int, float)) and math.isfinite(lr) and 0 < lr <= 1):
+        raise SimdiffError(f"train.optim.lr (--lr) must be a number in (0, 1], got {lr!r}")
     if args.mode == "backbone":
         model = config.model
         if args.init is not None:
@@ -271,6 +278,8 @@ def _run_config(args: argparse.Namespace):
         if args.num_categories is not None:
             sim.num_categories = args.num_categories
         config.model.sim = sim
+    check_train_config(tc, where)
+    check_model_config(config.model, where, prefix="model.")
     return config
 
 
@@ -332,6 +341,7 @@ def run(args: argparse.Namespace) -> int:
     import torch
 
     from simdiff.errors import SimdiffError
+    from simdiff.inference.device import torch_device
     from simdiff.text.base import load_text_encoder
     from simdiff.train.distributed import init_from_env, shutdown
     from simdiff.train.state import latest_checkpoint
@@ -340,10 +350,10 @@ def run(args: argparse.Namespace) -> int:
     config = _run_config(args)
     if args.no_resume and latest_checkpoint(args.out) is not None:
         raise SimdiffError(f"{args.out} already holds checkpoints (drop --no-resume to continue it)")
-    try:
-        device = torch.device(args.device)
-    except RuntimeError:
-        raise SimdiffError(f"unknown device {args.device!r}") from None
+    device = torch_device(args.device)
+    from simdiff.text.base import check_weights_option
+
+    check_weights_option(args.clip_weights)
     dist = init_from_env(device)
     if device.type == "cuda" and dist.world_size > 1:
         device = torch.device("cuda", dist.local_rank)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from simdiff.cli.options import SEED, WORKERS, real
 from simdiff.cli.main import command_group
 
 
@@ -25,8 +26,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--config", type=Path, help="a pipeline config JSON (as written to <out>/pipeline_config.json)")
     p.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override a setting, e.g. backbone.steps=500 (repeatable)")
-    p.add_argument("--seed", type=int, help="seed of every stage (default 10)")
-    p.add_argument("--sim-workers", type=int, help="simulation processes (0 = all cores)")
+    p.add_argument("--seed", type=SEED, help="seed of every stage (default 10)")
+    p.add_argument("--sim-workers", type=WORKERS, help="simulation processes (0 = all cores)")
     p.add_argument("--device", default="cpu", help="torch device for training and evaluation (cpu, cuda)")
     p.add_argument("--dry-run", action="store_true", help="print the plan (stage, current/resume/run, key) and stop")
     p.add_argument("--no-progress", action="store_true", help="hide progress bars")
@@ -35,10 +36,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     k = group.add_parser("pack", help="write a corpus as compact arrays (for carrying to a GPU machine)")
     k.add_argument("corpus", type=Path, help="HumanML3D-layout corpus folder")
     k.add_argument("--out", type=Path, required=True, help="pack folder")
-    k.add_argument("--workers", type=int, default=1, help="processes encoding clips (0: all cores)")
+    k.add_argument("--workers", type=WORKERS, default=1, help="processes encoding clips (0: all cores)")
     k.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     k.add_argument("--splits", nargs="+", help="pack only these split files' clips (default all)")
-    k.add_argument("--budget-mib", type=float, default=64.0, help="refuse a pack larger than this (0: no check)")
+    k.add_argument("--budget-mib", type=real(0.0, 1e6), default=64.0, help="refuse a pack larger than this (0: no check)")
     k.set_defaults(func=run_pack)
 
     t = group.add_parser("text-table", help="encode every caption of corpora once (for a machine without the "
@@ -54,7 +55,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     u = group.add_parser("unpack", help="restore a pack as a HumanML3D-layout corpus folder")
     u.add_argument("pack", type=Path, help="pack folder")
     u.add_argument("--out", type=Path, required=True, help="corpus folder to write")
-    u.add_argument("--workers", type=int, default=0, help="processes rebuilding features (0: all cores)")
+    u.add_argument("--workers", type=WORKERS, default=0, help="processes rebuilding features (0: all cores)")
     u.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     u.set_defaults(func=run_unpack)
 
@@ -68,9 +69,12 @@ def _config(args: argparse.Namespace):
 
     if args.config is not None:
         try:
-            config = config_from_dict(json.loads(args.config.read_text()), PipelineConfig)
-        except (OSError, json.JSONDecodeError) as exc:
+            data = json.loads(args.config.read_text(encoding="utf-8"))
+        except json.JSONDecodeError as exc:
+            raise SimdiffError(f"{args.config}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+        except (OSError, UnicodeDecodeError) as exc:
             raise SimdiffError(f"{args.config}: cannot read pipeline config ({type(exc).__name__})") from None
+        config = config_from_dict(data, PipelineConfig, str(args.config))
     else:
         config = budget_config(args.budget)
     for flag, setting in (("corpus", "corpus.path"), ("shared", "corpus.shared"), ("augmented", "augment.path"),
@@ -89,22 +93,19 @@ def _config(args: argparse.Namespace):
 
 
 def run_pipeline_cmd(args: argparse.Namespace) -> int:
-    import torch
-
-    from simdiff.errors import SimdiffError
+    from simdiff.inference.device import torch_device
     from simdiff.train.pipeline import run_pipeline
 
-    try:
-        device = torch.device(args.device)
-    except RuntimeError:
-        raise SimdiffError(f"unknown device {args.device!r}") from None
+    device = torch_device(args.device)
     run_pipeline(_config(args), args.out, device=device, dry_run=args.dry_run, progress=not args.no_progress)
     return 0
 
 
 def run_pack(args: argparse.Namespace) -> int:
+    from simdiff.cli.paths import check_separate
     from simdiff.data.pack import pack
 
+    check_separate(args.out, CORPUS=args.corpus)
     info = pack(args.corpus, args.out, budget_mib=args.budget_mib, splits=args.splits, workers=args.workers,
                 progress=not args.no_progress)
     print(f"packed {info['clips']} clips ({info.get('mirrors', 0)} as mirrors), {info['frames']} frames "
@@ -114,8 +115,10 @@ def run_pack(args: argparse.Namespace) -> int:
 
 
 def run_unpack(args: argparse.Namespace) -> int:
+    from simdiff.cli.paths import check_separate
     from simdiff.data.pack import unpack
 
+    check_separate(args.out, PACK=args.pack)
     n = unpack(args.pack, args.out, workers=args.workers, progress=not args.no_progress)
     print(f"unpacked {n} clips into {args.out}")
     return 0
@@ -134,7 +137,9 @@ def run_text_table(args: argparse.Namespace) -> int:
         try:
             captions += [line.strip() for line in args.captions.read_text(encoding="utf-8").splitlines() if line.strip()]
         except OSError as exc:
-            raise SimdiffError(f"cannot read --captions {args.captions} ({type(exc).__name__})") from None
+            raise SimdiffError(f"--captions {args.captions}: cannot read ({exc.strerror or type(exc).__name__})") from None
+        except UnicodeDecodeError:
+            raise SimdiffError(f"--captions {args.captions}: not a UTF-8 text file of captions, one per line") from None
     info = write_caption_table(captions, load_text_encoder(args.encoder), args.out, dtype=args.dtype)
     print(f"wrote {info['captions']} captions × {info['dim']} ({info['dtype']}): "
           f"{int(info['bytes']) / 2**20:.2f} MiB in {args.out}")

@@ -19,7 +19,6 @@ follow even at Earth fails under every φ, and that failure is not φ's doing.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -27,7 +26,6 @@ from typing import Any
 from simdiff.data.augment.decide import is_earth
 from simdiff.data.augment.filter import CRITERIA, FilterConfig, rejections
 from simdiff.data.augment.signal import condition_bin
-from simdiff.errors import SimdiffError
 from simdiff.motion.flight import has_flight
 
 CLASSES: tuple[str, ...] = ("plain", "flight", "acrobatics", "unknown")
@@ -50,14 +48,12 @@ def load_motion_types(corpus: Path) -> dict[str, str] | None:
     Raises:
         SimdiffError: the manifest exists but is not JSON with a ``clips`` list of ``id``/``motion_type``.
     """
-    path = Path(corpus) / MANIFEST
-    if not path.is_file():
+    from simdiff.data.manifest import read_manifest
+
+    if not (Path(corpus) / MANIFEST).exists():
         return None
-    try:
-        clips = json.loads(path.read_text(encoding="utf-8"))["clips"]
-        return {str(c["id"]): str(c.get("motion_type", "")) for c in clips}
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise SimdiffError(f"{path}: not a corpus manifest with clips[].id/motion_type ({exc})") from None
+    clips = read_manifest(corpus, ("id",))["clips"]
+    return {str(c["id"]): str(c.get("motion_type", "")) for c in clips}
 
 
 def content_class(clip: str, content: dict[str, float] | None, motion_types: dict[str, str] | None) -> str:

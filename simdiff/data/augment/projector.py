@@ -69,3 +69,7 @@ class SimProjector:
     def close(self) -> None:
         """Shut the worker processes down."""
         self._pool.close()
+
+    def terminate(self) -> None:
+        """Stop the worker processes now, their running pairs lost (Ctrl-C, SIGTERM, a dead worker)."""
+        self._pool.terminate()

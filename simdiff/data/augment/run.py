@@ -40,7 +40,6 @@ deleted when the run finalises.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 import time
@@ -59,9 +58,10 @@ from simdiff.data.augment.report import build_report, report_markdown
 from simdiff.data.augment.share import group_mirrors, mirror_condition, mirror_info, mirror_rollout, mirror_sources
 from simdiff.data.augment.pairs import clip_id_for, info_dict, load_source_joints, pair_record
 from simdiff.data.augment.projector import Projector, SimProjector
-from simdiff.data.writer import write_bytes, write_json, write_lines
+from simdiff.data.writer import check_apart, write_bytes, write_json, write_lines
 from simdiff.errors import SimdiffError
 from simdiff.sim.env import GRAVITY_RANGE, Environment
+from simdiff.sim.pool import WorkerDied, note_progress
 from simdiff.sim.retime import RetimeConfig
 
 BINARY_SIM_INDEX: int = 1
@@ -310,6 +310,7 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
     from tqdm import tqdm
 
     corpus, out = Path(corpus), Path(out)
+    check_apart(corpus, out, "--corpus", "--out")
     clips, conditions, shards = plan(corpus, config)
     out.mkdir(parents=True, exist_ok=True)
     _check_settings(out, config, conditions)
@@ -326,16 +327,24 @@ def augment(corpus: str | os.PathLike[str], out: str | os.PathLike[str], config:
     done = sum(len(assigned[c]) for i in range(len(shards)) if i not in todo for c in shards[i])
     start = time.time()
     bar = tqdm(total=total, initial=done, desc="augment", unit="pair", disable=not progress, dynamic_ncols=True)
+    clips_done = sum(len(shards[i]) for i in range(len(shards)) if i not in todo)
     try:
         for i in todo:
             record = _run_shard(corpus, out, i, shards[i], assigned, config, proj, bar.update)
             write_json(_shard_path(out, i), record)
+            clips_done += len(shards[i])
         bar.close()
         if config.resimulate_gravity_below is not None:
             from simdiff.data.augment.resim import resimulate
 
             resimulate(corpus, out, [_shard_path(out, i) for i in range(len(shards))], proj,
                        config.resimulate_gravity_below, progress)
+    except BaseException as exc:  # Ctrl-C, SIGTERM, a dead worker: stop the workers now, not after their pairs
+        if own:
+            getattr(proj, "terminate", lambda: None)()
+        if isinstance(exc, (KeyboardInterrupt, WorkerDied)):
+            note_progress(exc, f"{clips_done} of {len(clips)} clips done")
+        raise
     finally:
         bar.close()
         if own:
@@ -395,6 +404,9 @@ def finalize(corpus: Path, out: Path, config: AugmentConfig, conditions: Sequenc
             folder.mkdir(exist_ok=True)
         else:
             folder.mkdir(parents=True)
+    for folder in (out, out / SHARD_DIR, *(out / sub for sub in ("new_joint_vecs", "new_joints", "texts"))):
+        for path in folder.glob(".*.tmp"):  # a write an interrupted run did not finish
+            path.unlink(missing_ok=True)
     report = build_report(records, conditions, config, summary, motion_types=load_motion_types(corpus))
     report["wall_s_this_run"] = round(wall_s, 3)
     write_json(out / "report.json", report)

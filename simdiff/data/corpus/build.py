@@ -15,21 +15,31 @@ import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from simdiff.data.clip_files import files_exist, load_record, remove_stale, write_splits, write_stats
-from simdiff.data.corpus.windows import MAX_WINDOW, MIN_WINDOW
-from simdiff.data.writer import write_json
+from simdiff.data.clip_files import (
+    files_exist,
+    load_record,
+    remove_stale,
+    write_splits,
+    write_stats,
+)
 from simdiff.data.corpus.clips import ClipSettings, process_item, source_relative
 from simdiff.data.corpus.item import Item
-from simdiff.licences import LICENCE_SETS
 from simdiff.data.corpus.registry import SOURCES, discover_all
 from simdiff.data.corpus.splits import assign_stratified
+from simdiff.data.corpus.windows import MAX_WINDOW, MIN_WINDOW
+from simdiff.data.writer import check_apart, cleaned_on_failure, write_json
 from simdiff.errors import SimdiffError
 from simdiff.fsio import file_digest
+from simdiff.licences import LICENCE_SETS
 from simdiff.motion.skeleton import FPS
+
+MIN_CAPTIONS, MAX_CAPTIONS = 2, 10
+"""Generated captions per clip: at least 2 (HumanML3D's minimum), at most 10."""
 
 PIPELINE_VERSION: int = 2
 """Bump when an item's clips change for the same inputs (invalidates the item cache)."""
@@ -49,7 +59,7 @@ class CorpusConfig:
         out: output corpus folder (outside the repository).
         licence: ``all`` or ``permissive`` (see :data:`.item.LICENCE_SETS`).
         sources: source families (default all of :data:`.registry.SOURCES`).
-        workers: processes (1: in this process); the output does not depend on it.
+        workers: processes, 0..64 (0: one per CPU core; 1: in this process); the output does not depend on it.
         seed: captions and split order.
         captions: generated sentences per clip.
         mirror: write mirrored ``M<id>`` clips.
@@ -117,28 +127,69 @@ def _run_item(item: Item, settings: ClipSettings) -> tuple[list[dict[str, Any]],
         return [], f"{item.path}: {type(exc).__name__}: {exc}".splitlines()[0], False
 
 
+def _run_pool(todo: list[tuple[Item, str]], settings: ClipSettings, workers: int, finish: Any) -> None:
+    """Process ``todo`` in ``workers`` processes, ``finish`` each result in order; on Ctrl-C, SIGTERM
+    or a dead worker (one-line ``WorkerDied``) the workers are terminated at once."""
+    from simdiff.sim.pool import (
+        stop_workers,
+        worker_died,
+        worker_init_quiet,
+        workers_starting,
+    )
+
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=worker_init_quiet, initargs=(os.getpid(),))
+    processes: list[Any] = []
+    try:
+        with workers_starting():  # the workers start here and keep SIGINT ignored: Ctrl-C is the parent's
+            futures = [(item, key, pool.submit(_run_item, item, settings)) for item, key in todo]
+        processes = list((getattr(pool, "_processes", None) or {}).values())
+        for item, key, future in futures:
+            try:
+                result = future.result()
+            except BrokenProcessPool:
+                raise worker_died(processes) from None
+            finish(item, key, result)
+    except BaseException:
+        stop_workers(pool, processes)
+        raise
+    pool.shutdown(wait=True)
+
+
 def _alternates(item: Item, shared: Path) -> list[dict[str, Any]]:
     return [{"source": a.source, "file": source_relative(a.path, shared)} for a in item.alternates]
 
 
 def build(cfg: CorpusConfig) -> CorpusResult:
-    """Build (or update) the corpus in ``cfg.out``; see the module docstring."""
-    from tqdm import tqdm
-
+    """Build (or update) the corpus in ``cfg.out``; see the module docstring. A build that fails before any item
+    is done removes the folders it created; ``--out`` must be apart from ``--shared``."""
     started = time.perf_counter()
     shared, out = Path(cfg.shared), Path(cfg.out)
-    if cfg.workers < 1:
-        raise SimdiffError(f"--workers must be >= 1, got {cfg.workers}")
+    from simdiff.sim.pool import MAX_WORKERS
+
+    if not 0 <= cfg.workers <= MAX_WORKERS:
+        raise SimdiffError(f"--workers must be 0 (one per CPU core) to {MAX_WORKERS}, got {cfg.workers}")
+    if not MIN_CAPTIONS <= cfg.captions <= MAX_CAPTIONS:
+        raise SimdiffError(f"--captions must be {MIN_CAPTIONS} to {MAX_CAPTIONS}, got {cfg.captions}")
+    workers = cfg.workers or os.cpu_count() or 1
     if cfg.licence not in LICENCE_SETS:
         raise SimdiffError(f"unknown licence set {cfg.licence!r}; choose from {', '.join(LICENCE_SETS)}")
+    check_apart(shared, out, "--shared", "--out")
     cache = out / BUILD_DIR
-    (cache / "items").mkdir(parents=True, exist_ok=True)
+    records: dict[str, dict[str, Any]] = {}
+    with cleaned_on_failure(cache / "items", keep=lambda: bool(records)):  # keep only resumable work
+        return _build_items(cfg, shared, out, cache, workers, records, started)
+
+
+def _build_items(cfg: CorpusConfig, shared: Path, out: Path, cache: Path, workers: int,
+                 records: dict[str, dict[str, Any]], started: float) -> CorpusResult:
+    """Discover, process (or reuse) and finish every item of a build whose cache folder exists."""
+    from tqdm import tqdm
+
     items = discover_all(shared, cache, cfg.sources, cfg.licence)
     if not items:
         raise SimdiffError(f"no motion files for sources {', '.join(cfg.sources)} under {shared}")
     settings = ClipSettings(out=out, shared=shared, seed=cfg.seed, captions=cfg.captions, mirror=cfg.mirror)
 
-    records: dict[str, dict[str, Any]] = {}
     todo: list[tuple[Item, str]] = []
     stale: set[str] = set()
     reused = 0
@@ -164,18 +215,20 @@ def build(cfg: CorpusConfig) -> CorpusResult:
         records[item.id] = record
         bar.update(1)
 
-    if cfg.workers == 1 or len(todo) <= 1:
-        for item, key in todo:
-            finish(item, key, _run_item(item, settings))
-    else:
-        from simdiff.sim.pool import exit_with_parent
+    try:
+        if workers == 1 or len(todo) <= 1:
+            for item, key in todo:
+                finish(item, key, _run_item(item, settings))
+        else:
+            _run_pool(todo, settings, workers, finish)
+    except BaseException as exc:  # Ctrl-C, SIGTERM, a dead worker: finished items are cached, a rerun resumes
+        from simdiff.sim.pool import WorkerDied, note_progress
 
-        with ProcessPoolExecutor(max_workers=cfg.workers, initializer=exit_with_parent,
-                                 initargs=(os.getpid(),)) as pool:
-            futures = [(item, key, pool.submit(_run_item, item, settings)) for item, key in todo]
-            for item, key, future in futures:
-                finish(item, key, future.result())
-    bar.close()
+        if isinstance(exc, (KeyboardInterrupt, WorkerDied)):
+            note_progress(exc, f"{len(records)} of {len(items)} items done")
+        raise
+    finally:
+        bar.close()
     return _finish(cfg, items, records, stale, reused, len(todo), started)
 
 

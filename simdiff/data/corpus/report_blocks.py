@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from collections import defaultdict
 from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
 
+from simdiff.data.manifest import REPORT_CLIP_KEYS, read_manifest
 from simdiff.data.writer import write_text
 from simdiff.errors import SimdiffError
 from simdiff.fsio import atomic_path
@@ -29,14 +29,9 @@ class FilmstripRenderer(Protocol):
 
 
 def load_manifest(corpus: Path) -> dict[str, Any]:
-    """The ``manifest.json`` written by ``simdiff data build``."""
-    path = corpus / "manifest.json"
-    if not path.is_file():
-        raise SimdiffError(f"not a built corpus (no manifest.json): {corpus}")
-    try:
-        return json.loads(path.read_text())
-    except ValueError as exc:
-        raise SimdiffError(f"{path}: invalid JSON ({exc})") from None
+    """The ``manifest.json`` written by ``simdiff data build``, checked for every field the report reads
+    (:func:`simdiff.data.manifest.read_manifest`)."""
+    return read_manifest(corpus, REPORT_CLIP_KEYS)
 
 
 def table(header: list[str], rows: list[list[object]]) -> str:
@@ -195,11 +190,11 @@ def open_report(corpus: str | Path, out: str | Path | None) -> tuple[Path, dict[
     """
     corpus = Path(corpus)
     manifest = load_manifest(corpus)
-    folder = Path(out) if out is not None else corpus / "report"
-    folder.mkdir(parents=True, exist_ok=True)
     clips: list[dict[str, Any]] = manifest["clips"]
     if not clips:
         raise SimdiffError(f"{corpus}/manifest.json lists no clips")
+    folder = Path(out) if out is not None else corpus / "report"
+    folder.mkdir(parents=True, exist_ok=True)
     return corpus, manifest, folder, clips
 
 

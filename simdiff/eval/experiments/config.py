@@ -309,6 +309,10 @@ def load_config(path: str | os.PathLike[str], budget: str | None = None,
         raw = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise SimdiffError(f"{path}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+    if not isinstance(raw, dict):
+        from simdiff.model.config import json_kind
+
+        raise SimdiffError(f"{path}: must be a JSON object {{...}}, got {json_kind(raw)}")
     raw = copy.deepcopy(raw)
     budget = budget or "full"
     budgets = raw.get("budgets", {})
@@ -320,8 +324,11 @@ def load_config(path: str | os.PathLike[str], budget: str | None = None,
         set_dotted(raw, key, value)
     raw["budget"], raw["source"] = budget, str(path)
     try:
-        raw["models"] = [config_from_dict(m, ModelSpec) for m in raw.get("models", [])]
-        config = config_from_dict(raw, ExperimentConfig)
+        if not isinstance(raw.get("models", []), list):
+            raise SimdiffError(f"{path}: models must be a JSON array of objects")
+        raw["models"] = [config_from_dict(m, ModelSpec, str(path), f"models.{i}.")
+                         for i, m in enumerate(raw.get("models", []))]
+        config = config_from_dict(raw, ExperimentConfig, str(path))
     except TypeError as exc:  # a required field missing
         raise SimdiffError(f"{path}: {exc}") from None
     check(config, path)

@@ -33,6 +33,7 @@ the functions are :func:`retarget_rig` (also exported here) and
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -56,9 +57,10 @@ from simdiff.motion.io.bvh import (
     starts_with_tpose,
 )
 from simdiff.motion.io.bvh_writer import write_bvh
+from simdiff.motion.io.gltf_writer import write_glb
 from simdiff.motion.io.deepmimic import read_deepmimic
-from simdiff.motion.io.npy import read_npy, save_npy
-from simdiff.motion.io.rates import folder_fps_hint
+from simdiff.motion.io.npy import check_coordinates, read_npy, save_npy
+from simdiff.motion.io.rates import check_fps, folder_fps_hint
 from simdiff.motion.io.resample import resample as _resample
 from simdiff.motion.io.retarget import retarget_rig, to_canonical_lengths
 from simdiff.motion.io.rigs import RigSpec, detect_rig
@@ -68,6 +70,7 @@ from simdiff.motion.skeleton import FPS
 __all__ = [
     "AsfSkeleton",
     "RigMotion",
+    "check_regular_file",
     "detect_rig",
     "find_asf",
     "load_joints",
@@ -81,6 +84,7 @@ __all__ = [
     "save_npy",
     "to_canonical_lengths",
     "write_bvh",
+    "write_glb",
 ]
 
 SUFFIXES: tuple[str, ...] = (".amc", ".bvh", ".txt", ".json", ".npy")
@@ -119,15 +123,15 @@ def load_rig(
     """
     path = Path(path)
     suffix = path.suffix.lower()
-    if not path.is_file():
-        raise MotionFormatError(path, "no such file")
+    fps = check_fps(fps, "fps") if fps is not None else None
+    check_regular_file(path)
     if units is not None and suffix != ".bvh":
-        raise MotionFormatError(path, f"units={units!r} applies to BVH files only")
+        raise MotionFormatError(path, f"a unit ({units!r}) applies to BVH files only")
     if suffix == ".amc":
         skeleton = Path(asf) if asf is not None else find_asf(path)
         if skeleton is None:
             raise MotionFormatError(
-                path, "no ASF skeleton found (looked for SS.asf / HDM_<actor>.asf beside it and in asf/); pass asf="
+                path, "no ASF skeleton found (looked for SS.asf / HDM_<actor>.asf beside it and in asf/); pass --asf FILE"
             )
         rate = fps if fps is not None else (
             lookup_cmu_fps(path) or amc_fps_from_name(path) or AMC_DEFAULT_FPS
@@ -140,14 +144,29 @@ def load_rig(
     raise MotionFormatError(path, f"unsupported motion file type {suffix!r} (known: {', '.join(SUFFIXES)})")
 
 
+def check_regular_file(path: Path) -> None:
+    """Refuse a ``path`` that is missing, a folder, or not a regular file (a device such as ``/dev/zero``, a pipe).
+
+    Raises:
+        MotionFormatError: one line naming the file and what it is.
+    """
+    if path.is_file():
+        return
+    if path.is_dir():
+        raise MotionFormatError(path, "a folder, not a motion file")
+    if path.exists():
+        raise MotionFormatError(path, "not a regular file (a device, pipe or socket), not a motion file")
+    raise MotionFormatError(path, "no such file")
+
+
 def _units_to_scale(path: Path, units: str | float) -> float:
     """Metres per file unit of a ``units`` argument."""
     if isinstance(units, str):
         if units.lower() not in KNOWN_SCALES:
             raise MotionFormatError(path, f"unknown units {units!r} (known: {', '.join(KNOWN_SCALES)})")
         return KNOWN_SCALES[units.lower()]
-    if not float(units) > 0:
-        raise MotionFormatError(path, f"units must be positive metres per unit, got {units!r}")
+    if not 0 < float(units) < math.inf:
+        raise MotionFormatError(path, f"a unit must be a positive finite number of metres, got {units!r}")
     return float(units)
 
 
@@ -198,7 +217,9 @@ def load_joints(
     Args:
         path: the motion file.
         asf: ASF skeleton for an ``.amc`` file (default: found beside it).
-        fps: the source frame rate, overriding the file's (for ``.npy``: default 20).
+        fps: the source frame rate, overriding the file's (for ``.npy``: default 20); any rate,
+            given or read, must be a finite number in [1, 1000] Hz
+            (:func:`~simdiff.motion.io.rates.check_fps`).
         drop_first: BVH only, see :func:`load_rig`.
         units: BVH only, file unit, see :func:`load_rig`.
         canonical: rebuild with HumanML3D's canonical bone lengths.
@@ -207,14 +228,16 @@ def load_joints(
     Returns:
         (T, 22, 3) float32 joint positions in metres, Y-up, 20 fps.
     Raises:
-        MotionFormatError: one line naming the file (and line) of any bad input.
+        MotionFormatError: one line naming the file (and line) of any bad input, including joints beyond
+            ±:data:`~simdiff.limits.MAX_COORD` m (10 km).
+        FrameRateError: ``fps`` outside [1, 1000] Hz (a ``SimdiffError``).
     """
     path = Path(path)
+    fps = check_fps(fps, "fps") if fps is not None else None
     if path.suffix.lower() == ".npy":
-        if not path.is_file():
-            raise MotionFormatError(path, "no such file")
+        check_regular_file(path)
         if units is not None:
-            raise MotionFormatError(path, f"units={units!r} applies to BVH files only")
+            raise MotionFormatError(path, f"a unit ({units!r}) applies to BVH files only")
         array = read_npy(path)
         if array.ndim == 2:
             # lazy: the feature pipeline (simdiff.motion.features) is heavier and optional here
@@ -224,10 +247,15 @@ def load_joints(
                 array = np.asarray(features_to_joints(array), dtype=np.float32)
             except (ValueError, SimdiffError) as exc:
                 raise MotionFormatError(path, f"bad HumanML3D features: {exc}") from None
+            if not np.all(np.isfinite(array)):
+                raise MotionFormatError(path, "bad HumanML3D features: the joints they give are not finite")
+            check_coordinates(path, array, "the joints of these features")
         if fps is not None and fps != FPS:
             array = _resample(array, fps, FPS)
         if canonical:
             array = to_canonical_lengths(array, floor=False)
         return np.ascontiguousarray(array, dtype=np.float32)
     rig = load_rig(path, asf=asf, fps=fps, drop_first=drop_first, units=units)
-    return retarget_rig(rig, fps=FPS, canonical=canonical, clean=clean)
+    joints = retarget_rig(rig, fps=FPS, canonical=canonical, clean=clean)
+    check_coordinates(path, joints)
+    return joints

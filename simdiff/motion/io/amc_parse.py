@@ -11,6 +11,11 @@ from simdiff.motion.io.asf import AsfSkeleton, _floats
 from simdiff.motion.io.rig import read_motion_text
 
 
+def _frame_number(token: str) -> bool:
+    """Whether ``token`` is a frame number: ASCII digits, at most 9 of them."""
+    return token.isascii() and token.isdecimal() and len(token) <= 9
+
+
 def _dof_counts(skeleton: AsfSkeleton) -> dict[str, int]:
     ndof = {name: len(b.dofs) for name, b in skeleton.bones.items()}
     ndof["root"] = len(skeleton.root_order)
@@ -49,14 +54,14 @@ def _parse_amc_regular(
             continue
         start = i
         break
-    if start < 0 or not lines[start].strip().isdigit():
+    if start < 0 or not _frame_number(lines[start].strip()):
         return None
     layout: list[tuple[str, int]] = []
     for raw in lines[start + 1 :]:
         words = raw.split()
         if not words:
             continue
-        if len(words) == 1 and words[0].isdigit():
+        if len(words) == 1 and _frame_number(words[0]):
             break
         layout.append((words[0], len(words) - 1))
     if {name for name, _ in layout} != expected or len(layout) != len(expected):
@@ -128,7 +133,7 @@ def _parse_amc_lines(
             elif first.upper() == ":DEGREES":
                 degrees = True
             continue
-        if len(tokens) == 1 and first.isdigit():
+        if len(tokens) == 1 and _frame_number(first):
             close_frame()
             number = int(first)
             if frame_count and number != frame_number + 1:

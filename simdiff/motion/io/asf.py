@@ -239,6 +239,9 @@ def read_asf(path: str | Path) -> AsfSkeleton:
     to_m = INCH / length_unit
     for bone in bones.values():
         bone.length *= to_m
+        if not np.isfinite(bone.length):
+            raise MotionFormatError(path, f"bone {bone.name!r} is infinitely long in metres (length unit "
+                                          f"{length_unit:g})", bone.line)
     return AsfSkeleton(
         path=path,
         bones=bones,

@@ -12,9 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
+from simdiff.errors import MotionFormatError
 from simdiff.motion.io.amc_parse import parse_amc as _parse_amc
 from simdiff.motion.io.asf import INCH, AsfBone, AsfSkeleton, read_asf
 from simdiff.motion.io.euler import euler_to_matrix
+from simdiff.motion.io.rates import check_fps
 from simdiff.motion.io.rig import RigMotion
 
 __all__ = ["ASF_SITES", "DEFAULT_FPS", "INCH", "AsfBone", "AsfSkeleton", "find_asf", "lookup_cmu_fps",
@@ -24,6 +26,7 @@ DEFAULT_FPS: float = 120.0
 """Capture rate of most CMU trials (a few are 60 fps: see CMU_data.csv)."""
 
 
+@np.errstate(over="ignore", invalid="ignore")
 def read_amc(
     path: str | Path, asf: str | Path | AsfSkeleton, *, fps: float = DEFAULT_FPS
 ) -> RigMotion:
@@ -38,8 +41,10 @@ def read_amc(
         :data:`ASF_SITES` (``head_centre``), (T, J, 3) metres, Y-up.
     Raises:
         MotionFormatError: naming the file and line of a malformed or truncated input.
+        FrameRateError: ``fps`` outside [1, 1000] Hz.
     """
     path = Path(path)
+    fps = check_fps(fps, "fps")
     skeleton = asf if isinstance(asf, AsfSkeleton) else read_asf(asf)
     data, degrees = _parse_amc(path, skeleton)
     num_frames = next(iter(data.values())).shape[0]
@@ -83,6 +88,9 @@ def read_amc(
         positions[:, i] = positions[:, parent] + rotations[:, i] @ offset
     parents = tuple(-1 if parent_of[n] is None else index[parent_of[n]] for n in names)  # type: ignore[index]
     names, parents, positions = _add_sites(skeleton, list(names), parents, positions, rotations)
+    positions = positions.astype(np.float32)
+    if not np.all(np.isfinite(positions)):  # overflowing values (warnings silenced by the decorator)
+        raise MotionFormatError(path, "joint positions overflow: root translation or bone lengths too large")
     return RigMotion(
         names=tuple(names),
         parents=parents,
@@ -191,7 +199,7 @@ def lookup_cmu_fps(amc_path: str | Path) -> float | None:
     """
     amc_path = Path(amc_path)
     parts = amc_path.stem.split("_")
-    if len(parts) != 2 or not all(p.isdigit() for p in parts):
+    if len(parts) != 2 or not all(p.isascii() and p.isdecimal() and len(p) < 10 for p in parts):
         return None
     subject, trial = int(parts[0]), int(parts[1])
     for folder in (amc_path.parent, amc_path.parent.parent):
@@ -203,9 +211,12 @@ def lookup_cmu_fps(amc_path: str | Path) -> float | None:
                 for row in csv.DictReader(handle):
                     try:
                         if int(row["Subject"]) == subject and int(row["Trial #"]) == trial:
-                            return float(row["framerate"])
+                            rate = float(row["framerate"])
+                        else:
+                            continue
                     except (KeyError, TypeError, ValueError):
                         continue
+                    return check_fps(rate, f"framerate of trial {amc_path.stem}", index)
         except OSError:
             continue
     return None

@@ -9,6 +9,7 @@ kept as joints named ``<parent>_End``. File units are converted to metres by ``s
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,6 +18,7 @@ import numpy as np
 
 from simdiff.errors import MotionFormatError
 from simdiff.motion.io.euler import euler_to_matrix
+from simdiff.motion.io.rates import MAX_FPS, MIN_FPS, check_fps, fps_problem
 from simdiff.motion.io.rig import RigMotion, read_motion_text
 
 _CHANNELS = ("xposition", "yposition", "zposition", "xrotation", "yrotation", "zrotation")
@@ -84,7 +86,7 @@ class _Tokens:
     def expect(self, word: str) -> int:
         token, line = self.next(repr(word))
         if token.upper() != word.upper():
-            raise MotionFormatError(self.path, f"expected {word!r}, got {token!r}", line)
+            raise MotionFormatError(self.path, f"expected {word!r}, got {token[:40]!r}", line)
         return line
 
     def number(self, what: str) -> float:
@@ -92,44 +94,43 @@ class _Tokens:
         try:
             value = float(token)
         except ValueError:
-            raise MotionFormatError(self.path, f"expected a number for {what}, got {token!r}", line) from None
+            raise MotionFormatError(self.path, f"expected a number for {what}, got {token[:40]!r}", line) from None
         if not np.isfinite(value):
             raise MotionFormatError(self.path, f"non-finite {what}", line)
         return value
 
 
-def _parse_joint(tokens: _Tokens, joints: list[BvhJoint], parent: int, name: str, line: int) -> None:
-    """Parse ``{ OFFSET .. CHANNELS .. children }`` of one joint (its keyword and name read)."""
+MAX_DEPTH: int = 256
+"""Deepest joint nesting a BVH hierarchy may have (a human rig is about 10 deep)."""
+MAX_JOINTS: int = 4096
+"""Most joints a BVH hierarchy may have (a human rig with fingers has about 100)."""
+
+
+def _parse_hierarchy(tokens: _Tokens, root_name: str, root_line: int) -> list[BvhJoint]:
+    """Parse the root's ``{ OFFSET .. CHANNELS .. children }`` and every joint below it, iteratively."""
     path = tokens.path
-    tokens.expect("{")
-    tokens.expect("OFFSET")
-    offset = np.array([tokens.number(f"OFFSET of {name!r}") for _ in range(3)])
-    index = len(joints)
-    joint = BvhJoint(name=name, parent=parent, offset=offset, line=line)
-    joints.append(joint)
-    peek = tokens.peek()
-    if peek is not None and peek[0].upper() == "CHANNELS":
-        tokens.next("CHANNELS")
-        count_token, count_line = tokens.next("channel count")
-        if not count_token.isdigit():
-            raise MotionFormatError(path, f"bad channel count {count_token!r}", count_line)
-        channels = []
-        for _ in range(int(count_token)):
-            channel, ch_line = tokens.next("channel name")
-            if channel.lower() not in _CHANNELS:
-                raise MotionFormatError(path, f"unknown channel {channel!r}", ch_line)
-            channels.append(channel.lower())
-        if len(set(channels)) != len(channels):
-            raise MotionFormatError(path, f"repeated channel in {name!r}", count_line)
-        joint.channels = tuple(channels)
-    while True:
+    joints: list[BvhJoint] = []
+    open_joints: list[int] = []  # indices of the joints whose '}' is still to come
+    pending: tuple[str, int] | None = (root_name, root_line)
+    while pending is not None or open_joints:
+        if pending is not None:  # a joint's keyword and name are read: its block follows
+            name, line = pending
+            pending = None
+            if len(open_joints) >= MAX_DEPTH:
+                raise MotionFormatError(path, f"hierarchy deeper than {MAX_DEPTH} joints", line)
+            if len(joints) >= MAX_JOINTS or len(name) > 200:
+                what = f"more than {MAX_JOINTS} joints" if len(name) <= 200 else "a joint name over 200 characters"
+                raise MotionFormatError(path, f"hierarchy has {what}", line)
+            open_joints.append(_joint_head(tokens, joints, open_joints[-1] if open_joints else -1, name, line))
+            continue
+        index = open_joints[-1]
+        name = joints[index].name
         token, tline = tokens.next("'}' or a child joint")
         upper = token.upper()
         if upper == "}":
-            return
-        if upper == "JOINT":
-            child, cline = tokens.next("joint name")
-            _parse_joint(tokens, joints, index, child, cline)
+            open_joints.pop()
+        elif upper == "JOINT":
+            pending = tokens.next("joint name")
         elif upper == "END":
             tokens.expect("Site")
             tokens.expect("{")
@@ -140,7 +141,34 @@ def _parse_joint(tokens: _Tokens, joints: list[BvhJoint], parent: int, name: str
                 BvhJoint(name=f"{name}_End", parent=index, offset=end_offset, line=tline, is_end=True)
             )
         else:
-            raise MotionFormatError(path, f"unexpected {token!r} in joint {name!r}", tline)
+            raise MotionFormatError(path, f"unexpected {token[:40]!r} in joint {name!r}", tline)
+    return joints
+
+
+def _joint_head(tokens: _Tokens, joints: list[BvhJoint], parent: int, name: str, line: int) -> int:
+    """Read ``{ OFFSET x y z [CHANNELS n ...]`` of one joint, append it; returns its index."""
+    path = tokens.path
+    tokens.expect("{")
+    tokens.expect("OFFSET")
+    offset = np.array([tokens.number(f"OFFSET of {name!r}") for _ in range(3)])
+    joint = BvhJoint(name=name, parent=parent, offset=offset, line=line)
+    joints.append(joint)
+    peek = tokens.peek()
+    if peek is not None and peek[0].upper() == "CHANNELS":
+        tokens.next("CHANNELS")
+        count_token, count_line = tokens.next("channel count")
+        if not (count_token.isdecimal() and int(count_token[:4]) <= len(_CHANNELS)):
+            raise MotionFormatError(path, f"bad channel count {count_token[:20]!r} (0 to 6)", count_line)
+        channels = []
+        for _ in range(int(count_token)):
+            channel, ch_line = tokens.next("channel name")
+            if channel.lower() not in _CHANNELS:
+                raise MotionFormatError(path, f"unknown channel {channel[:40]!r}", ch_line)
+            channels.append(channel.lower())
+        if len(set(channels)) != len(channels):
+            raise MotionFormatError(path, f"repeated channel in {name!r}", count_line)
+        joint.channels = tuple(channels)
+    return len(joints) - 1
 
 
 def parse_bvh(path: str | Path) -> BvhFile:
@@ -160,27 +188,29 @@ def parse_bvh(path: str | Path) -> BvhFile:
     tokens.next("HIERARCHY")
     tokens.expect("ROOT")
     root_name, root_line = tokens.next("root name")
-    joints: list[BvhJoint] = []
-    _parse_joint(tokens, joints, -1, root_name, root_line)
+    joints = _parse_hierarchy(tokens, root_name, root_line)
     extra = tokens.peek()
     if extra is not None:
         raise MotionFormatError(
-            path, f"unexpected {extra[0]!r} after the root joint (one skeleton only)", extra[1]
+            path, f"unexpected {extra[0][:40]!r} after the root joint (one skeleton only)", extra[1]
         )
     if not tokens.motion_line:
         raise MotionFormatError(path, "no MOTION section", len(lines) or None)
     names = [j.name for j in joints]
     if len(set(names)) != len(names):
-        dup = next(n for n in names if names.count(n) > 1)
+        seen: set[str] = set()
+        dup = next(n for n in names if n in seen or seen.add(n))  # type: ignore[func-returns-value]
         raise MotionFormatError(path, f"duplicate joint name {dup!r}", joints[names.index(dup)].line)
 
     row = tokens.motion_line  # 0-based index of the line after MOTION
     num_frames, row = _header_value(path, lines, row, "Frames:")
+    frames_row = row
     frame_time, row = _header_value(path, lines, row, "Frame Time:")
-    if num_frames != int(num_frames) or num_frames < 0:
-        raise MotionFormatError(path, f"Frames must be a whole number, got {num_frames}", row)
-    if frame_time <= 0:
-        raise MotionFormatError(path, f"Frame Time must be positive, got {frame_time}", row)
+    if not (math.isfinite(num_frames) and num_frames >= 0 and num_frames == int(num_frames)):
+        raise MotionFormatError(path, f"Frames must be a whole number, got {num_frames:g}", frames_row)
+    if not (frame_time > 0 and fps_problem(1.0 / frame_time) is None):  # nan, inf, <= 0, outside MIN..MAX_FPS Hz
+        raise MotionFormatError(path, f"Frame Time must be seconds per frame, {1 / MAX_FPS:g} to {1 / MIN_FPS:g} "
+                                      f"({MIN_FPS:g} to {MAX_FPS:g} frames per second), got {frame_time:g}", row)
     n = int(num_frames)
     starts, total = [], 0
     for joint in joints:
@@ -197,9 +227,7 @@ def parse_bvh(path: str | Path) -> BvhFile:
             path, f"truncated: Frames says {n} but {len(data_lines)} frame lines follow", len(lines)
         )
     if len(data_lines) > n:
-        raise MotionFormatError(
-            path, f"more frame lines than Frames: {n}", data_numbers[n]
-        )
+        raise MotionFormatError(path, f"more frame lines than Frames: {n}", data_numbers[n])
     values = np.empty((n, total), dtype=np.float64)
     for k, (raw, lineno) in enumerate(zip(data_lines, data_numbers)):
         words = raw.split()
@@ -211,7 +239,7 @@ def parse_bvh(path: str | Path) -> BvhFile:
             values[k] = [float(w) for w in words]
         except ValueError:
             bad = next(w for w in words if not _is_float(w))
-            raise MotionFormatError(path, f"non-numeric value {bad!r} in frame {k + 1}", lineno) from None
+            raise MotionFormatError(path, f"non-numeric value {bad[:40]!r} in frame {k + 1}", lineno) from None
     if not np.all(np.isfinite(values)):
         k = int(np.argwhere(~np.isfinite(values))[0, 0])
         raise MotionFormatError(path, f"non-finite value in frame {k + 1}", data_numbers[k])
@@ -388,12 +416,13 @@ def read_bvh(
         RigMotion with every joint, End Site and site, (T, J, 3) metres Y-up; ``meta``
         holds "scale" and "frame_time".
     Raises:
-        MotionFormatError: naming the file and line of a malformed or truncated input.
+        MotionFormatError: naming the file (and line) of a malformed, truncated or overflowing input.
     """
     return rig_from_bvh(parse_bvh(path), scale=scale, up=up, drop_first=drop_first, fps=fps,
                         sites=sites, rest_axes=rest_axes)
 
 
+@np.errstate(over="ignore", invalid="ignore")
 def rig_from_bvh(
     bvh: BvhFile,
     *,
@@ -426,12 +455,14 @@ def rig_from_bvh(
         positions = np.concatenate([positions, extra], axis=1)
         names += [s[0] for s in sites]
         parents += [names.index(s[1]) for s in sites]
-    positions = _to_y_up(positions, up)
+    positions = _to_y_up(positions, up).astype(np.float32)
+    if not np.all(np.isfinite(positions)):  # overflowing values (warnings silenced by the decorator)
+        raise MotionFormatError(bvh.path, "joint positions overflow: OFFSET or position values too large")
     return RigMotion(
         names=tuple(names),
         parents=tuple(parents),
-        positions=positions.astype(np.float32),
-        fps=fps if fps is not None else 1.0 / bvh.frame_time,
+        positions=positions,
+        fps=check_fps(fps, "fps") if fps is not None else 1.0 / bvh.frame_time,
         source=bvh.path,
         meta={"scale": scale, "frame_time": bvh.frame_time},
     )

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from simdiff.errors import MotionFormatError
+from simdiff.motion.io.rates import check_fps
 from simdiff.motion.io.rig import RigMotion, read_motion_text
 from simdiff.motion.quaternion import qnormalize, quat_to_matrix
 
@@ -93,6 +94,7 @@ def _frame_lines(text: str) -> list[int]:
     return lines
 
 
+@np.errstate(over="ignore", invalid="ignore")
 def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
     """Read a DeepMimic humanoid3d motion file into global joint positions.
 
@@ -112,6 +114,10 @@ def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise MotionFormatError(path, f"invalid JSON: {exc.msg}", exc.lineno) from None
+    except RecursionError:
+        raise MotionFormatError(path, "invalid DeepMimic JSON: nested too deeply") from None
+    except ValueError:  # an integer of thousands of digits
+        raise MotionFormatError(path, "invalid JSON: a number thousands of digits long") from None
     if not isinstance(doc, dict) or "Frames" not in doc:
         raise MotionFormatError(path, "not a DeepMimic motion: no \"Frames\" list", 1)
     frames = doc["Frames"]
@@ -119,7 +125,7 @@ def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
         raise MotionFormatError(path, "\"Frames\" must be a non-empty list", _key_line(text, "Frames"))
     for k, frame in enumerate(frames):
         ok = isinstance(frame, list) and len(frame) == VALUES_PER_FRAME
-        ok = ok and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in frame)
+        ok = ok and all(isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) < 1e300 for v in frame)
         if not ok or not np.all(np.isfinite(np.asarray(frame, dtype=np.float64))):
             line = _nth(_frame_lines(text), k)
             what = (
@@ -138,7 +144,9 @@ def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
         if positive.size == 0:
             fps = DEFAULT_FPS
         else:
-            fps = 1.0 / float(np.median(positive))
+            fps = check_fps(1.0 / float(np.median(positive)), "the frame rate of the frame durations", path)
+    else:
+        fps = check_fps(fps, "fps")
     quats = [data[:, 4:8]]
     col = 8
     angles: dict[int, np.ndarray] = {}
@@ -162,11 +170,17 @@ def read_deepmimic(path: str | Path, *, fps: float | None = None) -> RigMotion:
         i = names.index(link)
         extra.append(positions[:, i] + rotations[:, i] @ np.asarray(offset))
     all_positions = np.concatenate([positions, np.stack(extra, axis=1)], axis=1)
+    if float(np.sum(dts[:-1])) * fps > 10 * len(dts) + 100:  # resampling would make far more frames than given
+        raise MotionFormatError(path, f"frame durations add up to {float(np.sum(dts[:-1])):g} s, far more than "
+                                      f"{len(dts)} frames at {fps:g} fps")
     all_positions, retimed = _uniform_time(all_positions, dts, fps)
+    all_positions = all_positions.astype(np.float32)
+    if not np.all(np.isfinite(all_positions)):
+        raise MotionFormatError(path, "joint positions overflow: root position values too large")
     return RigMotion(
         names=tuple(names),
         parents=tuple(parents),
-        positions=all_positions.astype(np.float32),
+        positions=all_positions,
         fps=fps,
         source=path,
         meta={"loop": doc.get("Loop"), "retimed": retimed},

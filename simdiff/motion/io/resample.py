@@ -6,6 +6,8 @@ from fractions import Fraction
 
 import numpy as np
 
+from simdiff.motion.io.rates import check_fps
+
 _MAX_FACTOR = 64
 """Largest up/down factor handled by polyphase filtering; other ratios interpolate."""
 
@@ -37,10 +39,13 @@ def resample(positions: np.ndarray, src_fps: float, dst_fps: float = 20.0) -> np
         dst_fps: wanted frame rate.
     Returns:
         (T', ...) float32 array, T' = ceil(T * dst_fps / src_fps).
+    Raises:
+        FrameRateError: a rate that is not a finite number in [1, 1000] Hz (a ``SimdiffError``
+            and a ``ValueError``; :func:`~simdiff.motion.io.rates.check_fps`).
     """
+    src_fps = check_fps(src_fps, "source frame rate")
+    dst_fps = check_fps(dst_fps, "target frame rate")
     x = np.asarray(positions, dtype=np.float64)
-    if src_fps <= 0 or dst_fps <= 0:
-        raise ValueError(f"frame rates must be positive, got {src_fps} -> {dst_fps}")
     if x.shape[0] == 0:
         return x.astype(np.float32)
     if abs(src_fps - dst_fps) <= 1e-6 * dst_fps:

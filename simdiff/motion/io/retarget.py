@@ -33,7 +33,6 @@ from simdiff.motion.io.rigs import (  # noqa: F401  (re-exported: the joint maps
     Source,
     detect_rig,
 )
-from simdiff.motion.io.rigs.base import sources_of as _sources_of
 from simdiff.motion.io.rigs.base import terms as _terms
 
 

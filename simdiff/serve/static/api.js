@@ -18,9 +18,15 @@ async function request(url, options = {}) {
   return body;
 }
 
+let uploadLimit = Infinity;  // bytes; from /api/info: a larger file is refused here, before it is sent
+
 export const api = {
   /** Model status, listed files, slider limits, defaults, skeleton. */
-  info: () => request("/api/info"),
+  info: async () => {
+    const info = await request("/api/info");
+    uploadLimit = info.limits.upload_bytes ?? Infinity;
+    return info;
+  },
 
   /** Generate one motion: {text, gravity, wind_x, wind_y, seconds, seed, simulate, alpha, env_guidance, guidance, foot_lock} → {joints, fps, parents, meta}. */
   generate: (params) => request("/api/generate", {
@@ -30,12 +36,28 @@ export const api = {
   }),
 
   /** Upload a motion file (.npy joints or features, .bvh, DeepMimic) → same shape as generate. */
-  open: (file) => request(`/api/open?name=${encodeURIComponent(file.name)}`, {
-    method: "POST",
-    headers: { "Content-Type": "application/octet-stream" },
-    body: file,
-  }),
+  open: (file) => file.size > uploadLimit
+    ? Promise.reject(new Error(`${file.name}: ${file.size} bytes is over the server's ${uploadLimit}-byte upload limit`))
+    : request(`/api/open?name=${encodeURIComponent(file.name)}`, {
+      method: "POST",
+      headers: { "Content-Type": "application/octet-stream" },
+      body: file,
+    }),
 
   /** The index-th file named on the command line. */
   openListed: (index) => request(`/api/files/${index}`),
+
+  /** The skinned body of an answer (its `body` address) → the .glb file's bytes (ArrayBuffer). */
+  body: async (url) => {
+    let response;
+    try {
+      response = await fetch(url);
+    } catch (err) {
+      throw new Error("cannot reach the server: is `simdiff serve` still running?");
+    }
+    if (response.ok) return response.arrayBuffer();
+    let message = `${response.status} ${response.statusText}`;
+    try { message = (await response.json()).error || message; } catch (err) { /* not JSON: keep the status */ }
+    throw new Error(message);
+  },
 };

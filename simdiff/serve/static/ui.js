@@ -1,7 +1,9 @@
-// Page wiring: controls → API → player. Page state for tests and scripts is window.simdiffState.
+// Page wiring: controls → API → player. Page state for tests and scripts is window.simdiffState; the 3D
+// view's numbers are window.simdiffViewer.debug().
 
 import { api } from "./api.js";
 import { SkeletonPlayer } from "./player.js";
+import { BodyPlayer } from "./scene.js";
 
 const $ = (id) => document.getElementById(id);
 const SLIDERS = ["gravity", "wind_x", "wind_y", "alpha", "env_guidance", "guidance"];
@@ -20,10 +22,14 @@ const state = {
   digest: null,        // checksum of the joints on screen (changes when the motion does)
   meta: null,
   model: null,
+  view: null,          // "webgl" (body + stick figure) | "2d" (stick figure only: no WebGL here)
+  body: null,          // the body of the motion on screen: "loading" | "ready" | "error" | null (2d view)
+  body_error: null,    // why it could not be shown
+  stick: false,        // the stick-figure box
 };
 window.simdiffState = state;
 
-const player = new SkeletonPlayer($("view"), {
+const hooks = {
   onFrame(frame, frames, playing) {
     Object.assign(state, { frame, frames, playing });
     $("scrub").max = String(Math.max(0, frames - 1));
@@ -32,8 +38,36 @@ const player = new SkeletonPlayer($("view"), {
     $("time").textContent = `${(frame / fps).toFixed(2)} / ${(Math.max(0, frames - 1) / fps).toFixed(2)} s`;
     $("play").textContent = playing ? "Pause" : "Play";
   },
-});
+};
+let player;
+try {
+  player = new BodyPlayer($("view"), hooks);
+  state.view = "webgl";
+} catch (err) {  // no WebGL: the 2D stick figure
+  player = new SkeletonPlayer($("view"), hooks);
+  state.view = "2d";
+  $("stick").closest("label").hidden = true;
+  $("model-info").dataset.note = "No WebGL in this browser: the stick figure only.";
+}
 window.simdiffPlayer = player;
+window.simdiffViewer = { debug: () => (player.debug ? player.debug() : { renderer: "2d" }) };
+
+/** Fetch and show the body of `motion` (the answer's `body` address); the stick figure stands in meanwhile. */
+async function showBody(motion) {
+  if (!player.setBody) return;
+  Object.assign(state, { body: "loading", body_error: null });
+  try {
+    if (!motion.body) throw new Error("the server sent no body");
+    const bytes = await api.body(motion.body);
+    await player.setBody(motion, bytes);
+    if (player.motion === motion) state.body = "ready";
+  } catch (err) {
+    if (player.motion !== motion) return;
+    player.bodyFailed();
+    Object.assign(state, { body: "error", body_error: err.message });
+    $("status").textContent += ` No body: ${err.message}`;
+  }
+}
 
 function setStatus(status, text) {
   state.status = status;
@@ -56,6 +90,7 @@ function digest(joints) {
 
 function show(motion) {
   player.load(motion);
+  showBody(motion);
   const meta = motion.meta;
   Object.assign(state, { frames: motion.joints.length, source: meta.source, digest: digest(motion.joints), meta, error: null });
   $("error").hidden = true;
@@ -145,13 +180,13 @@ function configure(info) {
   }
   $("env-note").hidden = info.model.env || !info.model.found;
   $("prompt").value = defaults.text;
-  Object.assign($("seconds"), { min: String(1 / limits.fps), max: String(limits.seconds), value: String(defaults.seconds) });
+  Object.assign($("seconds"), { min: String(limits.min_seconds ?? 1 / limits.fps), max: String(limits.seconds), value: String(defaults.seconds) });
   $("seed").value = String(defaults.seed);
   $("foot_lock").checked = Number(defaults.foot_lock) > 0;
   footLock = Number(defaults.foot_lock) > 0 ? Number(defaults.foot_lock) : 1;
   $("version").textContent = `v${info.version}`;
   const m = info.model;
-  $("model-info").textContent = m.error ? m.error : `Model: ${m.path} (${m.kind})`;
+  $("model-info").textContent = (m.error ? m.error : `Model: ${m.path} (${m.kind})`) + ($("model-info").dataset.note ? ` ${$("model-info").dataset.note}` : "");
   $("generate").disabled = !m.found || Boolean(m.error);
   for (const b of $("gravity-presets").querySelectorAll("button")) {
     b.disabled = !m.env;
@@ -184,6 +219,10 @@ function bindControls() {
     player.setFrame(frame);
   });
   $("follow").addEventListener("change", () => { player.follow = $("follow").checked; player._dirty = true; });
+  $("stick").addEventListener("change", () => {
+    state.stick = $("stick").checked;
+    if (player.setStick) player.setStick(state.stick);
+  });
   $("file-input").addEventListener("change", () => {
     const file = $("file-input").files[0];
     if (file) openWith(file.name, () => api.open(file));
