@@ -127,7 +127,7 @@ def test_sigterm_stops_workers_quietly_and_the_rerun_resumes(clean, tmp_path: Pa
 def test_a_killed_worker_is_one_line_and_the_rerun_resumes(clean, tmp_path: Path) -> None:
     code, err = _stop_and_resume(clean, tmp_path, "kill-worker")
     assert code == 1, err
-    assert "a worker process died (signal 9" in err and "run the same command again" in err
+    assert "a worker process died" in err and "run the same command again" in err  # its signal when still known
 
 
 def _motions(tmp_path: Path, n: int) -> list[Path]:
@@ -164,7 +164,7 @@ def test_track_stops_quietly(tmp_path: Path, how: str) -> None:
     if how == "ctrl-c":
         assert proc.returncode == 130 and "interrupted" in err and "of 8 motions done" in err, err
     else:
-        assert proc.returncode == 1 and "a worker process died (signal 9" in err, err
+        assert proc.returncode == 1 and "a worker process died" in err, err
 
 
 BUILD = textwrap.dedent('''
