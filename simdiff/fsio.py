@@ -197,6 +197,18 @@ def read_json(path: str | Path) -> Any:
         raise SimdiffError(f"{path}: cannot read JSON: {first}") from None
 
 
+def read_config_json(path: Path) -> Any:
+    """Parse a configuration file; undecodable, malformed or unreadable is one line naming it and the line."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise SimdiffError(f"{path}: not a UTF-8 text file") from None
+    except json.JSONDecodeError as exc:
+        raise SimdiffError(f"{path}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+    except OSError as exc:
+        raise SimdiffError(f"{path}: cannot read ({exc.strerror or exc})") from None
+
+
 def save_npy(path: str | Path, array: np.ndarray) -> Path:
     """Save ``array`` as ``.npy`` at exactly ``path`` (no suffix added) atomically."""
     with atomic_path(path) as tmp:

@@ -12,15 +12,9 @@ import torch
 
 from simdiff.cli.main import main
 from simdiff.errors import SimdiffError
-from simdiff.inference.generator import MotionGenerator
-from simdiff.model import ModelConfig, SimConfig, backbone_preset, build_network
 
 
-def save_tiny(folder: Path, sim: bool = True) -> Path:
-    torch.manual_seed(0)
-    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig() if sim else None)
-    MotionGenerator(build_network(config), config, std=torch.full((263,), 0.05)).save(folder)
-    return folder
+from test_generate_cli import save_tiny  # noqa: E402 - the shared tiny-model fixture
 
 
 @pytest.fixture(scope="module")

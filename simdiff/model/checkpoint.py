@@ -14,7 +14,7 @@ from safetensors.torch import load_file
 from torch import Tensor, nn
 
 from simdiff.errors import SimdiffError
-from simdiff.fsio import atomic_save_tensors
+from simdiff.fsio import atomic_save_tensors, read_config_json
 from simdiff.model.backbone import MDMBackbone
 from simdiff.model.config import BackboneConfig, ModelConfig, check_model_config, config_from_dict
 from simdiff.model.simdiff_net import SimDiffNet
@@ -90,14 +90,7 @@ def read_config(folder: str | os.PathLike[str]) -> ModelConfig:
     path = Path(folder) / CONFIG_NAME
     if not path.is_file():
         raise SimdiffError(f"{path}: no such file (expected a model folder with {CONFIG_NAME} and {WEIGHTS_NAME})")
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise SimdiffError(f"{path}: not a UTF-8 text file") from None
-    except json.JSONDecodeError as exc:
-        raise SimdiffError(f"{path}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
-    except OSError as exc:
-        raise SimdiffError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    data = read_config_json(path)
     return check_model_config(config_from_dict(data, ModelConfig, str(path)), str(path))
 
 

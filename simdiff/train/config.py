@@ -138,21 +138,13 @@ def read_run_config(path: str | os.PathLike[str]) -> RunConfig:
         SimdiffError: unreadable or invalid JSON, not an object, an unknown key, a value of the wrong type or out of
             range; one line naming the file and the key.
     """
-    import json
-
+    from simdiff.fsio import read_config_json
     from simdiff.model.config import config_from_dict
 
     path = Path(path)
     if not path.is_file():
         raise SimdiffError(f"{path}: no such config file")
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise SimdiffError(f"{path}: not a UTF-8 text file") from None
-    except json.JSONDecodeError as exc:
-        raise SimdiffError(f"{path}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
-    except OSError as exc:
-        raise SimdiffError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    data = read_config_json(path)
     config = config_from_dict(data, RunConfig, str(path))
     check_train_config(config.train, str(path))
     return config
