@@ -58,6 +58,7 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
                  {"name": "SimDiff", "model": "adapters", **FAST}],
         "fig5": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}],
         "env_response": [{"name": "MDM", "model": "backbone", **FAST}],
+        "contacts": [{"name": "MDM", "model": "backbone", **FAST}],
         "retrack": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                     {"name": "SimDiff", "model": "adapters", **FAST}],
     }[kind]
@@ -70,14 +71,14 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
     return path
 
 
-def test_shipped_configs_are_the_five_experiments_with_relative_paths() -> None:
+def test_shipped_configs_are_the_experiments_with_relative_paths() -> None:
     paths = sorted(CONFIGS.glob("eval_*.json"))
-    assert [p.stem for p in paths] == ["eval_env_response", "eval_fig4", "eval_fig5", "eval_retrack", "eval_table1",
-                                       "eval_table2"]
+    assert [p.stem for p in paths] == ["eval_contacts", "eval_env_response", "eval_fig4", "eval_fig5", "eval_retrack",
+                                       "eval_table1", "eval_table2"]
     for path in paths:
         raw = json.loads(path.read_text())
         assert raw["kind"] == raw["name"] == path.stem[5:]
-        for value in [raw["corpus"], raw["evaluator"]["path"], *raw["paths"].values()]:
+        for value in [raw["corpus"], *([raw["evaluator"]["path"]] if "evaluator" in raw else []), *raw["paths"].values()]:
             assert not Path(value).is_absolute() and "/tmp" not in value, value
         quick = load_config(path, "quick")
         full = load_config(path, "full")
@@ -483,3 +484,27 @@ def test_env_response_row_with_env_guidance(setup: dict[str, Path]) -> None:
     with pytest.raises(SimdiffError, match="env_guidance must be a finite number ≥ 0, got -1"):
         run_experiment(write(setup, "env_response", name="env_neg", env_control=control, models=neg),
                        projector=PhysicsStandIn(), progress=False, text_encoder=hash_text)
+
+
+def test_contacts_reports_each_type_with_and_without_cleanup_against_real_clips(setup: dict[str, Path]) -> None:
+    corpus = setup["corpus"]
+    ids = sorted(p.stem for p in (corpus / "new_joints").glob("*.npy"))
+    test = set((corpus / "test.txt").read_text().split())
+    clips = [{"id": i, "motion_type": "jump" if int(i) % 3 == 2 else "walk", "mirror_of": None,
+              "split": "test" if i in test else "train"} for i in ids]
+    (corpus / "manifest.json").write_text(json.dumps({"clips": clips}))
+    try:
+        options = {"prompts": {"walk": ["a person walks"], "jump": ["a person jumps"]}, "seeds": 2, "length": 30}
+        report = run_experiment(write(setup, "contacts", contacts=options), progress=False, text_encoder=hash_text)
+    finally:
+        (corpus / "manifest.json").unlink()
+    rows = {(r["method"], r["type"]): r for r in report["rows"]}
+    assert set(rows) == {("real mocap", "walk"), ("real mocap", "jump"), ("MDM", "walk"), ("MDM", "jump")}
+    real = rows[("real mocap", "walk")]
+    assert real["real"]["n"] == sum(1 for c in clips if c["split"] == "test" and c["motion_type"] == "walk")
+    assert real["real"]["bone_std_mm"]["max"] < 0.1 and real["real"]["above_speed_limit"] == 0.0  # the corpus is its own limit
+    model = rows[("MDM", "walk")]
+    assert model["without"]["n"] == model["with"]["n"] == 2
+    assert model["with"]["bone_std_mm"]["max"] < 1.0 and model["without"]["bone_std_mm"]["max"] < 1.0  # rigid written joints
+    md = (setup["root"] / "reports/contacts/report.md").read_text()
+    assert "| walk | real (test" in md and "| jump | MDM, no cleanup |" in md

@@ -46,7 +46,8 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
         (tiny_model / "sampling.json").unlink()
     captured = capsys.readouterr()
     assert code == 0, captured.err
-    assert captured.err == ""  # quiet: no bars, no notes
+    # quiet: no bars, no notes; only warnings about the motion itself (this random tiny model may glide)
+    assert all(line.startswith("simdiff: warning: ") for line in captured.err.splitlines()), captured.err
     printed = captured.out.split()
     assert [Path(p).name for p in printed] == ["sample0.bvh", "sample0.gif", "sample0_features.npy",
                                                "sample0_joints.npy", "generation.json"]
@@ -54,7 +55,7 @@ def test_generate_end_to_end(tiny_model: Path, tmp_path: Path, capsys) -> None:
     assert np.load(tmp_path / "o" / "sample0_joints.npy").shape == (10, 22, 3)
     meta = json.loads((tmp_path / "o" / "generation.json").read_text())
     assert (meta["alpha"], meta["steps"], meta["frames"]) == (0.5, 2, 10)
-    assert meta["foot_lock"] == 1.0 and meta["foot_cleanup"] == 3  # lock, swing clearance, floating clip dropped
+    assert meta["foot_lock"] == 1.0 and meta["foot_cleanup"] == 4  # swing clearance, floating clip dropped, planted feet held by leg IK
     assert meta["model"]["path"] == str(tiny_model.resolve()) and meta["timings_s"]["load_model"] > 0
     assert meta["threads"] == torch.get_num_threads()
     assert (meta["model"]["trained_on"], meta["model"]["weights_licence"]) == ("unknown", "unknown")  # no provenance.json
@@ -207,8 +208,9 @@ def test_a_failed_finish_still_writes_the_generated_motion(tiny_model: Path, tmp
     assert json.loads((tmp_path / "o" / "generation.json").read_text())["simulate_error"] == "the simulator broke"
 
 
-def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path: Path, capsys) -> None:
+def test_generate_foot_lock_holds_planted_feet_and_keeps_the_root_path(tiny_model: Path, tmp_path: Path, capsys) -> None:
     from simdiff.motion.features import SLICES
+    from simdiff.motion.rigid import joints_from_features
 
     import shutil
 
@@ -224,10 +226,11 @@ def test_generate_foot_lock_moves_only_the_root_path(tiny_model: Path, tmp_path:
     assert main([*argv, "--out", str(tmp_path / "off")]) == 0, capsys.readouterr().err
     assert main([*argv, "--foot-lock", "1", "--out", str(tmp_path / "on")]) == 0, capsys.readouterr().err
     off, on = (np.load(tmp_path / d / "sample0_features.npy") for d in ("off", "on"))
-    expected = clean_feet_numpy(off)  # every foot planted: the lock moves the root, nothing swings to lift
-    assert np.allclose(on, expected, atol=1e-5) and not np.allclose(on, off, atol=1e-4)  # something was planted
-    for name in ("root_rot_vel", "root_y", "ric", "rot6d", "contacts"):
-        assert np.allclose(on[:, SLICES[name]], off[:, SLICES[name]], atol=1e-5), name
+    assert np.allclose(on, clean_feet_numpy(off), atol=1e-5)  # the feature passes
+    joints_off, joints_on = (np.load(tmp_path / d / "sample0_joints.npy") for d in ("off", "on"))
+    assert np.allclose(joints_on, joints_from_features(on, 1.0), atol=1e-5)  # the hold, on the written joints
+    assert np.allclose(joints_on[:, 0], joints_off[:, 0], atol=1e-5)  # the root keeps its path
+    assert not np.allclose(joints_on, joints_off, atol=1e-4)  # something was planted and held
     assert json.loads((tmp_path / "on" / "generation.json").read_text())["foot_lock"] == 1.0
     capsys.readouterr()
     assert main([*argv, "--foot-lock", "2", "--out", str(tmp_path / "bad")]) == 2

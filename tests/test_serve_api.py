@@ -145,7 +145,7 @@ def test_generate_matches_direct_sampling(server, model_dir):
     assert status == 200 and out["meta"]["sampling"]["foot_lock"] == 1.0
     locked = gen.generate(["a person jumps forward"], 40, replace(config, foot_lock=1.0), env=(-5.0, 3.0, -2.0),
                           seed=7).clips()[0]
-    np.testing.assert_allclose(np.asarray(out["joints"]), joints_from_features(locked.numpy()), atol=1e-4)
+    np.testing.assert_allclose(np.asarray(out["joints"]), joints_from_features(locked.numpy(), 1.0), atol=1e-4)
 
 
 def test_generate_with_simulated_finish(server):

@@ -115,11 +115,17 @@ def _draw(dataset: Any, rng: np.random.Generator, config: ProtocolConfig) -> lis
     return batches
 
 
-def _physics(features: Tensor, lengths: Tensor) -> dict[str, float]:
+def _physics(features: Tensor, lengths: Tensor, foot_lock: float | None = None) -> dict[str, float]:
+    """Physics metrics of ground truth's stored positions (``foot_lock`` None) or of the joints a user gets for
+    generated features (smoothed, rigid, planted feet held at ``foot_lock``)."""
     from simdiff.motion.features import features_to_joints
     from simdiff.motion.metrics import never_touches, own_floor_metrics, physics_metrics
+    from simdiff.motion.rigid import batch_joints_from_features
 
-    joints = features_to_joints(features.detach().cpu().double()).numpy()
+    if foot_lock is None:
+        joints = features_to_joints(features.detach().cpu().double()).numpy()
+    else:
+        joints = batch_joints_from_features(features, lengths, foot_lock)
     lens = lengths.cpu().clamp(min=2, max=joints.shape[1]).numpy()
     return {**physics_metrics(joints, lens), **own_floor_metrics(joints, lens),
             "never_touch": float(never_touches(joints, lens).mean())}
@@ -169,7 +175,7 @@ def evaluate_t2m(evaluator: Evaluator, dataset: Any, generate: GenerateFn | None
                 seconds += time.perf_counter() - start
                 gen_emb.append(evaluator.embed_motion(feats, b["lengths"]))
                 if config.physics:
-                    phys.append(_physics(feats, b["lengths"]))
+                    phys.append(_physics(feats, b["lengths"], getattr(generate, "foot_lock", 0.0)))
             gen = np.concatenate(gen_emb)
             row["generated"] = _scores(text, gen, gt, config, np.random.default_rng([config.seed, r, 3]))
             if phys:
@@ -258,6 +264,8 @@ def generator_fn(generator: Any, sampling: SamplingConfig = SamplingConfig(), *,
         return feats
 
     generate.finish_log = finish_log  # type: ignore[attr-defined]
+    # the planted-feet hold of the written joints; a PhysDiff projection or a simulated finish is measured as is
+    generate.foot_lock = 0.0 if physdiff is not None or simulate else sampling.foot_lock  # type: ignore[attr-defined]
     return generate
 
 

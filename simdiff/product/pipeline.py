@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from simdiff.product.finisher import Finisher
 
 FEATURES_NOTE = ("(T, 263) float32 un-normalised HumanML3D features, one row per joint frame as the model "
-                 "samples them (MDM convention); joints = simdiff.motion.rigid.joints_from_features(features)")
+                 "samples them (MDM convention); joints = simdiff.motion.rigid.joints_from_features(features, foot_lock)")
 
 
 @dataclass
@@ -126,7 +126,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
     samples = []
     with timer.stage("decode"):
         for (c, k), f in zip(runs, features):
-            joints = joints_from_features(f)
+            joints = joints_from_features(f, request.sampling.foot_lock)
             samples.append(Sample(c, k, request.seed + k, envs[c], f, joints))
     return samples
 

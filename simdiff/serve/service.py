@@ -302,7 +302,7 @@ class MotionService:
             self._lock.release()
         features = out.clips()[0].detach().cpu().numpy().astype(np.float32)
         _check_finite(features)
-        joints = joints_from_features(features)  # the joints every command writes
+        joints = joints_from_features(features, config.foot_lock)  # the joints every command writes
         _check_finite(joints)
         from simdiff.product.pipeline import floor_contact
 

@@ -89,8 +89,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--alpha", type=real(*ALPHA_RANGE), metavar="A",
                      help=f"strength of the environment adapters, 0 = ignore φ (default {cfg.alpha:g})")
     smp.add_argument("--foot-lock", type=real(0.0, 1.0), metavar="S",
-                     help="foot cleanup, strength 0..1: move the root so the feet the motion marks planted do not "
-                          "slide, lift swinging feet that drag along the floor 2 cm clear of it, and lower a motion "
+                     help="foot cleanup, strength 0..1: hold the feet the motion marks planted in place by leg IK (the "
+                          "root keeps its path), lift swinging feet that drag along the floor 4 cm clear of it, and lower a motion "
                           f"that never comes within 0.10 m of the floor onto it (0 = off; default {cfg.foot_lock:g})")
     smp.add_argument("--env-guidance", type=real(*ENV_GUIDANCE_RANGE), metavar="S",
                      help="push the adapters' answer to φ (against Earth without wind) S times as far, 1 = off "

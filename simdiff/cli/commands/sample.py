@@ -118,7 +118,7 @@ def _sample(args: argparse.Namespace) -> int:
             for i, clip in enumerate(out.clips(), start=c):
                 features = clip.cpu().numpy().astype(np.float32)
                 save_npy(stage / f"sample_{i:03d}.npy", features)
-                save_npy(stage / f"sample_{i:03d}_joints.npy", joints_from_features(features))
+                save_npy(stage / f"sample_{i:03d}_joints.npy", joints_from_features(features, config.foot_lock))
                 index.append({"file": f"sample_{i:03d}.npy", "joints": f"sample_{i:03d}_joints.npy", "text": texts[i],
                               "frames": int(features.shape[0]), "fps": 20})
         if bar is not None:

@@ -13,10 +13,12 @@ Kinds (``configs/eval_<kind>.json``):
 * ``retrack``: closed loop: generated motions re-tracked in the simulator under their φ (:mod:`.retrack`).
 * ``env_response``: each generated response to φ against the simulator's response of the same
   Earth motion: sign agreement, slope ratio, additivity (:mod:`.env_response`).
+* ``contacts``: sliding, skate ratio, joint speeds and root accelerations of the written joints per motion type,
+  with and without the foot cleanup, against real mocap of the type (:mod:`.contacts`).
 
 Each report folder holds ``report.json`` (config, resolved paths, provenance, budget, rows),
 ``report.md`` (tables, provenance), figures, and ``rows/`` (one file per finished row; a rerun
-skips them, see :mod:`.runner`). :func:`run_all` runs the five in dependency order.
+skips them, see :mod:`.runner`). :func:`run_all` runs them in dependency order.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from typing import Any
 
 from simdiff.fsio import write_text
 from simdiff.errors import SimdiffError
-from simdiff.eval.experiments import env_response, fig4, fig5, retrack, table1, table2
+from simdiff.eval.experiments import contacts, env_response, fig4, fig5, retrack, table1, table2
 from simdiff.eval.experiments.config import KINDS, ExperimentConfig, ModelSpec, load_config
 from simdiff.eval.experiments.provenance import load_average, now
 from simdiff.eval.experiments.report import duration, header
@@ -39,8 +41,8 @@ __all__ = ["KINDS", "ORDER", "ExperimentConfig", "ModelSpec", "Runner", "load_co
            "run_experiment"]
 
 MODULES: dict[str, ModuleType] = {"table1": table1, "table2": table2, "fig4": fig4, "fig5": fig5, "retrack": retrack,
-                                  "env_response": env_response}
-ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack", "env_response")
+                                  "env_response": env_response, "contacts": contacts}
+ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack", "env_response", "contacts")
 """Run order of :func:`run_all`: table2 first, so table1 finds the best α and reuses its rows."""
 
 
@@ -118,7 +120,7 @@ def run_all(configs: str | os.PathLike[str] = "configs", *, budget: str | None =
             overrides: list[tuple[str, Any]] | None = None, only: list[str] | None = None, projector: Any = None,
             command: list[str] | None = None, progress: bool = True, log: Any = print,
             text_encoder: Any = None) -> list[dict[str, Any]]:
-    """Run table2, table1, fig4, fig5 and retrack (or ``only`` those) in order; returns their reports.
+    """Run every kind of :data:`ORDER` (or ``only`` those) in order; returns their reports.
 
     An override whose first key an experiment's config does not use (``env_control`` for table1) is
     still applied: every config accepts every field.

@@ -21,7 +21,7 @@ from typing import Any
 from simdiff.errors import SimdiffError
 from simdiff.eval.protocol import ProtocolConfig
 
-KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response")
+KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response", "contacts")
 """Experiment kinds, named as in the issue (and the paper)."""
 ROLES: tuple[str, ...] = ("backbone", "adapters", "adapters_binary")
 """Model roles ``paths`` may name: MDM backbone, continuous (φ) adapters, categorical (binary) adapters."""
@@ -169,6 +169,20 @@ class EnvControlOptions:
 
 
 @dataclass
+class ContactOptions:
+    """The contacts report: generated motions per motion type against the corpus's clips of that type.
+
+    Attributes:
+        prompts: motion type (a corpus ``motion_type``) → captions; seeds: noise seeds per caption;
+        length: frames per generated motion (20 fps).
+    """
+
+    prompts: dict[str, list[str]] = field(default_factory=dict)
+    seeds: int = 4
+    length: int = 160
+
+
+@dataclass
 class ExperimentConfig:
     """One experiment; see :mod:`simdiff.eval.experiments` for the kinds.
 
@@ -186,7 +200,7 @@ class ExperimentConfig:
         ddpm_samples: DDPM rows measure on this many test motions (0: the full protocol; ≥ batch
             size: ``ddpm_replications`` protocol replications of whole batches; fewer: physics
             metrics and time only).
-        envs: φ list (retrack); retrack_samples: motions per (method, φ);
+        envs: φ list (retrack); retrack_samples: motions per (method, φ); contacts: the contacts report;
         include_ground_truth: retrack also re-tracks the test motions themselves.
         budgets: named override sets, e.g. ``{"quick": {"about": "...", "set": {"protocol.replications": 3}}}``.
         text_encoder: ``auto``, each model's own (the only value; tests inject a stand-in through
@@ -222,6 +236,7 @@ class ExperimentConfig:
     include_ground_truth: bool = True
     timing: TimingOptions = field(default_factory=TimingOptions)
     env_control: EnvControlOptions = field(default_factory=EnvControlOptions)
+    contacts: ContactOptions = field(default_factory=ContactOptions)
     projector: ProjectorSpec = field(default_factory=ProjectorSpec)
     costs: CostModel = field(default_factory=CostModel)
     budgets: dict[str, dict[str, Any]] = field(default_factory=dict)

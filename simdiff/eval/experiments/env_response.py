@@ -48,7 +48,7 @@ def measure(runner: Runner, spec: ModelSpec) -> dict[str, Any]:
     """Generate under every φ, re-track the Earth motions under every φ, score the responses."""
     import time
 
-    from simdiff.motion.features import features_to_joints
+    from simdiff.motion.rigid import batch_joints_from_features
     from simdiff.sim.env import Environment
 
     c, o = runner.config, runner.config.env_control
@@ -62,7 +62,7 @@ def measure(runner: Runner, spec: ModelSpec) -> dict[str, Any]:
         fn = runner.generate_fn(spec, "ddim", alpha, env)
         feats, s = runner.generate(fn, captions, [o.length] * len(captions), c.seed)
         seconds += s
-        generated[tuple(env)] = np.asarray(features_to_joints(feats.double()), dtype=np.float32)
+        generated[tuple(env)] = batch_joints_from_features(feats, [o.length] * len(captions), fn.foot_lock)
     earth = generated[tuple(EARTH)]
     start = time.perf_counter()
     jobs = [(i, env) for env in envs for i in range(len(units))]

@@ -60,15 +60,15 @@ def conditions(runner: Runner) -> list[tuple[str, list[float]]]:
 
 
 def measure(runner: Runner, spec: ModelSpec, env: list[float] | None, key: str) -> dict[str, Any]:
-    """Generate every prompt × seed under φ; per-motion statistics and their mean ± 95% CI."""
-    from simdiff.motion.features import features_to_joints
+    """Generate every prompt × seed under φ; per-motion statistics (of the written joints) and their mean ± 95% CI."""
+    from simdiff.motion.rigid import batch_joints_from_features
 
     o = runner.config.env_control
     captions = [p for p in o.prompts for _ in range(o.seeds)]
     fn = runner.generate_fn(spec, "ddim", (o.alpha if o.alpha is not None else runner.alpha(spec))
                            if runner.is_simdiff(spec) else None, env)
     feats, seconds = runner.generate(fn, captions, [o.length] * len(captions), runner.config.seed)
-    joints = np.asarray(features_to_joints(feats.double()), dtype=np.float32)
+    joints = batch_joints_from_features(feats, [o.length] * len(captions), fn.foot_lock)
     samples = [{"prompt": c, "seed": i % o.seeds, **motion_stats(j)} for i, (c, j) in enumerate(zip(captions, joints))]
     save_npy(runner.rows_dir / f"{key}.motion.npy", joints[0])
     summary = {}

@@ -252,6 +252,15 @@ class Runner:
                                "env_index": spec.env_index, "device": self.config.device}
         if self.backbone_of_simdiff(spec):
             out["backbone_only"] = True  # the folder's SimDiff model, adapters left out
+        if out["sampling"]["foot_lock"]:
+            from simdiff.motion.foot_lock import CLEANUP_VERSION
+
+            out["foot_cleanup"] = CLEANUP_VERSION  # a cleanup change re-measures
+        from simdiff.motion.contact_hold import RELEASE_FRAMES
+        from simdiff.motion.rigid import SMOOTH_POSE_FRAMES, SMOOTH_ROOT_FRAMES
+
+        # measured on the written joints (simdiff.motion.rigid.joints_from_features); a decode change re-measures
+        out["joints"] = {"smooth": [SMOOTH_ROOT_FRAMES, SMOOTH_POSE_FRAMES], "rigid": True, "release": RELEASE_FRAMES}
         if spec.physdiff is not None:
             out["physdiff"] = dataclasses.asdict(self.physdiff_config(spec, sampler, env))
             out["projector"] = dataclasses.asdict(self.config.projector)
@@ -355,12 +364,13 @@ class Runner:
         """Physics metrics and time of ``n`` generated test motions (too few for the T2M metrics)."""
         from simdiff.motion.features import features_to_joints
         from simdiff.motion.metrics import physics_metrics
+        from simdiff.motion.rigid import batch_joints_from_features
 
         items = self.test_motions(n)
-        feats, seconds = self.generate(self.generate_fn(spec, sampler, alpha, env), items["captions"], items["lengths"],
-                                       self.config.seed * 1_000_003)
-        joints = np.asarray(features_to_joints(feats.double()))
-        lengths = np.clip(np.asarray(items["lengths"]), 2, joints.shape[1])
+        fn = self.generate_fn(spec, sampler, alpha, env)
+        feats, seconds = self.generate(fn, items["captions"], items["lengths"], self.config.seed * 1_000_003)
+        lengths = np.clip(np.asarray(items["lengths"]), 2, feats.shape[1])
+        joints = batch_joints_from_features(feats, lengths, fn.foot_lock)
         physics = physics_metrics(joints, lengths)
         gt = [np.asarray(features_to_joints(torch.as_tensor(f).double())) for f in items["features"]]
         gt_float = float(np.average([physics_metrics(j)["floating"] for j in gt], weights=[len(j) for j in gt]))
