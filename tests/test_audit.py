@@ -161,3 +161,18 @@ def test_cli_audit_errors_are_one_line(squat_file, tmp_path, capsys, argv, needl
     assert main(["audit", *argv]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("simdiff: error:") and needle in err[0]
+
+
+def test_the_gravity_of_a_flight_is_read_back(walk_audit):
+    from simdiff.motion.synthetic import jump
+
+    height, gravity = 0.4, -3.7
+    airtime = float(np.sqrt(8 * height / -gravity))  # a ballistic jump under g −3.7
+    audit = audit_motion(jump(frames=60, height=height, start=15, airtime=airtime), Environment(gravity, 0, 0),
+                         track=False)
+    assert audit.flight["gravity"] == pytest.approx(gravity, rel=0.02) and audit.flight["flights"] == 1
+    assert audit.rollout_flight is None
+    text = audit.table()
+    assert "φ asks -3.7 m/s²" in text and f"{audit.flight['gravity']:9.2f} m/s²" in text
+    assert walk_audit.flight is None and "no flight long enough to read" in walk_audit.table()
+    assert json.loads(json.dumps(audit.to_dict()))["flight"]["gravity"] == pytest.approx(gravity, rel=0.02)

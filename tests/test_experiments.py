@@ -126,11 +126,13 @@ def test_select_alpha_rules() -> None:
 
 
 def test_motion_stats_apex_and_drift() -> None:
-    s = motion_stats(jump(60, height=0.3, start=20))
+    s = motion_stats(jump(60, height=0.3, start=20))  # 0.5 s up: curvature −8·0.3/0.5² = −9.6 m/s²
     assert s["apex_m"] == pytest.approx(0.3, abs=0.01) and abs(s["drift_x_m"]) < 1e-6
+    assert s["gravity_read"] == pytest.approx(-9.6, rel=0.02) and s["flight_fit_mm"] < 1.0
     w = walk(41, speed=1.0)  # 2 s forward (+Z)
     s = motion_stats(w)
     assert s["drift_z_m"] == pytest.approx(2.0, abs=0.05) and abs(s["drift_x_m"]) < 0.05
+    assert s["gravity_read"] is None  # no flight
 
 
 def test_table2_then_table1_best_alpha_reuse_and_resume(setup: dict[str, Path], monkeypatch: pytest.MonkeyPatch) -> None:

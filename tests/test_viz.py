@@ -1,4 +1,4 @@
-"""Stick-figure rendering: files written with the right frame counts and sizes; bad input rejected."""
+"""Stick-figure rendering: files written with the right frame counts and sizes; panels share one scale; bad input rejected."""
 
 from __future__ import annotations
 
@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 
 from simdiff.errors import SimdiffError
-from simdiff.motion.synthetic import walk
+from simdiff.motion.synthetic import jump, walk
 from simdiff.viz import animation_frames, render_animation, render_filmstrip
-from simdiff.viz.camera import choose_azim, clip_bounds, to_plot
+from simdiff.viz.camera import choose_azim, clip_bounds, content_points, screen_points, to_plot, view_basis
+from simdiff.viz.panel import StickPanel
+from simdiff.viz.stick import AnimationScene, filmstrip_figure
 
 SMALL = dict(panel_size=(1.6, 1.6), dpi=50)  # 80 x 80 px panels
 
@@ -109,3 +111,77 @@ def test_cli_render(tmp_path: Path, walks: list[np.ndarray]) -> None:
     assert main(["render", str(tmp_path / "missing.npy"), "--out", str(out)]) == 2
     np.save(tmp_path / "bad.npy", np.zeros((4, 3)))
     assert main(["render", str(tmp_path / "bad.npy"), "--out", str(out)]) == 2
+
+
+SHIN = (4, 7)  # left knee, left ankle: a bone of constant length in both synthetic motions
+
+
+def _px_per_metre(panel: StickPanel, motion: np.ndarray) -> np.ndarray:
+    """(T,) screen length of the shin in display pixels over its length in the view plane in metres."""
+    bone = motion[:, list(SHIN)].astype(np.float64)
+    px = np.linalg.norm(np.diff(panel.screen(bone), axis=1)[:, 0], axis=-1)
+    right, up = view_basis(panel.ax.elev, panel.ax.azim)
+    d = to_plot(bone[:, 1] - bone[:, 0])
+    return px / np.hypot(d @ right, d @ up)
+
+
+def _inside(panel: StickPanel, motion: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Display-pixel box (lo, hi) of the panel's rectangle and the screen points of every joint of every frame."""
+    box = panel.rect.transformed(panel.ax.get_figure().transFigure)
+    return np.array([box.x0, box.y0]), np.array([box.x1, box.y1]), panel.screen(motion.reshape(-1, 3))
+
+
+def _fills(panel: StickPanel, motion: np.ndarray) -> bool:
+    """Whether the panel's content (joints and floor) spans its rectangle, less the 6 px (at 100 dpi) pad, on one side."""
+    fig = panel.ax.get_figure()
+    box = panel.rect.transformed(fig.transFigure)
+    free = np.array([box.width, box.height]) - 2 * 6.0 * fig.dpi / 100
+    xy = screen_points(panel.ax, content_points(motion, *clip_bounds(motion)))
+    return bool((np.abs(np.ptp(xy, axis=0) - free) < 0.5).any())
+
+
+@pytest.fixture(scope="module")
+def jump_and_walk() -> list[np.ndarray]:
+    return [jump(40, height=0.5), walk(80)]  # in place / 5 m of travel
+
+
+def _check_shared_scale(panels: list[StickPanel], motions: list[np.ndarray]) -> None:
+    assert max(p.fill_scale for p in panels) > 1.3 * min(p.fill_scale for p in panels)  # fitted alone, they differ
+    assert len({(p.ax.elev, p.ax.azim) for p in panels}) == 1
+    scales = np.concatenate([_px_per_metre(p, m) for p, m in zip(panels, motions)])
+    assert np.ptp(scales) < 0.02 * scales.mean()  # one metres-per-pixel across panels
+    for p, m in zip(panels, motions):
+        lo, hi, xy = _inside(p, m)
+        assert (xy >= lo - 0.5).all() and (xy <= hi + 0.5).all()  # every joint of every frame in its panel
+
+
+def test_filmstrip_rows_share_one_scale(jump_and_walk: list[np.ndarray]) -> None:
+    fig, rows = filmstrip_figure(jump_and_walk, ["jump", "walk"], n_frames=3, cell_size=(1.6, None), dpi=60)
+    fig.canvas.draw()
+    panels = [p for row in rows for p in row]
+    motions = [m for row, m in zip(rows, jump_and_walk) for _ in row]
+    _check_shared_scale(panels, motions)
+
+
+def test_animation_panels_share_one_scale(jump_and_walk: list[np.ndarray]) -> None:
+    scene = AnimationScene(jump_and_walk, ["jump", "walk"], panel_size=(2.0, None), dpi=60)
+    scene.frame(0)
+    _check_shared_scale(scene.panels, jump_and_walk)
+    walk_panel = scene.panels[1]  # the largest content sets the scale and fills its panel
+    assert walk_panel.scale == pytest.approx(walk_panel.fill_scale) and _fills(walk_panel, jump_and_walk[1])
+    assert not _fills(scene.panels[0], jump_and_walk[0])
+
+
+@pytest.mark.parametrize("which", [0, 1])
+def test_single_motion_fills_its_panel(jump_and_walk: list[np.ndarray], which: int) -> None:
+    motion = jump_and_walk[which]
+    scene = AnimationScene([motion], [""], panel_size=(2.0, None), dpi=60)
+    scene.frame(0)
+    fig, rows = filmstrip_figure([motion], [""], n_frames=2, cell_size=(1.6, None), dpi=60)
+    fig.canvas.draw()
+    for panel in [*scene.panels, *rows[0]]:
+        assert panel.scale == pytest.approx(panel.fill_scale)
+        lo, hi, xy = _inside(panel, motion)
+        assert (xy >= lo - 0.5).all() and (xy <= hi + 0.5).all()
+        assert _fills(panel, motion)
+

@@ -13,7 +13,9 @@ Three parts, all for joints (T, 22, 3) in metres, Y-up, 20 fps:
    shows in the metrics and the shift, not in the residual;
 3. tracking it under φ with :func:`simdiff.sim.project.project` (exactly what
    ``simdiff track`` does): success, fall frame, d_L2, tracking error, the residual the
-   rollout applied, CPU seconds.
+   rollout applied, CPU seconds;
+4. the gravity its flights obey (:func:`simdiff.motion.gravity_readout.read_gravity`: the centre of mass's
+   parabola over the airborne frames), for the motion and for the rollout, against φ's g_z.
 """
 
 from __future__ import annotations
@@ -65,6 +67,8 @@ class Audit:
         cpu_s: CPU seconds of the whole audit.
         series: the residual over time (not in :meth:`to_dict`).
         root_height: (T,) input pelvis height (m); ``rollout``: (T', 22, 3) rollout joints or None.
+        flight, rollout_flight: the gravity read from the motion's and the rollout's flights
+            (:func:`simdiff.motion.gravity_readout.read_gravity`), None without a readable flight.
     """
 
     name: str
@@ -78,12 +82,15 @@ class Audit:
     series: ResidualSeries = field(repr=False)
     root_height: np.ndarray = field(repr=False)
     rollout: np.ndarray | None = field(default=None, repr=False)
+    flight: dict[str, float] | None = None
+    rollout_flight: dict[str, float] | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready summary (NaN → None)."""
         out = {
             "file": self.name, "frames": self.n_frames, "duration_s": self.duration_s, "env": list(self.env),
             "metrics": self.metrics, "reference": self.reference, "tracking": self.tracking, "cpu_s": self.cpu_s,
+            "flight": self.flight, "rollout_flight": self.rollout_flight,
         }
         return _clean(out)
 
@@ -206,10 +213,13 @@ def audit_motion(joints: np.ndarray, env: Environment = Environment(), *, name: 
         tracking["residual_bound_mg"] = residual.max_force
         bar.update()
     bar.close()
+    from simdiff.motion.gravity_readout import read_gravity
+
     return Audit(
         name=name, n_frames=int(joints.shape[0]), duration_s=(joints.shape[0] - 1) / 20.0, env=env.as_tuple(),
         metrics=metrics, reference=summary, tracking=tracking, cpu_s=time.process_time() - t0, series=series,
-        root_height=joints[:, 0, 1].astype(np.float64), rollout=out,
+        root_height=joints[:, 0, 1].astype(np.float64), rollout=out, flight=read_gravity(joints),
+        rollout_flight=read_gravity(out) if out is not None and len(out) >= 2 else None,
     )
 
 
@@ -263,8 +273,20 @@ def format_table(a: Audit) -> str:
             f"torque {res['torque_mean_nm']:.0f} / {res['torque_peak_nm']:.0f} N·m, airborne {100 * res['airborne_frac']:.0f} %",
             f"    CPU              {t['cpu_s']:9.2f} s ({t['cpu_s'] / max(t['duration_s'], 1e-9):.2f} s per motion second)",
         ]
+    lines.append(f"  flights: gravity of the centre of mass's parabola (φ asks {g:g} m/s²)")
+    lines.append(f"    motion           {_flight(a.flight)}")
+    if a.tracking is not None:
+        lines.append(f"    rollout          {_flight(a.rollout_flight)}")
     lines.append(f"  audit CPU          {a.cpu_s:9.2f} s")
     return "\n".join(lines)
+
+
+def _flight(reading: dict[str, float] | None) -> str:
+    if reading is None:
+        return "no flight long enough to read (5 airborne frames)"
+    n = int(reading["flights"])
+    return (f"{reading['gravity']:9.2f} m/s² over {int(reading['frames'])} airborne frames in {n} "
+            f"flight{'s' if n != 1 else ''}, fit error ≤ {1e3 * reading['rmse_m']:.0f} mm")
 
 
 def _spans(mask: np.ndarray) -> list[tuple[int, int]]:

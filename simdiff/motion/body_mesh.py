@@ -12,6 +12,11 @@ length, torso widths from the hip and collar spans, head from the neck), so any 
 Shapes: positions and normals (V, 3) float32 metres, Y up, in the rest pose with the pelvis at ``root``;
 triangles (F, 3) uint32, counter-clockwise seen from outside; joints (V, 4) uint8 and weights (V, 4) float32
 (at most 3 non-zero influences, summing to 1; unused slots hold joint 0 with weight 0).
+
+:func:`skin` poses the mesh by linear blend skinning as the glTF export binds it
+(:mod:`simdiff.motion.io.gltf_writer`): joint j's rest transform is the identity rotation at its rest position,
+and its posed transform is its global rotation at its forward-kinematics position, so a vertex bound to j alone
+moves rigidly with j and turns with the rotation that turns j's child bones.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.motion.rigid import RigidMotion, forward_kinematics, global_rotations
 from simdiff.motion.skeleton import NUM_JOINTS, PARENTS, RAW_OFFSETS
 
 LON: int = 16
@@ -295,3 +301,43 @@ def build_body(offsets: np.ndarray, root: np.ndarray | None = None) -> BodyMesh:
     w = np.concatenate(weights).astype(np.float32)
     return BodyMesh(np.concatenate(positions).astype(np.float32), np.concatenate(normals).astype(np.float32),
                     np.concatenate(triangles).astype(np.uint32), np.concatenate(joints).astype(np.uint8), w)
+
+
+SKIN_CHUNK: int = 64
+"""Frames posed at once by :func:`skin` (bounds its temporary memory to about 30 MB)."""
+
+
+def skin(mesh: BodyMesh, motion: RigidMotion, root: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and unit normals (T, V, 3) float32 of ``mesh`` posed by ``motion`` (linear blend skinning).
+
+    Args:
+        mesh: built by :func:`build_body` from ``motion.offsets`` with its pelvis at ``root``.
+        motion: local rotations (T, 22, 3, 3), pelvis path (T, 3) and offsets (22, 3), metres, Y up.
+        root: (3,) the rest pelvis position ``mesh`` was built with (default 0, as :func:`build_body`).
+    Returns:
+        Per frame Σ_k w_k (G_k (x − r_k) + p_k) for each vertex x with joints k and weights w_k, G the global
+        rotations, r the rest joint positions and p the posed ones; normals are the blended rotations applied
+        to the rest normals, renormalised.
+    Raises:
+        SimdiffError: mesh and motion of different joint counts or non-finite values.
+    """
+    local = np.asarray(motion.local, dtype=np.float64)
+    path = np.asarray(motion.root, dtype=np.float64)
+    if local.ndim != 4 or local.shape[1:] != (NUM_JOINTS, 3, 3) or path.shape != (len(local), 3):
+        raise SimdiffError(f"skin needs (T, 22, 3, 3) rotations and a (T, 3) root, got {local.shape} and {path.shape}")
+    rest = rest_positions(motion.offsets, root)
+    idx, w = mesh.joints.astype(np.intp), mesh.weights.astype(np.float64)
+    x, n = mesh.positions.astype(np.float64), mesh.normals.astype(np.float64)
+    verts = np.empty((len(local), len(x), 3), np.float32)
+    normals = np.empty_like(verts)
+    for a in range(0, len(local), SKIN_CHUNK):
+        glob = global_rotations(local[a:a + SKIN_CHUNK])  # (t, 22, 3, 3)
+        shift = forward_kinematics(local[a:a + SKIN_CHUNK], path[a:a + SKIN_CHUNK], motion.offsets) \
+            - np.einsum("tjab,jb->tja", glob, rest)  # (t, 22, 3): p_j − G_j r_j
+        rot = np.einsum("vk,tvkab->tvab", w, glob[:, idx])  # (t, V, 3, 3) blended rotations
+        verts[a:a + SKIN_CHUNK] = np.einsum("tvab,vb->tva", rot, x) + np.einsum("vk,tvka->tva", w, shift[:, idx])
+        turned = np.einsum("tvab,vb->tva", rot, n)
+        normals[a:a + SKIN_CHUNK] = turned / np.maximum(np.linalg.norm(turned, axis=-1, keepdims=True), 1e-12)
+    if not (np.all(np.isfinite(verts)) and np.all(np.isfinite(normals))):
+        raise SimdiffError("skin: the motion contains NaN or infinite values")
+    return verts, normals

@@ -231,6 +231,17 @@ def joints_from_features(features: np.ndarray, foot_lock: float = 0.0) -> np.nda
     return hold_contacts(joints, features[:, SLICES["contacts"]], foot_lock)
 
 
+def decode_inputs(foot_lock: float) -> dict[str, object]:
+    """What :func:`joints_from_features` depends on besides the features (the foot cleanup's version when
+    ``foot_lock`` > 0, the smoothing, the hold's release), for the fingerprints of cached measurements."""
+    from simdiff.motion.contact_hold import RELEASE_FRAMES
+    from simdiff.motion.foot_lock import CLEANUP_VERSION
+
+    out: dict[str, object] = {"foot_cleanup": CLEANUP_VERSION} if foot_lock else {}
+    out["joints"] = {"smooth": [SMOOTH_ROOT_FRAMES, SMOOTH_POSE_FRAMES], "rigid": True, "release": RELEASE_FRAMES}
+    return out
+
+
 def batch_joints_from_features(features: object, lengths: object, foot_lock: float = 0.0) -> np.ndarray:
     """:func:`joints_from_features` of a (B, T, 263) batch (numpy or torch) with (B,) valid frames: float32
     (B, T, 22, 3); frames past a clip's length repeat its last valid frame."""

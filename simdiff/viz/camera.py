@@ -1,13 +1,14 @@
 """Cameras that keep a whole clip in view.
 
-Stick figures (matplotlib): a fixed camera per clip, bounds, viewing azimuth and zoom
-computed once from the whole clip. Plot coordinates are matplotlib's Z-up frame,
+Stick figures (matplotlib): a fixed orthographic camera per clip, bounds and viewing azimuth
+computed once from the whole clip, zoomed to a scale in display pixels per metre (the
+renders share one scale across their panels). Plot coordinates are matplotlib's Z-up frame,
 ``(x, -z, y)`` of the Y-up world (a proper rotation, so nothing is mirrored).
 
 Body renders (MuJoCo, world Z-up): :class:`BodyCamera`, a perspective camera that follows the
 smoothed root horizontally, with one distance, look-at height, azimuth and elevation shared
-by every panel, chosen by :func:`fit_body_camera` so that every geom of every frame is inside
-the image with a margin.
+by every panel, chosen by :func:`fit_body_camera` so that every body vertex of every frame is
+inside the image with a margin.
 """
 
 from __future__ import annotations
@@ -88,48 +89,85 @@ def view_basis(elev: float, azim: float) -> tuple[np.ndarray, np.ndarray]:
     return right, up
 
 
-def content_aspect(motion: np.ndarray, elev: float, azim: float | None) -> float:
-    """Height / width of a clip's content seen orthographically from (elev, azim) degrees."""
+def content_extent(motion: np.ndarray, elev: float, azim: float | None) -> tuple[float, float]:
+    """(width, height) in metres of a clip's content (:func:`content_points`) seen orthographically from
+    (elev, azim) degrees; ``azim`` None: :func:`choose_azim` of the clip."""
     lo, hi = clip_bounds(motion)
     pts = content_points(motion, lo, hi)
     right, up = view_basis(elev, choose_azim(motion) if azim is None else azim)
-    return float(np.ptp(pts @ up) / max(np.ptp(pts @ right), 1e-9))
+    return float(np.ptp(pts @ right)), float(np.ptp(pts @ up))
+
+
+def content_aspect(motion: np.ndarray, elev: float, azim: float | None) -> float:
+    """Height / width of a clip's content seen orthographically from (elev, azim) degrees."""
+    w, h = content_extent(motion, elev, azim)
+    return h / max(w, 1e-9)
 
 
 def auto_height(motions: list[np.ndarray], width: float, elev: float, azim: float | None,
                 lo_ratio: float = 0.45, hi_ratio: float = 1.4) -> float:
-    """Panel height (unit of ``width``) fitting the tallest clip, clamped to [lo_ratio, hi_ratio] * width."""
-    ratio = max(content_aspect(m, elev, azim) for m in motions)
+    """Panel height (unit of ``width``) for clips drawn at one shared scale, clamped to [lo_ratio, hi_ratio] * width.
+
+    At the scale that fits the widest content across ``width``, the tallest content needs
+    ``width * max height / max width``; for one clip this is its own height / width.
+    """
+    extents = np.array([content_extent(m, elev, azim) for m in motions])
+    ratio = extents[:, 1].max() / max(float(extents[:, 0].max()), 1e-9)
     return width * float(np.clip(ratio, lo_ratio, hi_ratio))
 
 
-def fit_view(ax: Axes3D, lo: np.ndarray, hi: np.ndarray, points: np.ndarray, pad_px: float = 6.0) -> None:
-    """Zoom and shift ``ax`` so ``points`` (N, 3, plot space) fill its original rectangle, centred.
+def screen_points(ax: Axes3D, points: np.ndarray) -> np.ndarray:
+    """(N, 2) display pixel coordinates of plot-space ``points`` (N, 3) under ``ax``'s current projection."""
+    h = np.concatenate([points, np.ones((len(points), 1))], axis=1) @ ax.get_proj().T
+    return ax.transData.transform(h[:, :2] / h[:, 3:4])
 
-    Assumes an orthographic camera, under which screen offsets from the projected box centre are
-    linear in the zoom. Axes3D does not clip its artists to the axes, so the axes may be moved.
+
+def _unit_zoom(ax: Axes3D, lo: np.ndarray, hi: np.ndarray, points: np.ndarray, pad_px: float
+               ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+    """Project at zoom 1 from ``ax``'s original rectangle.
+
+    Returns:
+        Box centre (2,) and ``points`` (N, 2) in display pixels, the scale at zoom 1 in pixels per
+        metre, and the free size (2,) of the rectangle in pixels once ``pad_px`` is kept on every side.
     """
-    aspect = tuple(hi - lo)
-    panel = ax.get_position(original=True)
-    ax.set_box_aspect(aspect, zoom=1.0)
+    ax.set_box_aspect(tuple(hi - lo), zoom=1.0)
     ax.apply_aspect()
-    m = ax.get_proj()
+    centre = (lo + hi) / 2
+    right, _ = view_basis(ax.elev, ax.azim)
+    c, r = screen_points(ax, np.stack([centre, centre + right]))
+    fig = ax.get_figure()
+    box = ax.get_position(original=True).transformed(fig.transFigure)
+    free = np.array([box.width, box.height]) - 2 * pad_px * fig.dpi / 100.0
+    return c, screen_points(ax, points), float(np.hypot(*(r - c))), free
 
-    def screen(p: np.ndarray) -> np.ndarray:
-        h = np.concatenate([p, np.ones((len(p), 1))], axis=1) @ m.T
-        return ax.transData.transform(h[:, :2] / h[:, 3:4])
 
-    centre = screen(((lo + hi) / 2)[None])[0]
-    xy = screen(points)
-    pmin, pmax = xy.min(axis=0), xy.max(axis=0)
+def fill_scale(ax: Axes3D, lo: np.ndarray, hi: np.ndarray, points: np.ndarray, pad_px: float = 6.0) -> float:
+    """Largest scale (display pixels per metre) at which ``points`` (N, 3, plot space) fit in ``ax``'s original
+    rectangle, ``pad_px`` (at 100 dpi) kept free on every side; ``lo``, ``hi`` the axes' data box.
+
+    Assumes an orthographic camera and a box aspect equal to ``hi - lo``, under which one metre has
+    the same screen length in every direction.
+    """
+    _, xy, unit, free = _unit_zoom(ax, lo, hi, points, pad_px)
+    size = np.maximum(np.ptp(xy, axis=0), 1e-9)
+    return unit * float(min(free[0] / size[0], free[1] / size[1]))
+
+
+def fit_view(ax: Axes3D, lo: np.ndarray, hi: np.ndarray, points: np.ndarray, scale: float) -> None:
+    """Zoom ``ax`` to ``scale`` display pixels per metre and shift it so ``points`` (N, 3, plot space) are centred
+    in its original rectangle; ``lo``, ``hi`` the axes' data box.
+
+    Under an orthographic camera, screen offsets from the projected box centre are linear in the
+    zoom. Axes3D does not clip its artists to the axes, so the axes may be moved.
+    """
+    centre, xy, unit, _ = _unit_zoom(ax, lo, hi, points, 0.0)
+    panel = ax.get_position(original=True)
     fig = ax.get_figure()
     box = panel.transformed(fig.transFigure)
-    pad = pad_px * fig.dpi / 100.0
-    size = np.maximum(pmax - pmin, 1e-9)
-    zoom = min((box.width - 2 * pad) / size[0], (box.height - 2 * pad) / size[1])
-    ax.set_box_aspect(aspect, zoom=max(zoom, 1e-3))
-    new_centre = centre + zoom * ((pmin + pmax) / 2 - centre)
-    shift = (np.array([box.x0 + box.width / 2, box.y0 + box.height / 2]) - new_centre) / fig.bbox.size
+    zoom = max(scale / unit, 1e-3)
+    ax.set_box_aspect(tuple(hi - lo), zoom=zoom)
+    zoomed_centre = centre + zoom * ((xy.min(axis=0) + xy.max(axis=0)) / 2 - centre)
+    shift = (np.array([box.x0 + box.width / 2, box.y0 + box.height / 2]) - zoomed_centre) / fig.bbox.size
     ax.set_position(panel.translated(shift[0], shift[1]))
 
 
@@ -200,42 +238,11 @@ def project(points: np.ndarray, lookat: np.ndarray, camera: BodyCamera, width: i
     return np.stack([(ndc_x + 1) / 2 * width, (1 - ndc_y) / 2 * height], axis=-1)
 
 
-def geom_boxes(model, qpos: np.ndarray, every: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """World boxes bounding the humanoid's geoms in each state: centres (T, G, 3), axes (T, G, 3, 3), half sizes (G, 3).
-
-    Each geom's box is its local axis-aligned bounding box (``geom_aabb``) carried by the
-    geom's pose; geoms of the world body (the floor) are left out. ``every``: keep one state
-    in ``every`` (the last one always).
-    """
-    import mujoco
-
-    keep = np.flatnonzero(model.geom_bodyid != 0)
-    q = np.asarray(qpos, dtype=np.float64)
-    idx = np.unique(np.r_[np.arange(0, len(q), max(int(every), 1)), len(q) - 1])
-    data = mujoco.MjData(model)
-    centres = np.empty((len(idx), len(keep), 3))
-    axes = np.empty((len(idx), len(keep), 3, 3))
-    for k, t in enumerate(idx):
-        data.qpos[:] = q[t]
-        mujoco.mj_kinematics(model, data)
-        rot = data.geom_xmat[keep].reshape(-1, 3, 3)
-        centres[k] = data.geom_xpos[keep] + np.einsum("gij,gj->gi", rot, model.geom_aabb[keep, :3])
-        axes[k] = rot
-    return centres, axes, model.geom_aabb[keep, 3:].copy()
-
-
 def point_boxes(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """World points (T, N, 3) as zero-size boxes, in the form of :func:`geom_boxes`."""
+    """World points (T, N, 3) as zero-size boxes (T, N, 3) centres, (T, N, 3, 3) axes, (N, 3) half sizes."""
     pts = np.asarray(points, dtype=np.float64)
     axes = np.broadcast_to(np.eye(3), (*pts.shape[:2], 3, 3))
     return pts, axes, np.zeros((pts.shape[1], 3))
-
-
-def join_boxes(a: tuple[np.ndarray, np.ndarray, np.ndarray],
-               b: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The boxes of ``a`` and ``b`` (same states) together."""
-    return (np.concatenate([a[0], b[0]], axis=1), np.concatenate([a[1], b[1]], axis=1),
-            np.concatenate([a[2], b[2]], axis=0))
 
 
 def _support(centres: np.ndarray, axes: np.ndarray, half: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -244,12 +251,33 @@ def _support(centres: np.ndarray, axes: np.ndarray, half: np.ndarray, w: np.ndar
     return (np.einsum("tgi,ti->tg", centres, w) + (local * half).sum(axis=-1)).max(axis=1)
 
 
+def _forms(camera: BodyCamera, aspect: float) -> np.ndarray:
+    """(4, 3) the linear forms whose largest values over the content bound the view: right, left, top, bottom."""
+    forward, up, right = camera_axes(camera.azimuth, camera.elevation)
+    ty = np.tan(np.radians(camera.fovy) / 2) * (1.0 - camera.margin)
+    tx = ty * aspect
+    return np.array([right / tx - forward, -right / tx - forward, up / ty - forward, -up / ty - forward])
+
+
+def extreme_points(points: np.ndarray, camera: BodyCamera, aspect: float) -> np.ndarray:
+    """(T, 4, 3) the points of each state (T, N, 3) that bound the view on the right, left, top and bottom.
+
+    :func:`fit_body_camera` of these points equals its fit of all ``points`` (each bound is the largest value
+    of a linear form, and a look-at shift moves every point of a state alike), for this camera's angles, fovy
+    and margin and this ``aspect`` (width / height).
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    best = np.argmax(pts @ _forms(camera, aspect).T, axis=1)  # (T, 4)
+    return np.take_along_axis(pts, best[..., None], axis=1)
+
+
 def fit_body_camera(boxes: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]], lookats: Sequence[np.ndarray],
                     camera: BodyCamera, aspect: float) -> tuple[BodyCamera, list[np.ndarray]]:
     """The distance, look-at height and sideways shifts that keep every box of every state in view.
 
     Args:
-        boxes: per panel, :func:`geom_boxes` of its states.
+        boxes: per panel, world boxes (centres (T, N, 3), axes (T, N, 3, 3), half sizes (N, 3)) of its
+            states, e.g. :func:`point_boxes` of its body vertices or of their :func:`extreme_points`.
         lookats: per panel, the (T, 3) horizontal look-at path of the same states (its z is
             ignored: one look-at height is chosen for all panels and frames).
         camera: azimuth, elevation, fovy and margin to keep; ``min_distance`` bounds the result.
@@ -270,7 +298,6 @@ def fit_body_camera(boxes: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]], 
     """
     forward, up, right = camera_axes(camera.azimuth, camera.elevation)
     ty = np.tan(np.radians(camera.fovy) / 2) * (1.0 - camera.margin)
-    tx = ty * aspect
     big = np.full(3, -np.inf)  # sideways bound, top bound, bottom bound
     shifts = []
     for (centres, axes, half), look in zip(boxes, lookats):
@@ -278,9 +305,9 @@ def fit_body_camera(boxes: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]], 
         origin[..., 2] = 0.0
         rel = centres - origin
         n = len(rel)
-        forms = [right / tx - forward, -right / tx - forward, up / ty - forward, -up / ty - forward]
-        p, q, top, bottom = [_support(rel, axes, half, np.broadcast_to(w, (n, 3))).max() for w in forms]
-        shifts.append(tx * (p - q) / 2 * right)  # d >= max(p - s/tx, q + s/tx) is least at s = tx (p - q) / 2
+        p, q, top, bottom = [_support(rel, axes, half, np.broadcast_to(w, (n, 3))).max()
+                             for w in _forms(camera, aspect)]
+        shifts.append(ty * aspect * (p - q) / 2 * right)  # d >= max(p - s/tx, q + s/tx) is least at s = tx (p - q) / 2
         big = np.maximum(big, [(p + q) / 2, top, bottom])
     # at look-at height z: d >= A + fz z (sides), B + (fz - k) z (top), C + (fz + k) z (bottom), k = uz / ty;
     # the height that balances top and bottom centres the content vertically
@@ -290,15 +317,16 @@ def fit_body_camera(boxes: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]], 
     return replace(camera, distance=distance, height=float(best)), shifts
 
 
-def camera_path(qpos: np.ndarray, fps: float, camera: BodyCamera = BodyCamera()) -> np.ndarray:
-    """(T, 3) world look-at points: the root path, Gaussian-smoothed over ``camera.smooth_s``.
+def camera_path(root: np.ndarray, fps: float, camera: BodyCamera = BodyCamera()) -> np.ndarray:
+    """(T, 3) world look-at points: the pelvis path ``root`` (T, 3) world metres, Gaussian-smoothed over
+    ``camera.smooth_s``.
 
     The height is ``camera.height`` (the fitted one when the camera was fitted), or the
     smoothed root height with ``follow_height``.
     """
     from scipy.ndimage import gaussian_filter1d
 
-    root = np.asarray(qpos, dtype=np.float64)[:, :3].copy()
+    root = np.array(root, dtype=np.float64)
     sigma = camera.smooth_s * fps
     if sigma > 0 and len(root) > 1:
         root = gaussian_filter1d(root, sigma, axis=0, mode="nearest")

@@ -7,6 +7,7 @@ figure is never mirrored.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,7 +16,7 @@ from mpl_toolkits.mplot3d import Axes3D
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
 from simdiff.motion.skeleton import KINEMATIC_CHAIN, LEFT_CHAIN, RIGHT_CHAIN
-from simdiff.viz.camera import choose_azim, clip_bounds, content_points, fit_view, to_plot
+from simdiff.viz.camera import choose_azim, clip_bounds, content_points, fill_scale, fit_view, screen_points, to_plot
 
 HEAD: int = 15
 """Joint index drawn with a round head marker."""
@@ -66,9 +67,12 @@ def _chain_colour(chain: tuple[int, ...], style: Style) -> str:
 class StickPanel:
     """Draws one motion on ``ax`` with a camera fixed for the whole clip.
 
-    Static artists: floor plane, grid, the whole root path (dashed). Dynamic artists
-    (``animated=True`` keeps them out of full redraws, for blitting): bones, head, the
-    root path travelled so far.
+    The panel's content (every joint of every frame and the floor) is centred in ``rect``, the
+    axes' rectangle (figure fraction), at ``scale`` display pixels per metre: ``fill_scale``, the
+    one at which the content fills ``rect``, unless :meth:`set_scale` or :func:`share_scale` set
+    another. Static artists: floor plane, grid, the whole root path (dashed). Dynamic artists
+    (``animated=True`` keeps them out of full redraws, for blitting): bones, head, the root path
+    travelled so far.
     """
 
     def __init__(self, ax: Axes3D, motion: np.ndarray, *, animated: bool = False, style: Style = DEFAULT_STYLE) -> None:
@@ -83,7 +87,11 @@ class StickPanel:
         azim = choose_azim(motion) if style.azim is None else style.azim
         ax.view_init(elev=style.elev, azim=azim)
         ax.set_proj_type("ortho")
-        fit_view(ax, lo, hi, content_points(motion, lo, hi))
+        self.rect = ax.get_position(original=True).frozen()  # figure fraction
+        self._box = (lo, hi, content_points(motion, lo, hi))
+        self.fill_scale = fill_scale(ax, *self._box)  # display pixels per metre
+        self.scale = self.fill_scale
+        fit_view(ax, *self._box, self.scale)
         ax.patch.set_visible(False)  # panels may overlap after centring
         ax.set_axis_off()
         ax.computed_zorder = False
@@ -112,6 +120,18 @@ class StickPanel:
             artist.set_clip_on(False)  # the fit in fit_view keeps everything inside the panel
         self._eye = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
 
+    def set_scale(self, scale: float) -> None:
+        """Zoom to ``scale`` display pixels per metre, content centred in :attr:`rect` (at most
+        :attr:`fill_scale` keeps it inside)."""
+        self.ax.set_position(self.rect)
+        self.scale = float(scale)
+        fit_view(self.ax, *self._box, self.scale)
+
+    def screen(self, points: np.ndarray) -> np.ndarray:
+        """(..., 2) display pixel coordinates of world points (..., 3) (metres, Y-up) on this panel."""
+        pts = np.asarray(points, dtype=np.float64)
+        return screen_points(self.ax, to_plot(pts.reshape(-1, 3))).reshape(*pts.shape[:-1], 2)
+
     def frame_index(self, t: int) -> int:
         """Frame shown at global frame ``t``: clips shorter than the animation hold their last frame."""
         return min(max(int(t), 0), self.n_frames - 1)
@@ -134,3 +154,13 @@ class StickPanel:
     def dynamic_artists(self) -> list[Artist]:
         """Dynamic artists in drawing order for the current frame."""
         return sorted([self.trace, self.root_dot, *self.bones, self.head], key=lambda a: a.get_zorder())
+
+
+def share_scale(panels: Sequence[StickPanel]) -> float:
+    """Zoom every panel to the largest scale (display pixels per metre) at which each panel's content
+    fits its own rectangle, and return it. Panels are expected to have rectangles of one pixel size."""
+    # one metres-per-pixel across panels, so sizes, heights and distances compare between them
+    scale = min(p.fill_scale for p in panels)
+    for p in panels:
+        p.set_scale(scale)
+    return scale

@@ -22,7 +22,7 @@ from simdiff.viz._checks import (
     ANIMATION_SUFFIXES, IMAGE_SUFFIXES, as_captions, as_motions, output_path, positive_float, positive_int,
 )
 from simdiff.viz.camera import auto_height, choose_azim
-from simdiff.viz.panel import DEFAULT_STYLE, StickPanel, Style
+from simdiff.viz.panel import DEFAULT_STYLE, StickPanel, Style, share_scale
 from simdiff.viz.video import write_video
 
 CAPTION_FONT: float = 9.0
@@ -49,6 +49,9 @@ def _band_height(texts: Sequence[str]) -> float:
 
 class AnimationScene:
     """Side-by-side panels, one per motion, rendered frame by frame to RGB arrays.
+
+    All panels share one azimuth, elevation and scale (metres per pixel, :func:`share_scale`),
+    each centred on its own clip.
 
     Args:
         motions: list of (T_i, 22, 3) world joints (metres); shorter clips hold their last frame.
@@ -80,6 +83,7 @@ class AnimationScene:
             if text:
                 self.fig.text((i + 0.5) / n, 1.0 - 0.04 / height, text, ha="center", va="top", fontsize=CAPTION_FONT)
             self.clocks.append(self.fig.text((i + 0.03) / n, 0.03 / height, "", fontsize=7.5, color="#555555", animated=True))
+        share_scale(self.panels)
         self._background = None
 
     def frame(self, t: int) -> np.ndarray:
@@ -139,13 +143,48 @@ def filmstrip_indices(n_total: int, n_frames: int) -> np.ndarray:
     return np.round(np.linspace(0, n_total - 1, n_frames)).astype(int)
 
 
+def filmstrip_figure(motions: list[np.ndarray], captions: list[str], n_frames: int = 8, fps: float = FPS,
+                     cell_size: tuple[float, float | None] = (1.7, None), dpi: int = 100
+                     ) -> tuple[Figure, list[list[StickPanel]]]:
+    """The figure of :func:`render_filmstrip` (validated arguments) and its panels, one list per row."""
+    cw, ch = cell_size
+    style = shared_view(motions, DEFAULT_STYLE)
+    ch = auto_height(motions, cw, style.elev, style.azim) + LABEL_STRIP if ch is None else ch
+    strip = min(LABEL_STRIP, 0.2 * ch)
+    width = cw * n_frames
+    texts = [_wrap(c, width, max_lines=2) for c in captions]
+    band = _band_height(texts)
+    row_h = ch + band
+    height = row_h * len(motions)
+    fig = Figure(figsize=(width, height), dpi=dpi, facecolor="white")
+    FigureCanvasAgg(fig)
+    rows: list[list[StickPanel]] = []
+    for r, (motion, text) in enumerate(zip(motions, texts)):
+        top = 1.0 - r * row_h / height
+        if text:
+            fig.text(0.5, top - 0.04 / height, text, ha="center", va="top", fontsize=CAPTION_FONT, weight="bold")
+        bottom = top - row_h / height
+        rows.append([])
+        for c, t in enumerate(filmstrip_indices(motion.shape[0], n_frames)):
+            ax = fig.add_axes((c / n_frames, bottom + strip / height, 1.0 / n_frames, (ch - strip) / height),
+                              projection="3d")
+            rows[-1].append(StickPanel(ax, motion, style=style))
+            rows[-1][-1].set_frame(int(t))
+            fig.text((c + 0.5) / n_frames, bottom + 0.03 / height, f"{t / fps:.2f} s", ha="center", va="bottom",
+                     fontsize=7.5, color="#555555")
+        if r > 0:
+            fig.add_artist(_rule(top))
+    share_scale([p for row in rows for p in row])
+    return fig, rows
+
+
 def render_filmstrip(motions: Sequence[np.ndarray] | np.ndarray, path: str | Path,
                      captions: Sequence[str] | None = None, n_frames: int = 8, fps: float = FPS,
                      cell_size: tuple[float, float | None] = (1.7, None), dpi: int = 100) -> Path:
     """Save a grid image: one row per motion, ``n_frames`` evenly spaced frames per row.
 
-    Every cell of a row uses the same fixed camera (the clip's bounds); each row is titled by
-    its caption and each cell by its time in seconds.
+    Every cell uses the same fixed camera angles and scale (metres per pixel); each row is
+    centred on its clip, titled by its caption, and each cell labelled by its time in seconds.
 
     Args:
         motions: list of (T_i, 22, 3) joints in metres, Y-up.
@@ -160,30 +199,7 @@ def render_filmstrip(motions: Sequence[np.ndarray] | np.ndarray, path: str | Pat
     n_frames = positive_int(n_frames, "n_frames")
     fps = positive_float(fps, "fps")
     path = output_path(path, IMAGE_SUFFIXES)
-    cw, ch = cell_size
-    style = shared_view(motions, DEFAULT_STYLE)
-    ch = auto_height(motions, cw, style.elev, style.azim) + LABEL_STRIP if ch is None else ch
-    strip = min(LABEL_STRIP, 0.2 * ch)
-    width = cw * n_frames
-    texts = [_wrap(c, width, max_lines=2) for c in captions]
-    band = _band_height(texts)
-    row_h = ch + band
-    height = row_h * len(motions)
-    fig = Figure(figsize=(width, height), dpi=dpi, facecolor="white")
-    FigureCanvasAgg(fig)
-    for r, (motion, text) in enumerate(zip(motions, texts)):
-        top = 1.0 - r * row_h / height
-        if text:
-            fig.text(0.5, top - 0.04 / height, text, ha="center", va="top", fontsize=CAPTION_FONT, weight="bold")
-        bottom = top - row_h / height
-        for c, t in enumerate(filmstrip_indices(motion.shape[0], n_frames)):
-            ax = fig.add_axes((c / n_frames, bottom + strip / height, 1.0 / n_frames, (ch - strip) / height),
-                              projection="3d")
-            StickPanel(ax, motion, style=style).set_frame(int(t))
-            fig.text((c + 0.5) / n_frames, bottom + 0.03 / height, f"{t / fps:.2f} s", ha="center", va="bottom",
-                     fontsize=7.5, color="#555555")
-        if r > 0:
-            fig.add_artist(_rule(top))
+    fig, _ = filmstrip_figure(motions, captions, n_frames, fps, cell_size, dpi)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=dpi, facecolor="white")
     return path

@@ -1,4 +1,4 @@
-"""``simdiff render``: stick-figure (or, with ``--body``, MuJoCo humanoid) GIF/MP4 animations and PNG filmstrips."""
+"""``simdiff render``: stick-figure (or, with ``--body``, skinned body) GIF/MP4 animations and PNG filmstrips."""
 
 from __future__ import annotations
 
@@ -76,7 +76,7 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _run_body(args: argparse.Namespace, motions: list, captions: list[str], out: Path, fps: float) -> int:
-    """``--body``: the MuJoCo humanoid (IK of the joints), offscreen OpenGL."""
+    """``--body``: the project's skinned body (the glTF export's mesh) posed by the joints, MuJoCo offscreen OpenGL."""
     from simdiff.viz.body import render_body
 
     if args.filmstrip and out.suffix.lower() != ".png":
@@ -91,7 +91,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``simdiff render``."""
     parser = subparsers.add_parser(
         "render",
-        help="render joint motions as a stick-figure (or --body humanoid) GIF/MP4 or a PNG filmstrip",
+        help="render joint motions as a stick-figure (or --body skinned body) GIF/MP4 or a PNG filmstrip",
         description="Render one or more (T, 22, 3) joint motions side by side. The output suffix picks the "
         "format: .gif or .mp4 animation, .png filmstrip (also with --filmstrip).",
     )
@@ -104,7 +104,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help=f"frames per filmstrip row, 1..{MAX_STRIP_FRAMES} (default 8)")
     parser.add_argument("--fps", type=FPS_OPTION, default=None, help="playback frames per second (default 20)")
     parser.add_argument("--body", action="store_true",
-                        help="render the MuJoCo humanoid (offscreen OpenGL: EGL or OSMesa) instead of stick figures")
+                        help="render the skinned body of the glTF export, posed by the joints, with shadows "
+                        "(MuJoCo offscreen OpenGL: EGL or OSMesa) instead of stick figures")
     parser.add_argument("--size", type=integer(16, MAX_SIZE), nargs=2, default=None, metavar=("W", "H"),
                         help="--body: pixels per panel (default 640 480; filmstrip cells 320 360)")
     parser.set_defaults(func=_run)

@@ -7,7 +7,9 @@ noise for every φ) and we measure per motion
 * apex height (m): peak root height above standing height (the median root height of the
   first 5 frames, 0.25 s);
 * drift along HumanML3D x and z (m): root displacement from the first to the last frame
-  (w_x pushes along +x, w_y along +z, the facing direction at frame 0).
+  (w_x pushes along +x, w_y along +z, the facing direction at frame 0);
+* gravity read from the flights (m/s²): the centre of mass's parabola over the airborne frames
+  (:func:`simdiff.motion.gravity_readout.read_gravity`), over the motions with a readable flight.
 
 MDM (env-blind) gives one set of motions: the flat reference line. Filmstrips show the
 first prompt at the first seed under selected φ.
@@ -31,13 +33,19 @@ TITLE = "Figure 5 — environment control"
 STANDING_FRAMES: int = 5
 
 
-def motion_stats(joints: np.ndarray) -> dict[str, float]:
-    """(T, 22, 3) joints → apex height (m), drift x / z (m), airborne fraction (lowest joint > 5 cm)."""
+def motion_stats(joints: np.ndarray) -> dict[str, float | None]:
+    """(T, 22, 3) joints → apex height (m), drift x / z (m), airborne fraction (lowest joint > 5 cm), gravity read
+    from the flights (m/s², None without a readable flight) and that fit's error (mm)."""
+    from simdiff.motion.gravity_readout import read_gravity
+
     root = joints[:, 0]
     standing = float(np.median(root[:STANDING_FRAMES, 1]))
+    reading = read_gravity(joints)
     return {"apex_m": float(root[:, 1].max() - standing), "drift_x_m": float(root[-1, 0] - root[0, 0]),
             "drift_z_m": float(root[-1, 2] - root[0, 2]),
-            "airborne": float((joints[:, :, 1].min(axis=1) > 0.05).mean())}
+            "airborne": float((joints[:, :, 1].min(axis=1) > 0.05).mean()),
+            "gravity_read": None if reading is None else reading["gravity"],
+            "flight_fit_mm": None if reading is None else 1e3 * reading["rmse_m"]}
 
 
 def conditions(runner: Runner) -> list[tuple[str, list[float]]]:
@@ -76,6 +84,10 @@ def measure(runner: Runner, spec: ModelSpec, env: list[float] | None, key: str) 
         v = np.array([s[k] for s in samples])
         mean, half = t_interval(v)
         summary[k] = {"mean": mean, "ci95": half if half == half else 0.0, "std": float(v.std(ddof=1)) if len(v) > 1 else 0.0}
+    for k in ("gravity_read", "flight_fit_mm"):  # over the motions whose flights could be read
+        v = np.array([s[k] for s in samples if s[k] is not None])
+        mean, half = t_interval(v) if len(v) else (float("nan"), float("nan"))
+        summary[k] = {"mean": mean, "ci95": half if half == half else 0.0, "n": int(len(v))}
     return {"summary": summary, "samples": samples, "s_per_motion": seconds / len(captions)}
 
 
@@ -220,11 +232,19 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     alpha_text = "the model's" if o.alpha is None else f"{o.alpha:g}"
     lines = [f"Prompts: {', '.join('“' + p + '”' for p in o.prompts)}; {o.seeds} seeds each (same noise for every φ); "
              f"{o.length} frames; DDIM; SimDiff α = {alpha_text}. Apex: peak root height above the median root height of "
-             f"the first {STANDING_FRAMES} frames; drift: root displacement first → last frame (m).", "",
-             "| Method | factor | φ (g, w_x, w_y) | apex (m) | drift x (m) | drift z (m) | airborne |", "|---|---|---|---|---|---|---|"]
+             f"the first {STANDING_FRAMES} frames; drift: root displacement first → last frame (m); g read: the gravity "
+             "of the centre of mass's parabola over the flights (m/s², mean ± 95% CI over the motions with a flight of "
+             "≥ 5 airborne frames, their count in brackets) and that fit's error (mm).", "",
+             "| Method | factor | φ (g, w_x, w_y) | apex (m) | drift x (m) | drift z (m) | airborne | g read (m/s²) "
+             "| fit error (mm) |", "|---|---|---|---|---|---|---|---|---|"]
+    n = o.seeds * len(o.prompts)
     for r in rows:
+        g = r["summary"].get("gravity_read", {"n": 0})
+        fit = r["summary"].get("flight_fit_mm", {"n": 0})
+        read = f"{g['mean']:+.2f} ± {g['ci95']:.2f} [{g['n']}/{n}]" if g["n"] else f"— [0/{n}]"
         lines.append(f"| {r['method']} | {r['factor']} | {fmt_env(r['env'])} | {cell(r, 'apex_m')} | {cell(r, 'drift_x_m')} | "
-                     f"{cell(r, 'drift_z_m')} | {r['summary']['airborne']['mean']:.2f} |")
+                     f"{cell(r, 'drift_z_m')} | {r['summary']['airborne']['mean']:.2f} | {read} | "
+                     f"{format(fit['mean'], '.0f') if fit['n'] else '—'} |")
     for combo in combos:
         parts = combination_parts(rows, combo)
         lines += ["", f"Unseen combination φ = {fmt_env(combo['env'])} vs its single-factor parts:", "",

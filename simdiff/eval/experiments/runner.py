@@ -26,6 +26,9 @@ import numpy as np
 import torch
 
 from simdiff.diffusion.config import SamplingConfig
+from simdiff.motion.features import features_to_joints
+from simdiff.motion.metrics import physics_metrics
+from simdiff.motion.rigid import batch_joints_from_features, decode_inputs
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ExperimentConfig, ModelSpec
 from simdiff.eval.experiments.provenance import provenance
@@ -252,15 +255,7 @@ class Runner:
                                "env_index": spec.env_index, "device": self.config.device}
         if self.backbone_of_simdiff(spec):
             out["backbone_only"] = True  # the folder's SimDiff model, adapters left out
-        if out["sampling"]["foot_lock"]:
-            from simdiff.motion.foot_lock import CLEANUP_VERSION
-
-            out["foot_cleanup"] = CLEANUP_VERSION  # a cleanup change re-measures
-        from simdiff.motion.contact_hold import RELEASE_FRAMES
-        from simdiff.motion.rigid import SMOOTH_POSE_FRAMES, SMOOTH_ROOT_FRAMES
-
-        # measured on the written joints (simdiff.motion.rigid.joints_from_features); a decode change re-measures
-        out["joints"] = {"smooth": [SMOOTH_ROOT_FRAMES, SMOOTH_POSE_FRAMES], "rigid": True, "release": RELEASE_FRAMES}
+        out.update(decode_inputs(out["sampling"]["foot_lock"]))  # measured on the written joints
         if spec.physdiff is not None:
             out["physdiff"] = dataclasses.asdict(self.physdiff_config(spec, sampler, env))
             out["projector"] = dataclasses.asdict(self.config.projector)
@@ -324,8 +319,7 @@ class Runner:
             seconds += time.perf_counter() - start
             out.append(feats)
         frames = max(f.shape[1] for f in out)
-        padded = [torch.nn.functional.pad(f, (0, 0, 0, frames - f.shape[1])) for f in out]
-        return torch.cat(padded), seconds
+        return torch.cat([torch.nn.functional.pad(f, (0, 0, 0, frames - f.shape[1])) for f in out]), seconds
 
     def test_motions(self, n: int) -> dict[str, Any]:
         """``n`` test items drawn as the protocol draws them (seeded): captions, lengths, raw GT features."""
@@ -362,10 +356,6 @@ class Runner:
 
     def subset_measure(self, spec: ModelSpec, sampler: str, alpha: float | None, n: int, env: Any = None) -> dict[str, Any]:
         """Physics metrics and time of ``n`` generated test motions (too few for the T2M metrics)."""
-        from simdiff.motion.features import features_to_joints
-        from simdiff.motion.metrics import physics_metrics
-        from simdiff.motion.rigid import batch_joints_from_features
-
         items = self.test_motions(n)
         fn = self.generate_fn(spec, sampler, alpha, env)
         feats, seconds = self.generate(fn, items["captions"], items["lengths"], self.config.seed * 1_000_003)
@@ -376,8 +366,8 @@ class Runner:
         gt_float = float(np.average([physics_metrics(j)["floating"] for j in gt], weights=[len(j) for j in gt]))
         physics["floating_to_gt"] = abs(physics["floating"] - gt_float)
         physics["phys_err"] = physics["penetration"] + physics["sliding"] + physics["floating_to_gt"]
-        return {"physics": physics, "gt_floating": gt_float, "s_per_motion": seconds / n, "samples": n,
-                "seeds": {"data": [self.config.seed, 99], "generation": self.config.seed * 1_000_003}}
+        seeds = {"data": [self.config.seed, 99], "generation": self.config.seed * 1_000_003}
+        return {"physics": physics, "gt_floating": gt_float, "s_per_motion": seconds / n, "samples": n, "seeds": seeds}
 
     def ddpm_protocol(self) -> ProtocolConfig | None:
         """Protocol of DDPM rows under ``ddpm_samples`` (None: physics-only subset rows)."""
