@@ -175,4 +175,6 @@ def test_the_gravity_of_a_flight_is_read_back(walk_audit):
     text = audit.table()
     assert "φ asks -3.7 m/s²" in text and f"{audit.flight['gravity']:9.2f} m/s²" in text
     assert walk_audit.flight is None and "no flight long enough to read" in walk_audit.table()
+    assert walk_audit.gait["pelvis_speed"] > 0.5 and walk_audit.gait["cadence"] > 30
+    assert "cadence" in walk_audit.table() and "duty factor" in walk_audit.table()
     assert json.loads(json.dumps(audit.to_dict()))["flight"]["gravity"] == pytest.approx(gravity, rel=0.02)

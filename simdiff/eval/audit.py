@@ -15,7 +15,8 @@ Three parts, all for joints (T, 22, 3) in metres, Y-up, 20 fps:
    ``simdiff track`` does): success, fall frame, d_L2, tracking error, the residual the
    rollout applied, CPU seconds;
 4. the gravity its flights obey (:func:`simdiff.motion.gravity_readout.read_gravity`: the centre of mass's
-   parabola over the airborne frames), for the motion and for the rollout, against φ's g_z.
+   parabola over the airborne frames), for the motion and for the rollout, against φ's g_z;
+5. its gait (:func:`simdiff.motion.gait.gait_measures`): pelvis and limb speed, cadence, duty factor.
 """
 
 from __future__ import annotations
@@ -69,6 +70,7 @@ class Audit:
         root_height: (T,) input pelvis height (m); ``rollout``: (T', 22, 3) rollout joints or None.
         flight, rollout_flight: the gravity read from the motion's and the rollout's flights
             (:func:`simdiff.motion.gravity_readout.read_gravity`), None without a readable flight.
+        gait: pelvis_speed, limb_speed (m/s), cadence (steps/min), duty_factor.
     """
 
     name: str
@@ -84,13 +86,14 @@ class Audit:
     rollout: np.ndarray | None = field(default=None, repr=False)
     flight: dict[str, float] | None = None
     rollout_flight: dict[str, float] | None = None
+    gait: dict[str, float] | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready summary (NaN → None)."""
         out = {
             "file": self.name, "frames": self.n_frames, "duration_s": self.duration_s, "env": list(self.env),
             "metrics": self.metrics, "reference": self.reference, "tracking": self.tracking, "cpu_s": self.cpu_s,
-            "flight": self.flight, "rollout_flight": self.rollout_flight,
+            "flight": self.flight, "rollout_flight": self.rollout_flight, "gait": self.gait,
         }
         return _clean(out)
 
@@ -213,13 +216,14 @@ def audit_motion(joints: np.ndarray, env: Environment = Environment(), *, name: 
         tracking["residual_bound_mg"] = residual.max_force
         bar.update()
     bar.close()
+    from simdiff.motion.gait import gait_measures
     from simdiff.motion.gravity_readout import read_gravity
 
     return Audit(
         name=name, n_frames=int(joints.shape[0]), duration_s=(joints.shape[0] - 1) / 20.0, env=env.as_tuple(),
         metrics=metrics, reference=summary, tracking=tracking, cpu_s=time.process_time() - t0, series=series,
         root_height=joints[:, 0, 1].astype(np.float64), rollout=out, flight=read_gravity(joints),
-        rollout_flight=read_gravity(out) if out is not None and len(out) >= 2 else None,
+        rollout_flight=read_gravity(out) if out is not None and len(out) >= 2 else None, gait=gait_measures(joints),
     )
 
 
@@ -277,6 +281,12 @@ def format_table(a: Audit) -> str:
     lines.append(f"    motion           {_flight(a.flight)}")
     if a.tracking is not None:
         lines.append(f"    rollout          {_flight(a.rollout_flight)}")
+    if a.gait is not None:
+        gait = a.gait
+        lines += ["  gait (a foot is down within 5 cm of its floor)",
+                  f"    pelvis speed     {gait['pelvis_speed']:9.2f} m/s   limb speed {gait['limb_speed']:.2f} m/s "
+                  "(wrists and ankles relative to the pelvis)",
+                  f"    cadence          {gait['cadence']:9.0f} steps/min   duty factor {gait['duty_factor']:.2f}"]
     lines.append(f"  audit CPU          {a.cpu_s:9.2f} s")
     return "\n".join(lines)
 
