@@ -10,13 +10,11 @@ import pytest
 import torch
 
 from simdiff.diffusion.config import SamplingConfig
-from simdiff.model import ModelConfig, SimConfig, backbone_preset, build_network
-from simdiff.inference.generator import MotionGenerator
 from simdiff.motion.rigid import bone_lengths, joints_from_features
-from simdiff.viz.video import write_gif
 from simdiff.product.pipeline import Timer, run_generation, sample_motions
 from simdiff.product.request import GenerationRequest, build_request
-from simdiff.train.testing import HashTextEncoder
+from simdiff.train.testing import tiny_generator
+from simdiff.viz.video import write_gif
 
 
 @pytest.fixture(autouse=True)
@@ -31,20 +29,6 @@ def one_thread():
 def req(text: str, steps: int, **kwargs) -> GenerationRequest:
     """A checked request sampled with ``steps`` DDIM steps (the other settings: SamplingConfig's defaults)."""
     return build_request(text, sampling=SamplingConfig(steps=steps), **kwargs)
-
-
-def tiny_generator(sim: bool = True, active_adapters: bool = True) -> MotionGenerator:
-    """A random ``tiny`` model; adapters are zero-initialised, so perturb them to make φ matter."""
-    torch.manual_seed(0)
-    config = ModelConfig(backbone=backbone_preset("tiny"), sim=SimConfig() if sim else None)
-    network = build_network(config)
-    if sim and active_adapters:
-        with torch.no_grad():
-            for name, p in network.named_parameters():
-                if "adapter" in name and name.endswith("weight"):
-                    p.add_(0.3 * torch.randn_like(p))
-    # small std keeps random outputs human-sized
-    return MotionGenerator(network, config, HashTextEncoder(), std=torch.full((263,), 0.05))
 
 
 def test_files_shapes_and_metadata(tmp_path: Path) -> None:

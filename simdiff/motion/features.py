@@ -74,14 +74,18 @@ def retarget_uniform(
         (T, 22, 3) float64 positions.
     """
     pos = _check_joints(joints, min_frames=1)
-    src = bone_offsets(pos[0])
+    quats = inverse_kinematics(pos, smooth_forward=False, hip_quirk=hip_quirk)
+    return forward_kinematics(quats, pos[:, 0] * uniform_scale(pos, target_offsets), target_offsets)
+
+
+def uniform_scale(joints: np.ndarray, target_offsets: np.ndarray = CANONICAL_OFFSETS) -> float:
+    """The factor :func:`retarget_uniform` scales the root path by: the target's leg length over that of
+    ``joints``' first frame ((T, 22, 3) metres)."""
 
     def leg(offsets: np.ndarray) -> float:
         return float(sum(np.abs(offsets[j]).max() for j in LEG_JOINTS))
 
-    scale = leg(target_offsets) / leg(src)
-    quats = inverse_kinematics(pos, smooth_forward=False, hip_quirk=hip_quirk)
-    return forward_kinematics(quats, pos[:, 0] * scale, target_offsets)
+    return leg(target_offsets) / leg(bone_offsets(np.asarray(joints, dtype=np.float64)[0]))
 
 
 def canonicalize(joints: np.ndarray) -> np.ndarray:
@@ -95,9 +99,15 @@ def canonicalize(joints: np.ndarray) -> np.ndarray:
     pos = _check_joints(joints, min_frames=1).copy()
     pos[..., 1] -= pos[..., 1].min()
     pos -= pos[0, 0] * np.array([1.0, 0.0, 1.0])
-    forward = facing_direction(pos[:1], FACE_JOINTS)
-    q0 = Q.qbetween(forward, np.array([[0.0, 0.0, 1.0]]))[0]
+    q0 = facing_rotation(pos)
     return Q.qrot(np.broadcast_to(q0, pos.shape[:-1] + (4,)), pos)
+
+
+def facing_rotation(joints: np.ndarray) -> np.ndarray:
+    """(4,) quaternion (w, x, y, z) of the yaw that turns ``joints``' ((T, 22, 3)) frame-0 facing to +Z, as
+    :func:`canonicalize` applies it."""
+    forward = facing_direction(np.asarray(joints, dtype=np.float64)[:1], FACE_JOINTS)
+    return Q.qbetween(forward, np.array([[0.0, 0.0, 1.0]]))[0]
 
 
 @dataclass

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import torch
 
@@ -59,3 +60,20 @@ class EchoProjector:
             yield np.asarray(m, dtype=np.float32), {"success": True, "d_l2_pose": 0.5, "d_l2": 0.5,
                                                      "residual": {"force_mean_n": 1.0, "force_mean_mg": 0.01},
                                                      "cpu_s": 0.0}
+
+
+def tiny_generator(sim: bool = True, active_adapters: bool = True):  # -> MotionGenerator (torch-heavy import)
+    """A random ``tiny`` model with the hash text encoder; its adapters are zero-initialised, so
+    ``active_adapters`` perturbs them to make φ matter. Feature std 0.05 keeps random outputs human-sized."""
+    from simdiff.inference.generator import MotionGenerator
+    from simdiff.model import build_network
+
+    torch.manual_seed(0)
+    config = tiny_model_config(sim=sim, dropout=0.1)
+    network = build_network(config)
+    if sim and active_adapters:
+        with torch.no_grad():
+            for name, p in network.named_parameters():
+                if "adapter" in name and name.endswith("weight"):
+                    p.add_(0.3 * torch.randn_like(p))
+    return MotionGenerator(network, config, HashTextEncoder(), std=torch.full((263,), 0.05))
