@@ -112,6 +112,13 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
             yield t
             bar.update(1)
 
+    keys = request.keyframes
+    guide = frame = None
+    if keys is not None:
+        from simdiff.inference.keyframes import KeyframeGuide, keyframe_frame
+
+        frame = keyframe_frame(keys)
+        guide = KeyframeGuide(frame.to_generated(keys), generator.mean, generator.std)
     features: list[np.ndarray] = []
     try:
         with timer.stage("sample"):
@@ -119,14 +126,22 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
                 env = envs[c]
                 out = generator.generate([request.text], request.frames, request.sampling,
                                          env=None if env is None else env.as_tuple(), seed=request.seed + k,
-                                         text_embeddings=text, progress=progress)
-                features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
+                                         text_embeddings=text, progress=progress, x0_hook=guide)
+                clip = out.clips()[0].detach()
+                if guide is not None:  # the cleaned sample pulled onto the keyframes once more
+                    normalised = guide.polish(((clip - generator.mean) / generator.std)[None])[0]
+                    clip = normalised * generator.std + generator.mean
+                features.append(clip.cpu().numpy().astype(np.float32))
     finally:
         bar.close()
     samples = []
     with timer.stage("decode"):
         for (c, k), f in zip(runs, features):
             joints = joints_from_features(f, request.sampling.foot_lock)
+            if keys is not None and frame is not None:
+                from simdiff.inference.keyframes import meet_keyframes
+
+                joints = meet_keyframes(frame.to_keyframes(joints), keys)
             samples.append(Sample(c, k, request.seed + k, envs[c], f, joints))
     return samples
 
@@ -248,6 +263,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "env_guidance": request.sampling.env_guidance if simdiff_model else None,
         "edit_t": request.sampling.edit_t if simdiff_model else None,
         "foot_cleanup": CLEANUP_VERSION if request.sampling.foot_lock else None,
+        "keyframes": _keyframes_record(request, samples),
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order; forward kinematics of "
                          "rotations on one fixed skeleton per motion (bone lengths constant)",
@@ -257,6 +273,18 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "timings_s": timer.rounded(timer.wall),
         "cpu_s": timer.rounded(timer.cpu),
     }
+
+
+def _keyframes_record(request: GenerationRequest, samples: list[Sample]) -> dict | None:
+    """The keyframe file, its finite entries and how far each sample's written joints are from them (m)."""
+    keys = request.keyframes
+    if keys is None:
+        return None
+    given = np.isfinite(keys)
+    worst = [float(np.linalg.norm(np.where(given, s.joints - np.nan_to_num(keys), 0.0), axis=-1).max())
+             for s in samples]
+    return {"file": request.keyframes_file, "entries": int(given.all(-1).sum() + (given[:, 0].sum(-1) == 2).sum()),
+            "max_error_m": [round(w, 4) for w in worst]}
 
 
 def floor_contact(joints: np.ndarray) -> dict:

@@ -6,7 +6,10 @@ Pure Python + numpy (no torch), so bad input fails in milliseconds with one line
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
 
 from simdiff.diffusion.config import MAX_SEED, SamplingConfig
 from simdiff.errors import SimdiffError
@@ -42,6 +45,8 @@ class GenerationRequest:
         sampling: the sampling configuration (the model's ``sampling.json`` with the user's options over it).
         formats: output kinds, a subset of :data:`FORMATS`.
         force: environments outside the trained range were allowed.
+        keyframes: (frames, 22, 3) joints to meet, NaN = free (:mod:`simdiff.inference.keyframes`), or None.
+        keyframes_file: where they were read from.
     """
 
     text: str
@@ -53,6 +58,8 @@ class GenerationRequest:
     sampling: SamplingConfig = SamplingConfig()
     formats: tuple[str, ...] = DEFAULT_FORMATS
     force: bool = False
+    keyframes: np.ndarray | None = field(default=None, compare=False, repr=False)
+    keyframes_file: str | None = None
 
     @property
     def seconds(self) -> float:
@@ -173,16 +180,26 @@ def check_finite(name: str, value: float, minimum: float | None = None) -> float
 def build_request(text: str, *, gravity: float | None = None, wind: tuple[float, float] | None = None,
                   length_s: float | None = None, seed: int = 0, num_samples: int = 1,
                   sampling: SamplingConfig = SamplingConfig(), compare: str | None = None,
-                  formats: str | None = None, force: bool = False) -> GenerationRequest:
-    """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one)."""
+                  formats: str | None = None, force: bool = False,
+                  keyframes: str | Path | None = None) -> GenerationRequest:
+    """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one).
+    ``keyframes``: a (T, 22, 3) .npy file, NaN = free; the motion then has its T frames."""
     if not 0 <= seed <= MAX_SEED:
         raise SimdiffError(f"--seed must be in 0..{MAX_SEED}, got {seed}")
     if not 1 <= num_samples <= MAX_SAMPLES:
         raise SimdiffError(f"--num-samples must be 1..{MAX_SAMPLES}, got {num_samples}")
     spec = parse_compare(compare) if compare is not None else None
+    keys = None
+    if keyframes is not None:
+        from simdiff.inference.keyframes import load_keyframes  # numpy only
+
+        keys = load_keyframes(keyframes)
+        if length_s is not None and frames_from(length_s) != keys.shape[0]:
+            raise SimdiffError(f"--length {length_s:g} s is {frames_from(length_s)} frames but the keyframes in "
+                               f"{keyframes} have {keys.shape[0]}; leave --length out")
     return GenerationRequest(
         text=check_text(text),
-        frames=frames_from(length_s),
+        frames=frames_from(length_s) if keys is None else int(keys.shape[0]),
         envs=environments(EARTH_GRAVITY if gravity is None else gravity, (0.0, 0.0) if wind is None else tuple(wind),
                           spec, force),
         compare=spec[0] if spec else None,
@@ -191,4 +208,6 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         sampling=sampling,
         formats=parse_formats(formats),
         force=bool(force),
+        keyframes=keys,
+        keyframes_file=None if keyframes is None else str(keyframes),
     )

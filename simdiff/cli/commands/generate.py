@@ -42,6 +42,10 @@ examples:
   simdiff generate "a person walks in a circle" --length 8 --num-samples 3 --format npy,bvh
   simdiff generate "a person jumps forward" --compare gravity=-9.81,-3.7,-1.6
   simdiff generate "a person jumps forward" --gravity -3.7 --simulate
+  simdiff generate "a person walks forward" --keyframes poses.npy
+
+--keyframes: frame 0 starts where the keyframes put the root and faces where their hips and shoulders face (at the
+origin facing +Z when not given); every finite entry is met within 2 cm.
 """
 
 
@@ -75,6 +79,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp = p.add_argument_group("sampling (defaults: the model's sampling.json; shown: the shipped model's)")
     cfg = shipped_sampling()
     smp.add_argument("--length", type=real(MIN_GENERATE_FRAMES / FPS, MAX_FRAMES / FPS), metavar="SECONDS", help="motion length in seconds, up to 9.8 (default 6)")
+    smp.add_argument("--keyframes", type=Path, metavar="FILE.npy",
+                     help="(T, 22, 3) joints to meet, metres, Y-up, 20 fps, NaN for free entries: whole poses (in-between, "
+                          "continuation, pinned poses) or the root's x/z alone (a path); the motion has T frames")
     smp.add_argument("--seed", type=SEED, default=0, metavar="S", help="noise seed; sample K uses seed+K (default 0)")
     smp.add_argument("--num-samples", type=integer(1, MAX_SAMPLES), default=1, metavar="K", help="samples to generate (default 1)")
     smp.add_argument("--sampler", choices=SAMPLERS, help=f"diffusion sampler (default {cfg.sampler})")
@@ -142,6 +149,7 @@ def run(args: argparse.Namespace) -> int:
     request = build_request(  # every user value is checked before torch is imported
         args.text, gravity=args.gravity, wind=args.wind, length_s=args.length, seed=args.seed,
         num_samples=args.num_samples, sampling=sampling, compare=args.compare, formats=args.format, force=args.force,
+        keyframes=args.keyframes,
     )
     finisher = None
     if args.simulate:  # the simulator loads in its own process while this one loads torch and samples
