@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 
@@ -47,7 +48,7 @@ def test_windows_cover_the_motion_and_weights_sum_to_one(frames: int) -> None:
     spans = windows(frames)
     assert spans[0][0] == 0 and spans[-1][1] == frames
     assert all(0 < e - s <= 196 for s, e in spans)
-    assert all(b[0] < a[1] and a[1] - b[0] >= OVERLAP for a, b in zip(spans, spans[1:]))  # neighbours overlap
+    assert all(b[0] < a[1] and a[1] - b[0] >= OVERLAP for a, b in itertools.pairwise(spans))  # neighbours overlap
     w = blend_weights(frames, spans)
     assert np.allclose(w.sum(0), 1.0) and (w >= 0).all()
     for i, (s, e) in enumerate(spans):

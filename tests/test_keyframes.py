@@ -11,8 +11,13 @@ import torch
 
 from simdiff.cli.main import main
 from simdiff.errors import SimdiffError
-from simdiff.inference.keyframes import (KeyframeFrame, KeyframeGuide, check_keyframes, keyframe_frame,
-                                         meet_keyframes)
+from simdiff.inference.keyframes import (
+    KeyframeFrame,
+    KeyframeGuide,
+    check_keyframes,
+    keyframe_frame,
+    meet_keyframes,
+)
 from simdiff.motion import synthetic
 from simdiff.motion.features import process_joints
 from simdiff.motion.rigid import bone_lengths

@@ -20,7 +20,12 @@ import torch
 from torch import Tensor
 
 from simdiff.errors import SimdiffError
-from simdiff.motion.skeleton import FACE_JOINTS, MAX_FRAMES, MIN_GENERATE_FRAMES, NUM_JOINTS
+from simdiff.motion.skeleton import (
+    FACE_JOINTS,
+    MAX_FRAMES,
+    MIN_GENERATE_FRAMES,
+    NUM_JOINTS,
+)
 
 GUIDE_STEPS: int = 20
 """Gradient steps on x̂₀ per denoising step."""
