@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import torch
 
 from simdiff.cli.main import main
 from simdiff.diffusion.config import SamplingConfig
@@ -23,12 +22,7 @@ from simdiff.train.testing import tiny_generator
 CONFIG = SamplingConfig(steps=4, eta=0.0, edit_t=600, guidance=2.0, alpha=1.0, foot_lock=1.0)
 
 
-@pytest.fixture(autouse=True)
-def one_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 @pytest.fixture(scope="module")

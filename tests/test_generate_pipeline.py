@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import torch
 
 from simdiff.diffusion.config import SamplingConfig
 from simdiff.motion.rigid import bone_lengths, joints_from_features
@@ -16,14 +15,7 @@ from simdiff.product.request import GenerationRequest, build_request
 from simdiff.train.testing import tiny_generator
 from simdiff.viz.video import write_gif
 
-
-@pytest.fixture(autouse=True)
-def one_thread():
-    """Tiny models run fastest on one thread (and do not fight a busy machine)."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def req(text: str, steps: int, **kwargs) -> GenerationRequest:

@@ -23,6 +23,8 @@ from simdiff.motion.features import process_joints
 from simdiff.motion.rigid import bone_lengths
 from simdiff.train.testing import tiny_generator
 
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
+
 
 def free(frames: int = 60) -> np.ndarray:
     return np.full((frames, 22, 3), np.nan)
