@@ -259,3 +259,25 @@ def meet_keyframes(joints: np.ndarray, keys: np.ndarray) -> np.ndarray:
         out[:, j + 1] += _faded(np.array([f]), (keys[f, j + 1] - out[f, j + 1])[None], n)
     offsets = rest_offsets(keys[posed]) if len(posed) else rest_offsets(out)
     return fit(out, offsets).joints.astype(np.float32)
+
+
+def sample_keyframed(generator, keys: np.ndarray, config, *, text_embeddings: Tensor,
+                     env: tuple[float, float, float] | None = None, seed: int = 0,
+                     progress=None) -> tuple[np.ndarray, np.ndarray]:
+    """One motion of ``keys``' T frames meeting ``keys`` (T, 22, 3, NaN = free, checked): the guided sample, its
+    polish, the written joints (:func:`simdiff.motion.rigid.joints_from_features` at ``config.foot_lock``) moved
+    into the keyframes' frame and :func:`meet_keyframes`. ``generator``: a
+    :class:`~simdiff.inference.generator.MotionGenerator`; ``text_embeddings`` (1, text_dim). Returns the
+    features (T, 263) (the sample's own frame) and the joints (T, 22, 3), float32."""
+    from simdiff.motion.rigid import joints_from_features
+
+    frame = keyframe_frame(keys)
+    guide = KeyframeGuide(frame.to_generated(keys), generator.mean, generator.std)
+    out = generator.generate([""], int(keys.shape[0]), config, env=env, seed=seed, text_embeddings=text_embeddings,
+                             progress=progress, x0_hook=guide)
+    clip = out.clips()[0].detach()
+    # the cleaned sample pulled onto the keyframes once more
+    normalised = guide.polish(((clip - generator.mean) / generator.std)[None])[0]
+    features = (normalised * generator.std + generator.mean).cpu().numpy().astype(np.float32)
+    joints = meet_keyframes(frame.to_keyframes(joints_from_features(features, config.foot_lock)), keys)
+    return features, joints

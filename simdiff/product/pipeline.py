@@ -104,7 +104,8 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
     with timer.stage("encode_text"):
         text = generator.encode_text([request.text])
     runs = [(c, k) for c in range(len(envs)) for k in range(request.num_samples)]
-    bar = tqdm(total=request.sampling.steps * len(runs), desc=f"{request.sampling.sampler} sampling", unit="step", leave=False,
+    windows = len(request.timeline) if request.timeline is not None else 1
+    bar = tqdm(total=request.sampling.steps * len(runs) * windows, desc=f"{request.sampling.sampler} sampling", unit="step", leave=False,
                disable=quiet, file=sys.stderr, dynamic_ncols=True)
 
     def progress(steps: Iterable) -> Iterator:
@@ -112,36 +113,38 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
             yield t
             bar.update(1)
 
-    keys = request.keyframes
-    guide = frame = None
-    if keys is not None:
-        from simdiff.inference.keyframes import KeyframeGuide, keyframe_frame
-
-        frame = keyframe_frame(keys)
-        guide = KeyframeGuide(frame.to_generated(keys), generator.mean, generator.std)
     features: list[np.ndarray] = []
+    written: list[np.ndarray | None] = []
     try:
         with timer.stage("sample"):
             for c, k in runs:
-                env = envs[c]
-                out = generator.generate([request.text], request.frames, request.sampling,
-                                         env=None if env is None else env.as_tuple(), seed=request.seed + k,
-                                         text_embeddings=text, progress=progress, x0_hook=guide)
-                clip = out.clips()[0].detach()
-                if guide is not None:  # the cleaned sample pulled onto the keyframes once more
-                    normalised = guide.polish(((clip - generator.mean) / generator.std)[None])[0]
-                    clip = normalised * generator.std + generator.mean
-                features.append(clip.cpu().numpy().astype(np.float32))
+                env = None if envs[c] is None else envs[c].as_tuple()
+                if request.timeline is not None:
+                    from simdiff.product.timeline import sample_timeline
+
+                    f, j = sample_timeline(generator, request.timeline, request.sampling, seed=request.seed + k,
+                                           progress=progress)
+                    features.append(f)
+                    written.append(j)
+                    continue
+                if request.keyframes is not None:
+                    from simdiff.inference.keyframes import sample_keyframed
+
+                    f, j = sample_keyframed(generator, request.keyframes, request.sampling, text_embeddings=text,
+                                            env=env, seed=request.seed + k, progress=progress)
+                    features.append(f)
+                    written.append(j)
+                    continue
+                out = generator.generate([request.text], request.frames, request.sampling, env=env,
+                                         seed=request.seed + k, text_embeddings=text, progress=progress)
+                features.append(out.clips()[0].detach().cpu().numpy().astype(np.float32))
+                written.append(None)
     finally:
         bar.close()
     samples = []
     with timer.stage("decode"):
-        for (c, k), f in zip(runs, features):
-            joints = joints_from_features(f, request.sampling.foot_lock)
-            if keys is not None and frame is not None:
-                from simdiff.inference.keyframes import meet_keyframes
-
-                joints = meet_keyframes(frame.to_keyframes(joints), keys)
+        for (c, k), f, j in zip(runs, features, written):
+            joints = joints_from_features(f, request.sampling.foot_lock) if j is None else j
             samples.append(Sample(c, k, request.seed + k, envs[c], f, joints))
     return samples
 
@@ -252,7 +255,8 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
             "text_encoder": cfg.text_encoder,
             **model_provenance(model_dir),
         },
-        "environment": _env_dict(request.envs[0]) if simdiff_model and request.compare is None else None,
+        "environment": (_env_dict(request.envs[0])
+                        if simdiff_model and request.compare is None and request.timeline is None else None),
         "compare": ({"component": request.compare,
                      "values": [getattr(e, request.compare) for e in request.envs]}
                     if simdiff_model and request.compare else None),
@@ -264,6 +268,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "edit_t": request.sampling.edit_t if simdiff_model else None,
         "foot_cleanup": CLEANUP_VERSION if request.sampling.foot_lock else None,
         "keyframes": _keyframes_record(request, samples),
+        "timeline": _timeline_record(request),
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order; forward kinematics of "
                          "rotations on one fixed skeleton per motion (bone lengths constant)",
@@ -285,6 +290,16 @@ def _keyframes_record(request: GenerationRequest, samples: list[Sample]) -> dict
              for s in samples]
     return {"file": request.keyframes_file, "entries": int(given.all(-1).sum() + (given[:, 0].sum(-1) == 2).sum()),
             "max_error_m": [round(w, 4) for w in worst]}
+
+
+def _timeline_record(request: GenerationRequest) -> list[dict] | None:
+    """Each timeline segment: its text, frames [start, end) and environment."""
+    if request.timeline is None:
+        return None
+    from simdiff.product.timeline import spans
+
+    return [{"text": seg.text, "frames": list(span), "environment": _env_dict(seg.env)}
+            for seg, span in zip(request.timeline, spans(request.timeline))]
 
 
 def floor_contact(joints: np.ndarray) -> dict:

@@ -47,6 +47,8 @@ class GenerationRequest:
         force: environments outside the trained range were allowed.
         keyframes: (frames, 22, 3) joints to meet, NaN = free (:mod:`simdiff.inference.keyframes`), or None.
         keyframes_file: where they were read from.
+        timeline: the segments of ``--timeline`` (:mod:`simdiff.product.timeline`), or None; ``text`` is then
+            their texts joined by ", then", ``frames`` their sum and ``envs`` Earth's (each segment has its own).
     """
 
     text: str
@@ -60,6 +62,7 @@ class GenerationRequest:
     force: bool = False
     keyframes: np.ndarray | None = field(default=None, compare=False, repr=False)
     keyframes_file: str | None = None
+    timeline: tuple | None = None
 
     @property
     def seconds(self) -> float:
@@ -177,13 +180,20 @@ def check_finite(name: str, value: float, minimum: float | None = None) -> float
     return value
 
 
-def build_request(text: str, *, gravity: float | None = None, wind: tuple[float, float] | None = None,
+def build_request(text: str | None, *, gravity: float | None = None, wind: tuple[float, float] | None = None,
                   length_s: float | None = None, seed: int = 0, num_samples: int = 1,
                   sampling: SamplingConfig = SamplingConfig(), compare: str | None = None,
                   formats: str | None = None, force: bool = False,
-                  keyframes: str | Path | None = None) -> GenerationRequest:
+                  keyframes: str | Path | None = None, timeline: str | Path | None = None) -> GenerationRequest:
     """Validate every user option and return the request (raises :class:`SimdiffError` on the first bad one).
-    ``keyframes``: a (T, 22, 3) .npy file, NaN = free; the motion then has its T frames."""
+    ``keyframes``: a (T, 22, 3) .npy file, NaN = free; the motion then has its T frames. ``timeline``: a JSON file
+    of segments (``text`` is then None)."""
+    if timeline is not None:
+        return _timeline_request(text, timeline, gravity=gravity, wind=wind, length_s=length_s, seed=seed,
+                                 num_samples=num_samples, sampling=sampling, compare=compare, formats=formats,
+                                 force=force, keyframes=keyframes)
+    if text is None:
+        raise SimdiffError("give the TEXT prompt, or --timeline FILE.json")
     if not 0 <= seed <= MAX_SEED:
         raise SimdiffError(f"--seed must be in 0..{MAX_SEED}, got {seed}")
     if not 1 <= num_samples <= MAX_SAMPLES:
@@ -211,3 +221,24 @@ def build_request(text: str, *, gravity: float | None = None, wind: tuple[float,
         keyframes=keys,
         keyframes_file=None if keyframes is None else str(keyframes),
     )
+
+
+def _timeline_request(text: str | None, timeline: str | Path, *, gravity: float | None, wind: tuple | None,
+                      length_s: float | None, seed: int, num_samples: int, sampling: SamplingConfig,
+                      compare: str | None, formats: str | None, force: bool,
+                      keyframes: str | Path | None) -> GenerationRequest:
+    """:func:`build_request` for ``--timeline``: the options a timeline's segments give are refused."""
+    from simdiff.product.timeline import read_timeline
+
+    given = [flag for flag, value in (("TEXT", text), ("--gravity", gravity), ("--wind", wind),
+                                       ("--length", length_s), ("--compare", compare), ("--keyframes", keyframes))
+             if value is not None]
+    if given:
+        raise SimdiffError(f"--timeline gives each segment's text, length and environment; leave {given[0]} out")
+    segments = read_timeline(timeline, force)
+    request = build_request(segments[0].text, seed=seed, num_samples=num_samples, sampling=sampling,
+                            formats=formats, force=force)
+    joined = ", then ".join(s.text for s in segments)
+    if len(joined) > MAX_PROMPT_CHARS:
+        joined = joined[: MAX_PROMPT_CHARS - 1] + "…"
+    return replace(request, text=joined, frames=sum(s.frames for s in segments), timeline=segments)

@@ -43,6 +43,7 @@ examples:
   simdiff generate "a person jumps forward" --compare gravity=-9.81,-3.7,-1.6
   simdiff generate "a person jumps forward" --gravity -3.7 --simulate
   simdiff generate "a person walks forward" --keyframes poses.npy
+  simdiff generate --timeline day.json
 
 --keyframes: frame 0 starts where the keyframes put the root and faces where their hips and shoulders face (at the
 origin facing +Z when not given); every finite entry is met within 2 cm.
@@ -60,7 +61,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("text", metavar="TEXT", help='what the person does, e.g. "a person jumps forward"')
+    p.add_argument("text", metavar="TEXT", nargs="?", help='what the person does, e.g. "a person jumps forward" '
+                                                           "(or --timeline)")
     env = p.add_argument_group("environment φ")
     env.add_argument("--gravity", type=real(MIN_FORCED_GRAVITY, MAX_GRAVITY), metavar="G",
                      help="vertical gravity in m/s², negative (default -9.81 Earth; Mars -3.7, Moon -1.6)")
@@ -82,6 +84,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--keyframes", type=Path, metavar="FILE.npy",
                      help="(T, 22, 3) joints to meet, metres, Y-up, 20 fps, NaN for free entries: whole poses (in-between, "
                           "continuation, pinned poses) or the root's x/z alone (a path); the motion has T frames")
+    smp.add_argument("--timeline", type=Path, metavar="FILE.json",
+                     help='several prompts in a row as one motion of any length: a JSON list of {"text": ..., '
+                          '"seconds": ..., "gravity"?: G, "wind"?: [X, Y]} (instead of TEXT, --length, --gravity, --wind)')
     smp.add_argument("--seed", type=SEED, default=0, metavar="S", help="noise seed; sample K uses seed+K (default 0)")
     smp.add_argument("--num-samples", type=integer(1, MAX_SAMPLES), default=1, metavar="K", help="samples to generate (default 1)")
     smp.add_argument("--sampler", choices=SAMPLERS, help=f"diffusion sampler (default {cfg.sampler})")
@@ -149,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
     request = build_request(  # every user value is checked before torch is imported
         args.text, gravity=args.gravity, wind=args.wind, length_s=args.length, seed=args.seed,
         num_samples=args.num_samples, sampling=sampling, compare=args.compare, formats=args.format, force=args.force,
-        keyframes=args.keyframes,
+        keyframes=args.keyframes, timeline=args.timeline,
     )
     finisher = None
     if args.simulate:  # the simulator loads in its own process while this one loads torch and samples
@@ -253,6 +258,8 @@ def _generate_into(args: argparse.Namespace, request: GenerationRequest, start: 
     n = len(meta["samples"])
     where = describe_env(request.envs[0]) if generator.is_simdiff and request.compare is None else (
         f"{len(request.envs)} environments" if generator.is_simdiff else describe_env(None))
+    if request.timeline is not None:
+        where = f"{len(request.timeline)} timeline segments"
     _note(args, f"{n} motion{'s' if n > 1 else ''} of {request.frames} frames ({request.seconds:g} s), {where}, "
                 f"in {time.perf_counter() - start:.1f} s")
     return 0
