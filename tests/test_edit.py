@@ -160,3 +160,38 @@ def test_edit_cli_bad_files_get_one_line(content: np.ndarray, needle: str, tiny_
     assert not (tmp_path / "o").exists()
     assert main(["edit", str(tmp_path / "missing.bvh"), "--model", str(tiny_model)]) == 2
     assert "missing.bvh" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("half", ["lower", "upper"])
+def test_keep_half_keeps_it_and_makes_the_other_anew(gen, half: str) -> None:
+    from simdiff.motion.skeleton import LOWER_BODY, UPPER_BODY
+    from simdiff.product.edit import keep_half
+
+    walk = turned(synthetic.walk(40), 0.6, (1.0, 2.0))
+    out = keep_half(gen, walk, CONFIG, (-9.81, 0.0, 0.0), half, "a person waves", seed=2)
+    kept = LOWER_BODY if half == "lower" else UPPER_BODY
+    other = [j for j in range(22) if j not in kept]
+    assert out.joints.shape == walk.shape
+    # the random tiny model's new half sits oddly on the kept one, so the rigid fit's compromise at the pelvis shows
+    assert float(np.linalg.norm(out.joints[:, kept] - walk[:, kept], axis=-1).max()) < 0.05
+    assert float(np.linalg.norm(out.joints[:, other] - walk[:, other], axis=-1).mean()) > 0.01
+    assert float(bone_lengths(out.joints).std(0).max()) < 1e-3
+    assert np.allclose(bone_lengths(out.joints).mean(0), bone_lengths(walk).mean(0), atol=2e-3)
+
+
+def test_keep_refuses_what_it_cannot_do(gen, tiny_model: Path, tmp_path: Path, capsys) -> None:
+    from simdiff.product.edit import keep_half
+
+    with pytest.raises(SimdiffError, match="up to 196"):
+        keep_half(gen, synthetic.walk(200), CONFIG, None, "lower", "a person waves")
+    with pytest.raises(SimdiffError, match="--keep must be"):
+        keep_half(gen, synthetic.walk(40), CONFIG, None, "left", "a person waves")
+    src = tmp_path / "walk.npy"
+    np.save(src, synthetic.walk(40).astype(np.float32))
+    assert main(["edit", str(src), "--keep", "lower", "--model", str(tiny_model), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "text prompt is empty" in err
+    assert main(["edit", str(src), "--keep", "lower", "--text", "a person waves", "--model", str(tiny_model),
+                 "--format", "npy", "--out", str(tmp_path / "k"), "-q"]) == 0, capsys.readouterr().err
+    meta = json.loads((tmp_path / "k" / "edit.json").read_text())
+    assert meta["keep"] == "lower" and meta["text"] == "a person waves"

@@ -151,9 +151,16 @@ class KeyframeFrame:
 
 
 def keyframe_frame(keys: np.ndarray) -> KeyframeFrame:
-    """Where frame 0 of the keyframes puts the root (its x/z when given) and which way it faces (when the hips and
-    shoulders are given); the origin and +Z otherwise."""
-    offset = (float(keys[0, 0, 0]), float(keys[0, 0, 2])) if np.isfinite(keys[0, 0, [0, 2]]).all() else (0.0, 0.0)
+    """Where frame 0 of the keyframes puts the root (its x/z when given, else the middle of at least
+    :data:`MIN_BODY_JOINTS` joints given) and which way it faces (when the hips and shoulders are given); the origin
+    and +Z otherwise."""
+    given = np.isfinite(keys[0]).all(-1)
+    if np.isfinite(keys[0, 0, [0, 2]]).all():
+        offset = (float(keys[0, 0, 0]), float(keys[0, 0, 2]))
+    elif given.sum() >= MIN_BODY_JOINTS:  # the root sits near the middle of the body given
+        offset = (float(keys[0, given, 0].mean()), float(keys[0, given, 2].mean()))
+    else:
+        offset = (0.0, 0.0)
     a, b, c, d = FACE_JOINTS
     if not np.isfinite(keys[0, [a, b, c, d]]).all():
         return KeyframeFrame(0.0, offset)
@@ -218,6 +225,8 @@ class KeyframeGuide:
         return self.pull(x0, POLISH_STEPS)
 
 
+MIN_BODY_JOINTS: int = 4
+"""Joints given at a frame without the root from which the body's position there is taken."""
 BLEND_FRAMES: int = 10
 """Frames either side of a keyframe over which :func:`meet_keyframes` fades its pose correction."""
 
@@ -238,36 +247,46 @@ def _faded(frames: np.ndarray, residuals: np.ndarray, length: int) -> np.ndarray
     return lin * envelope.reshape((length,) + (1,) * (residuals.ndim - 1))
 
 
-def meet_keyframes(joints: np.ndarray, keys: np.ndarray) -> np.ndarray:
+def meet_keyframes(joints: np.ndarray, keys: np.ndarray, skeleton: np.ndarray | None = None) -> np.ndarray:
     """Written joints (T, 22, 3) brought onto the keyframes (T, 22, 3, NaN = free), both in one frame: the whole
-    body shifted by the root's residuals (interpolated between the frames that give them), then each given pose's
-    residual faded in and out over :data:`BLEND_FRAMES`, then rotations fitted again on the skeleton of the given
-    poses (the motion's own when no whole pose is given). float32 (T, 22, 3)."""
+    body shifted by the root's residuals (or, where the root is free, the mean residual of at least
+    :data:`MIN_BODY_JOINTS` given joints; interpolated between the frames that give them), then each given pose's
+    residual faded in and out over :data:`BLEND_FRAMES` (joints given alone likewise), then rotations fitted again on
+    ``skeleton`` ((22, 3) rest offsets; default: that of the given poses, the motion's own when no whole pose is
+    given). float32 (T, 22, 3)."""
     from simdiff.motion.rigid import fit, rest_offsets
 
     out = np.asarray(joints, dtype=np.float64).copy()
     n = out.shape[0]
+    shift = keys[:, 0] - out[:, 0]  # (T, 3): the root's residual where given, else the body's mean residual
+    body = np.isfinite(keys).all(-1)  # (T, 22)
+    bodily = ~np.isfinite(shift).all(-1) & (body.sum(-1) >= MIN_BODY_JOINTS)
+    for f in np.flatnonzero(bodily):
+        shift[f] = (keys[f, body[f]] - out[f, body[f]]).mean(0)
     for axis in range(3):
-        given = np.flatnonzero(np.isfinite(keys[:, 0, axis]))
+        given = np.flatnonzero(np.isfinite(shift[:, axis]))
         if len(given):
-            out[..., axis] += _interpolate(given, (keys[given, 0, axis] - out[given, 0, axis])[:, None], n)
+            out[..., axis] += _interpolate(given, shift[given, axis][:, None], n)
     posed = np.flatnonzero(np.isfinite(keys[:, 1:]).all(axis=(1, 2)))
     if len(posed):
         out[:, 1:] += _faded(posed, keys[posed, 1:] - out[posed, 1:], n)
-    partial = np.argwhere(np.isfinite(keys[:, 1:]).all(-1) & ~np.isfinite(keys[:, 1:]).all(axis=(1, 2))[:, None])
-    for f, j in partial:  # single joints given alone: faded the same way, joint by joint
-        out[:, j + 1] += _faded(np.array([f]), (keys[f, j + 1] - out[f, j + 1])[None], n)
-    offsets = rest_offsets(keys[posed]) if len(posed) else rest_offsets(out)
-    return fit(out, offsets).joints.astype(np.float32)
+    alone = np.isfinite(keys[:, 1:]).all(-1) & ~np.isfinite(keys[:, 1:]).all(axis=(1, 2))[:, None]  # (T, 21)
+    for j in np.flatnonzero(alone.any(0)):  # joints given without their whole pose: faded the same way, per joint
+        frames = np.flatnonzero(alone[:, j])
+        out[:, j + 1] += _faded(frames, keys[frames, j + 1] - out[frames, j + 1], n)
+    if skeleton is None:
+        skeleton = rest_offsets(keys[posed]) if len(posed) else rest_offsets(out)
+    return fit(out, skeleton).joints.astype(np.float32)
 
 
 def sample_keyframed(generator, keys: np.ndarray, config, *, text_embeddings: Tensor,
-                     env: tuple[float, float, float] | None = None, seed: int = 0,
-                     progress=None) -> tuple[np.ndarray, np.ndarray]:
+                     env: tuple[float, float, float] | None = None, seed: int = 0, progress=None,
+                     skeleton: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """One motion of ``keys``' T frames meeting ``keys`` (T, 22, 3, NaN = free, checked): the guided sample, its
     polish, the written joints (:func:`simdiff.motion.rigid.joints_from_features` at ``config.foot_lock``) moved
     into the keyframes' frame and :func:`meet_keyframes`. ``generator``: a
-    :class:`~simdiff.inference.generator.MotionGenerator`; ``text_embeddings`` (1, text_dim). Returns the
+    :class:`~simdiff.inference.generator.MotionGenerator`; ``text_embeddings`` (1, text_dim); ``skeleton`` as
+    :func:`meet_keyframes`'. Returns the
     features (T, 263) (the sample's own frame) and the joints (T, 22, 3), float32."""
     from simdiff.motion.rigid import joints_from_features
 
@@ -279,5 +298,5 @@ def sample_keyframed(generator, keys: np.ndarray, config, *, text_embeddings: Te
     # the cleaned sample pulled onto the keyframes once more
     normalised = guide.polish(((clip - generator.mean) / generator.std)[None])[0]
     features = (normalised * generator.std + generator.mean).cpu().numpy().astype(np.float32)
-    joints = meet_keyframes(frame.to_keyframes(joints_from_features(features, config.foot_lock)), keys)
+    joints = meet_keyframes(frame.to_keyframes(joints_from_features(features, config.foot_lock)), keys, skeleton)
     return features, joints

@@ -85,6 +85,10 @@ FACE_JOINTS: tuple[int, int, int, int] = (2, 1, 17, 16)
 LEG_JOINTS: tuple[int, int] = (5, 8)
 """Knee and ankle whose offsets define the leg length for root scaling."""
 
+LOWER_BODY: tuple[int, ...] = (0, 1, 2, 4, 5, 7, 8, 10, 11)
+"""Pelvis, hips, knees, ankles and feet."""
+UPPER_BODY: tuple[int, ...] = (0, 3, 6, 9, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21)
+"""Pelvis, spine, neck, head, collars and arms (the pelvis carries both halves)."""
 RIGHT_CHAIN: tuple[int, ...] = (2, 5, 8, 11, 14, 17, 19, 21)
 LEFT_CHAIN: tuple[int, ...] = (1, 4, 7, 10, 13, 16, 18, 20)
 

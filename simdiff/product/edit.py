@@ -100,25 +100,72 @@ def edit_motion(generator: MotionGenerator, joints: np.ndarray, config: Sampling
     return EditedMotion(out, edited.astype(np.float32), float(np.linalg.norm(out - joints, axis=-1).mean()))
 
 
-def edit_file(source: Path, joints: np.ndarray, env: Environment, formats: Sequence[str], out_dir: Path, *,
-              text: str = "", seed: int = 0, model: Path | None = None, device: str = "cpu") -> tuple[list[Path], str]:
-    """Re-play ``joints`` (read from ``source``) under ``env`` with the default (or given) model and write the
-    edit, a side-by-side video and ``edit.json`` into ``out_dir``; (written paths, a one-line summary). A failed
-    run leaves no folder it created behind."""
+HALVES: tuple[str, ...] = ("lower", "upper")
+"""What ``simdiff edit --keep`` can keep (:data:`simdiff.motion.skeleton.LOWER_BODY` / ``UPPER_BODY``)."""
+
+
+def keep_half(generator: MotionGenerator, joints: np.ndarray, config: SamplingConfig, env: Sequence[float] | None,
+              half: str, text: str, *, seed: int = 0) -> EditedMotion:
+    """``joints`` (T ≤ 196, 22, 3) with one half of the body (``half`` in :data:`HALVES`) kept, every frame, and the
+    other made anew for ``text`` under φ = ``env`` (None: a backbone-only model): the kept joints are keyframes
+    (:func:`simdiff.inference.keyframes.sample_keyframed`) and the result is fitted on the input's skeleton."""
+    from simdiff.inference.keyframes import sample_keyframed
+    from simdiff.motion.rigid import rest_offsets
+    from simdiff.motion.skeleton import LOWER_BODY, MAX_FRAMES, UPPER_BODY
+
+    if half not in HALVES:
+        raise SimdiffError(f"--keep must be one of {', '.join(HALVES)}, got {half!r}")
+    joints = check_motion(joints)
+    if joints.shape[0] > MAX_FRAMES:
+        raise SimdiffError(f"the motion has {joints.shape[0]} frames; --keep takes up to {MAX_FRAMES} (9.8 s)")
+    keys = np.full_like(joints, np.nan)
+    kept = list(LOWER_BODY if half == "lower" else UPPER_BODY)
+    keys[:, kept] = joints[:, kept]
+    features, out = sample_keyframed(generator, keys, config, text_embeddings=generator.encode_text([text]),
+                                     env=None if env is None else tuple(env), seed=seed, skeleton=rest_offsets(joints))
+    return EditedMotion(out, features, float(np.linalg.norm(out - joints, axis=-1).mean()))
+
+
+@dataclass(frozen=True)
+class EditRequest:
+    """One checked ``simdiff edit`` run.
+
+    Attributes:
+        source: the motion file; joints: its (T, 22, 3) joints, metres, Y up, 20 fps.
+        env: φ to re-play under (or to make the new half under).
+        formats: output kinds (:data:`simdiff.product.request.FORMATS`).
+        text: what the motion shows (optional for a re-play; the new half's prompt with ``keep``).
+        seed: noise seed.
+        keep: None (re-play under φ) or the half kept (:data:`HALVES`).
+    """
+
+    source: Path
+    joints: np.ndarray
+    env: Environment
+    formats: Sequence[str]
+    text: str = ""
+    seed: int = 0
+    keep: str | None = None
+
+
+def edit_file(request: EditRequest, out_dir: Path, *, model: Path | None = None,
+              device: str = "cpu") -> tuple[list[Path], str]:
+    """Run ``request`` with the default (or given) model and write the edit, a side-by-side video and ``edit.json``
+    into ``out_dir``; (written paths, a one-line summary). A failed run leaves no folder it created behind."""
     from simdiff.inference.default import check_model_dir
 
     folder = check_model_dir(model)
     created = not out_dir.exists()
     try:
-        return _edit_into(source, joints, env, formats, prepare_out_dir(out_dir), text, seed, folder, model, device)
+        return _edit_into(request, prepare_out_dir(out_dir), folder, model, device)
     except BaseException:
         if created:
             shutil.rmtree(out_dir, ignore_errors=True)
         raise
 
 
-def _edit_into(source: Path, joints: np.ndarray, env: Environment, formats: Sequence[str], out_dir: Path, text: str,
-               seed: int, folder: Path, model: Path | None, device: str) -> tuple[list[Path], str]:
+def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | None,
+               device: str) -> tuple[list[Path], str]:
     """:func:`edit_file` once the output folder exists."""
     import time
 
@@ -130,27 +177,36 @@ def _edit_into(source: Path, joints: np.ndarray, env: Environment, formats: Sequ
 
     check_writable(out_dir / "edit.json")  # a read-only folder fails now, not after sampling
     start = time.perf_counter()
-    generator = load_default(model, torch_device(device), load_text=bool(text))
-    if generator.config.sim is None or generator.config.sim.mode != "continuous":
+    joints, env = request.joints, request.env
+    generator = load_default(model, torch_device(device), load_text=bool(request.text))
+    continuous = generator.config.sim is not None and generator.config.sim.mode == "continuous"
+    if request.keep is None and not continuous:
         raise SimdiffError(f"{folder} has no continuous environment input (φ as numbers); it cannot re-play a "
                            "motion under gravity and wind")
+    if request.keep is not None and generator.is_simdiff and not continuous:
+        raise SimdiffError(f"{folder} has categorical environments; use a model with φ as numbers")
     config = sampling_config(model)
     loaded = time.perf_counter()
-    edited = edit_motion(generator, joints, config, env.as_tuple(), seed=seed, text=text)
+    if request.keep is None:
+        edited = edit_motion(generator, joints, config, env.as_tuple(), seed=request.seed, text=request.text)
+    else:
+        edited = keep_half(generator, joints, config, env.as_tuple() if generator.is_simdiff else None, request.keep,
+                           request.text, seed=request.seed)
     sampled = time.perf_counter()
     before, after = read_gravity(joints), read_gravity(edited.joints)
+    label = describe_env(env) if request.keep is None else f"{request.keep} body kept: {request.text}"
     with output_set(out_dir, last="edit.json") as stage:  # every file appears together, or none
-        written = write_motion(stage / "edited", edited.joints, edited.features, formats)
+        written = write_motion(stage / "edited", edited.joints, edited.features, request.formats)
         paths = list(written.values())
         for kind in ("gif", "mp4"):
-            if kind in formats:
-                paths.append(render_video([joints.astype(np.float32), edited.joints], ["input", describe_env(env)],
+            if kind in request.formats:
+                paths.append(render_video([joints.astype(np.float32), edited.joints], ["input", label],
                                           stage / f"compare.{kind}"))
         meta = {
-            "input": str(source), "frames": int(joints.shape[0]), "fps": FPS,
+            "input": str(request.source), "frames": int(joints.shape[0]), "fps": FPS,
             "environment": {"gravity": env.gravity, "wind": [env.wind_x, env.wind_y]},
-            "text": text, "seed": seed, "sampling": config.to_dict(), "model": str(folder),
-            "changed_m": round(edited.changed_m, 4),
+            "keep": request.keep, "text": request.text, "seed": request.seed, "sampling": config.to_dict(),
+            "model": str(folder), "changed_m": round(edited.changed_m, 4),
             "gravity_read": {"input": before, "edited": after},
             "files": sorted(p.name for p in paths),
             "seconds": {"load_model": round(loaded - start, 3), "sample": round(sampled - loaded, 3),
@@ -158,5 +214,5 @@ def _edit_into(source: Path, joints: np.ndarray, env: Environment, formats: Sequ
         }
         paths.append(write_metadata(stage / "edit.json", meta))
     paths = [out_dir / p.name for p in paths]
-    return paths, (f"{joints.shape[0]} frames re-played under {describe_env(env)}; joints moved "
-                   f"{100 * edited.changed_m:.1f} cm on average")
+    what = "re-played under " + describe_env(env) if request.keep is None else f"with the {request.keep} body kept"
+    return paths, f"{joints.shape[0]} frames {what}; joints moved {100 * edited.changed_m:.1f} cm on average"

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from simdiff.cli.options import FPS_OPTION, SEED, real
+from simdiff.product.edit import HALVES
 from simdiff.sim.env import MAX_FORCED_WIND, MAX_GRAVITY, MIN_FORCED_GRAVITY
 
 EPILOG = """\
@@ -25,6 +26,7 @@ examples:
   simdiff edit jump.bvh --gravity -1.6
   simdiff edit walk.npy --wind 0 8 --text "a person walks forward"
   simdiff edit 13_29.amc --asf 13.asf --gravity -3.7 --format npy,bvh,glb
+  simdiff edit walk.bvh --keep lower --text "a person waves with both hands"
 """
 
 
@@ -53,6 +55,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     inp.add_argument("--text", default="", metavar="TEXT",
                      help="what the motion shows, e.g. \"a person jumps forward\" (optional; it steers the model's "
                           "answer to φ)")
+    inp.add_argument("--keep", choices=HALVES, metavar="lower|upper",
+                     help="keep this half of the body (lower: pelvis and legs; upper: pelvis, spine, head and arms) and "
+                          "make the other anew for --text (motions up to 9.8 s)")
     inp.add_argument("--seed", type=SEED, default=0, metavar="S", help="noise seed (default 0)")
     out = p.add_argument_group("output")
     out.add_argument("--out", type=Path, metavar="DIR", help="output folder, files in it are replaced (default "
@@ -75,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     env = environments(args.gravity, tuple(args.wind), None, args.force)[0]  # checked before torch loads
     formats = parse_formats(args.format)
-    text = check_text(args.text) if args.text.strip() else ""
+    text = check_text(args.text) if args.text.strip() or args.keep else ""
     if not args.motion.is_file():
         from simdiff.errors import SimdiffError
 
@@ -86,12 +91,12 @@ def run(args: argparse.Namespace) -> int:
 
     with slow_notice(f"reading {args.motion}"):
         joints = check_motion(load_joints(args.motion, asf=args.asf, fps=args.fps), str(args.motion))
-    from simdiff.product.edit import edit_file
+    from simdiff.product.edit import EditRequest, edit_file
     from simdiff.product.outputs import fresh_dir, slug
 
     out_dir = args.out if args.out is not None else fresh_dir(Path("out") / f"{slug(args.motion.stem)}_edit")
-    paths, summary = edit_file(args.motion, joints, env, formats, out_dir, text=text, seed=args.seed,
-                               model=args.model, device=args.device)
+    request = EditRequest(args.motion, joints, env, formats, text, args.seed, args.keep)
+    paths, summary = edit_file(request, out_dir, model=args.model, device=args.device)
     for path in paths:
         print(path)
     if not args.quiet:
