@@ -10,9 +10,10 @@ so the seam carries the motion on. Cost is one sample per segment: linear in the
 from __future__ import annotations
 
 import json
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any
 
 import numpy as np
 
