@@ -185,3 +185,18 @@ def test_single_motion_fills_its_panel(jump_and_walk: list[np.ndarray], which: i
         assert (xy >= lo - 0.5).all() and (xy <= hi + 0.5).all()
         assert _fills(panel, motion)
 
+
+
+def test_a_long_walk_keeps_a_readable_body_in_the_filmstrip() -> None:
+    """Past LOCAL_VIEW_M of travel each cell draws its own stretch: the body stays tens of pixels tall."""
+    from simdiff.viz.stick import LOCAL_VIEW_M
+
+    long_walk = walk(400, speed=1.5)  # 30 m
+    short_walk = walk(80, speed=1.5)  # 6 m: drawn whole
+    assert np.ptp(long_walk[:, 0, 2]) > 3 * LOCAL_VIEW_M
+    fig, rows = filmstrip_figure([long_walk], [""], n_frames=8, dpi=100)
+    fig.canvas.draw()
+    body_px = [float(np.ptp(p.screen(long_walk[0])[:, 1])) for p in rows[0]]
+    assert min(body_px) > 30  # the whole 30 m drawn in each cell leaves 8
+    _, short_rows = filmstrip_figure([short_walk], [""], n_frames=4, dpi=100)
+    assert all(p.n_frames == 80 for p in short_rows[0])

@@ -149,7 +149,8 @@ def filmstrip_figure(motions: list[np.ndarray], captions: list[str], n_frames: i
     """The figure of :func:`render_filmstrip` (validated arguments) and its panels, one list per row."""
     cw, ch = cell_size
     style = shared_view(motions, DEFAULT_STYLE)
-    ch = auto_height(motions, cw, style.elev, style.azim) + LABEL_STRIP if ch is None else ch
+    shown = [[_around(m, int(t), n_frames) for t in filmstrip_indices(m.shape[0], n_frames)] for m in motions]
+    ch = auto_height([w for row in shown for w, _ in row], cw, style.elev, style.azim) + LABEL_STRIP if ch is None else ch
     strip = min(LABEL_STRIP, 0.2 * ch)
     width = cw * n_frames
     texts = [_wrap(c, width, max_lines=2) for c in captions]
@@ -165,11 +166,11 @@ def filmstrip_figure(motions: list[np.ndarray], captions: list[str], n_frames: i
             fig.text(0.5, top - 0.04 / height, text, ha="center", va="top", fontsize=CAPTION_FONT, weight="bold")
         bottom = top - row_h / height
         rows.append([])
-        for c, t in enumerate(filmstrip_indices(motion.shape[0], n_frames)):
+        for c, (t, (window, at)) in enumerate(zip(filmstrip_indices(motion.shape[0], n_frames), shown[r])):
             ax = fig.add_axes((c / n_frames, bottom + strip / height, 1.0 / n_frames, (ch - strip) / height),
                               projection="3d")
-            rows[-1].append(StickPanel(ax, motion, style=style))
-            rows[-1][-1].set_frame(int(t))
+            rows[-1].append(StickPanel(ax, window, style=style))
+            rows[-1][-1].set_frame(at)
             fig.text((c + 0.5) / n_frames, bottom + 0.03 / height, f"{t / fps:.2f} s", ha="center", va="bottom",
                      fontsize=7.5, color="#555555")
         if r > 0:
@@ -178,13 +179,30 @@ def filmstrip_figure(motions: list[np.ndarray], captions: list[str], n_frames: i
     return fig, rows
 
 
+LOCAL_VIEW_M: float = 8.0
+"""Root travel (m) above which each filmstrip cell shows only its own stretch of the motion: drawn whole in each of
+8 cells, a 30 m walk's body is 8 px tall; drawn by stretches, 37 px."""
+
+
+def _around(motion: np.ndarray, t: int, n_frames: int) -> tuple[np.ndarray, int]:
+    """What one filmstrip cell draws for frame ``t``: the whole motion and ``t``, or, for a motion travelling more than
+    :data:`LOCAL_VIEW_M`, the frames between this cell's neighbours and ``t``'s index in them."""
+    root = motion[:, 0, [0, 2]]
+    if float(np.linalg.norm(root.max(0) - root.min(0))) <= LOCAL_VIEW_M or n_frames < 2:
+        return motion, t
+    half = int(np.ceil((motion.shape[0] - 1) / (n_frames - 1) / 2))
+    lo = max(0, t - half)
+    return motion[lo: t + half + 1], t - lo
+
+
 def render_filmstrip(motions: Sequence[np.ndarray] | np.ndarray, path: str | Path,
                      captions: Sequence[str] | None = None, n_frames: int = 8, fps: float = FPS,
                      cell_size: tuple[float, float | None] = (1.7, None), dpi: int = 100) -> Path:
     """Save a grid image: one row per motion, ``n_frames`` evenly spaced frames per row.
 
     Every cell uses the same fixed camera angles and scale (metres per pixel); each row is
-    centred on its clip, titled by its caption, and each cell labelled by its time in seconds.
+    centred on its clip (each cell on its own stretch for a motion travelling more than :data:`LOCAL_VIEW_M`),
+    titled by its caption, and each cell labelled by its time in seconds.
 
     Args:
         motions: list of (T_i, 22, 3) joints in metres, Y-up.
