@@ -5,9 +5,11 @@ Pure Python + numpy (no torch), so bad input fails in milliseconds with one line
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -74,7 +76,7 @@ class GenerationRequest:
         """The requested video kinds (``gif``, ``mp4``), possibly none."""
         return tuple(f for f in self.formats if f in VIDEO_FORMATS)
 
-    def with_envs(self, envs: tuple[Environment, ...]) -> "GenerationRequest":
+    def with_envs(self, envs: tuple[Environment, ...]) -> GenerationRequest:
         """A copy with other environments (used when a backbone-only model ignores φ)."""
         return replace(self, envs=envs, compare=None)
 
@@ -228,8 +230,6 @@ def _timeline_request(text: str | None, timeline: str | Path, *, gravity: float 
                       compare: str | None, formats: str | None, force: bool,
                       keyframes: str | Path | None) -> GenerationRequest:
     """:func:`build_request` for ``--timeline``: the options a timeline's segments give are refused."""
-    from simdiff.product.timeline import read_timeline
-
     given = [flag for flag, value in (("TEXT", text), ("--gravity", gravity), ("--wind", wind),
                                        ("--length", length_s), ("--compare", compare), ("--keyframes", keyframes))
              if value is not None]
@@ -242,3 +242,84 @@ def _timeline_request(text: str | None, timeline: str | Path, *, gravity: float 
     if len(joined) > MAX_PROMPT_CHARS:
         joined = joined[: MAX_PROMPT_CHARS - 1] + "…"
     return replace(request, text=joined, frames=sum(s.frames for s in segments), timeline=segments)
+
+
+# Timelines (``generate --timeline``): checked here, sampled by :mod:`simdiff.product.timeline`.
+
+CONTEXT_FRAMES: int = 10
+"""Frames (0.5 s) of the motion so far that each next segment continues from."""
+MAX_SEGMENT_FRAMES: int = MAX_FRAMES - CONTEXT_FRAMES
+"""A segment's longest own part: the network's 196 frames less the context."""
+MAX_SEGMENTS: int = 100
+"""Most segments in one timeline."""
+KEYS: frozenset[str] = frozenset({"text", "seconds", "gravity", "wind"})
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One prompt of a timeline: its text, its own frames at 20 fps and its environment φ."""
+
+    text: str
+    frames: int
+    env: Environment
+
+
+def read_timeline(path: str | Path, force: bool = False) -> tuple[Segment, ...]:
+    """The checked segments of a timeline file; one line naming the file, the segment and the bad value otherwise.
+    ``force`` widens the environment ranges as ``generate --force`` does."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SimdiffError(f"no timeline file {str(path)!r}") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise SimdiffError(f"{path}: not a JSON timeline ({exc})") from None
+    return parse_timeline(data, str(path), force)
+
+
+def parse_timeline(data: Any, name: str = "the timeline", force: bool = False) -> tuple[Segment, ...]:
+    """:func:`read_timeline` for parsed JSON: a non-empty list of segment objects."""
+    if not isinstance(data, list) or not data:
+        raise SimdiffError(f"{name} must be a non-empty JSON list of segments "
+                           '[{"text": ..., "seconds": ..., "gravity"?: ..., "wind"?: [x, y]}, ...]')
+    if len(data) > MAX_SEGMENTS:
+        raise SimdiffError(f"{name} has {len(data)} segments; the most is {MAX_SEGMENTS}")
+    segments = []
+    for i, seg in enumerate(data):
+        where = f"{name}: segment {i}"
+        if not isinstance(seg, dict):
+            raise SimdiffError(f"{where} is {type(seg).__name__}, not an object with text and seconds")
+        unknown = sorted(set(seg) - KEYS)
+        if unknown:
+            raise SimdiffError(f"{where} has an unknown key {unknown[0]!r}; use text, seconds, gravity, wind")
+        for key in ("text", "seconds"):
+            if key not in seg:
+                raise SimdiffError(f"{where} has no {key!r}")
+        if not isinstance(seg["text"], str):
+            raise SimdiffError(f"{where}: text must be a string, got {seg['text']!r}")
+        try:
+            text = check_text(seg["text"])
+            seconds = check_finite(f"{where}: seconds", _number(seg["seconds"], f"{where}: seconds"))
+            gravity = check_finite(f"{where}: gravity", _number(seg.get("gravity", EARTH_GRAVITY), f"{where}: gravity"))
+            wind = seg.get("wind", [0.0, 0.0])
+            if not isinstance(wind, list) or len(wind) != 2:
+                raise SimdiffError(f"{where}: wind must be [x, y] in newtons, got {wind!r}")
+            wx, wy = (check_finite(f"{where}: wind", _number(w, f"{where}: wind")) for w in wind)
+            env = Environment(gravity, wx, wy).validate(force)
+        except SimdiffError as exc:
+            message = str(exc)
+            raise SimdiffError(message if message.startswith(where) else f"{where}: {message}") from None
+        frames = round(seconds * FPS)
+        low = MIN_GENERATE_FRAMES if i == 0 else 1
+        if not low <= frames <= (MAX_FRAMES if i == 0 else MAX_SEGMENT_FRAMES):
+            top = (MAX_FRAMES if i == 0 else MAX_SEGMENT_FRAMES) / FPS
+            raise SimdiffError(f"{where}: seconds {seconds:g} is outside {low / FPS:g}..{top:g} (one segment is one "
+                               "network window; split longer ones)")
+        segments.append(Segment(text, frames, env))
+    return tuple(segments)
+
+
+def _number(value: Any, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SimdiffError(f"{name} must be a number, got {value!r}")
+    return float(value)
