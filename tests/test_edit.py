@@ -12,11 +12,11 @@ import pytest
 from simdiff.cli.main import main
 from simdiff.diffusion.config import SamplingConfig
 from simdiff.errors import SimdiffError
+from simdiff.inference.editing import edit_motion
 from simdiff.inference.replay import OVERLAP, blend_weights, replay_features, windows
 from simdiff.motion import synthetic
 from simdiff.motion.features import process_joints
 from simdiff.motion.rigid import bone_lengths
-from simdiff.product.edit import edit_motion
 from simdiff.train.testing import tiny_generator
 
 CONFIG = SamplingConfig(steps=4, eta=0.0, edit_t=600, guidance=2.0, alpha=1.0, foot_lock=1.0)
@@ -164,8 +164,8 @@ def test_edit_cli_bad_files_get_one_line(content: np.ndarray, needle: str, tiny_
 
 @pytest.mark.parametrize("half", ["lower", "upper"])
 def test_keep_half_keeps_it_and_makes_the_other_anew(gen, half: str) -> None:
+    from simdiff.inference.editing import keep_half
     from simdiff.motion.skeleton import LOWER_BODY, UPPER_BODY
-    from simdiff.product.edit import keep_half
 
     walk = turned(synthetic.walk(40), 0.6, (1.0, 2.0))
     out = keep_half(gen, walk, CONFIG, (-9.81, 0.0, 0.0), half, "a person waves", seed=2)
@@ -180,7 +180,7 @@ def test_keep_half_keeps_it_and_makes_the_other_anew(gen, half: str) -> None:
 
 
 def test_keep_refuses_what_it_cannot_do(gen, tiny_model: Path, tmp_path: Path, capsys) -> None:
-    from simdiff.product.edit import keep_half
+    from simdiff.inference.editing import keep_half
 
     with pytest.raises(SimdiffError, match="up to 196"):
         keep_half(gen, synthetic.walk(200), CONFIG, None, "lower", "a person waves")

@@ -10,8 +10,8 @@ import pytest
 
 from simdiff.cli.main import main
 from simdiff.errors import SimdiffError
-from simdiff.product.request import CONTEXT_FRAMES, parse_timeline
-from simdiff.product.timeline import segment_seed, spans
+from simdiff.inference.timeline import CONTEXT_FRAMES, segment_seed, spans
+from simdiff.product.request import parse_timeline
 from simdiff.train.testing import tiny_generator
 
 pytestmark = pytest.mark.usefixtures("one_torch_thread")

@@ -1,4 +1,4 @@
-"""A user's motion re-played under φ, in the user's own frame and skeleton (``simdiff edit``)."""
+"""``simdiff edit``'s run: the edit of a user's motion (:mod:`simdiff.inference.editing`) written as one set."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from simdiff.diffusion.config import SamplingConfig
 from simdiff.errors import SimdiffError
-from simdiff.motion.skeleton import FPS, NUM_JOINTS
+from simdiff.inference.editing import edit_motion, keep_half
+from simdiff.motion.skeleton import FPS
 from simdiff.product.outputs import (
     prepare_out_dir,
     render_video,
@@ -21,110 +21,7 @@ from simdiff.product.outputs import (
 )
 
 if TYPE_CHECKING:
-    from simdiff.inference.generator import MotionGenerator
     from simdiff.sim.env import Environment
-
-MIN_EDIT_FRAMES: int = 10
-"""Shortest motion ``simdiff edit`` takes (0.5 s at 20 fps), as ``generate``'s shortest."""
-
-
-@dataclass(frozen=True)
-class EditedMotion:
-    """A motion re-played under φ.
-
-    Attributes:
-        joints: (T, 22, 3) float32 metres, Y up, 20 fps, in the input's frame, on the input's own skeleton.
-        features: (T, 263) float32 un-normalised HumanML3D features of the edit (canonical frame, one row per
-            joint frame).
-        changed_m: mean joint displacement from the input, metres.
-    """
-
-    joints: np.ndarray
-    features: np.ndarray
-    changed_m: float
-
-
-def check_motion(joints: np.ndarray, name: str = "the motion") -> np.ndarray:
-    """``joints`` as float64 (T, 22, 3), T ≥ :data:`MIN_EDIT_FRAMES`, finite; one-line errors otherwise."""
-    joints = np.asarray(joints, dtype=np.float64)
-    if joints.ndim != 3 or joints.shape[1:] != (NUM_JOINTS, 3):
-        raise SimdiffError(f"{name} must be (T, 22, 3) joints, got shape {joints.shape}")
-    if joints.shape[0] < MIN_EDIT_FRAMES:
-        raise SimdiffError(f"{name} has {joints.shape[0]} frames; editing needs at least {MIN_EDIT_FRAMES} (0.5 s)")
-    if not np.all(np.isfinite(joints)):
-        raise SimdiffError(f"{name} contains NaN or infinite values")
-    return joints
-
-
-def edit_motion(generator: MotionGenerator, joints: np.ndarray, config: SamplingConfig, env: Sequence[float], *,
-                seed: int = 0, text: str = "") -> EditedMotion:
-    """Re-play ``joints`` (T, 22, 3) metres, Y up, 20 fps under φ = ``env`` (g_z m/s², w_x N, w_y N).
-
-    The model's answer to φ (:func:`simdiff.inference.replay.replay_features`, canonical frame, HumanML3D skeleton)
-    is turned back into the input's frame and scale and added to its joints (smoothed like every written motion,
-    :func:`simdiff.motion.rigid.smooth_positions`); the sum is fitted with rotations on the input's own skeleton
-    and, where φ changed something, its planted feet are held by leg IK at ``config.foot_lock``. At Earth without
-    wind the input comes back (rigidly fitted).
-    """
-    from simdiff.inference.replay import replay_features
-    from simdiff.motion import quaternion as Q
-    from simdiff.motion.contact_hold import hold_contacts
-    from simdiff.motion.features import (
-        SLICES,
-        extend_last_frame,
-        facing_rotation,
-        features_to_joints,
-        process_joints,
-        uniform_scale,
-    )
-    from simdiff.motion.rigid import fit, rest_offsets, smooth_positions
-
-    joints = check_motion(joints)
-    features = process_joints(joints).features
-    replay = replay_features(generator, features, config, env, seed=seed, text=text)
-    edited = np.concatenate([replay.features, replay.features[-1:]])
-    offsets = rest_offsets(joints)
-    if not replay.difference.any():
-        out = fit(joints, offsets).joints
-        return EditedMotion(out, edited, float(np.linalg.norm(out - joints, axis=-1).mean()))
-
-    def decode(f: np.ndarray) -> np.ndarray:
-        return extend_last_frame(features_to_joints(f), f).astype(np.float64)
-
-    delta = decode(replay.features) - decode(features)  # canonical frame, HumanML3D skeleton
-    back = Q.qinv(facing_rotation(joints))
-    delta = Q.qrot(np.broadcast_to(back, delta.shape[:-1] + (4,)), delta) / uniform_scale(joints)
-    moved = fit(joints + smooth_positions(delta), offsets).joints
-    out = hold_contacts(moved, edited[:, SLICES["contacts"]], config.foot_lock) if config.foot_lock else moved
-    out = np.asarray(out, dtype=np.float32)
-    return EditedMotion(out, edited.astype(np.float32), float(np.linalg.norm(out - joints, axis=-1).mean()))
-
-
-HALVES: tuple[str, ...] = ("lower", "upper")
-"""What ``simdiff edit --keep`` can keep (:data:`simdiff.motion.skeleton.LOWER_BODY` / ``UPPER_BODY``)."""
-
-
-def keep_half(generator: MotionGenerator, joints: np.ndarray, config: SamplingConfig, env: Sequence[float] | None,
-              half: str, text: str, *, seed: int = 0) -> EditedMotion:
-    """``joints`` (T ≤ 196, 22, 3) with one half of the body (``half`` in :data:`HALVES`) kept, every frame, and the
-    other made anew for ``text`` under φ = ``env`` (None: a backbone-only model): the kept joints are keyframes
-    (:func:`simdiff.inference.keyframes.sample_keyframed`) and the result is fitted on the input's skeleton."""
-    from simdiff.inference.keyframes import sample_keyframed
-    from simdiff.motion.rigid import rest_offsets
-    from simdiff.motion.skeleton import LOWER_BODY, MAX_FRAMES, UPPER_BODY
-
-    if half not in HALVES:
-        raise SimdiffError(f"--keep must be one of {', '.join(HALVES)}, got {half!r}")
-    joints = check_motion(joints)
-    if joints.shape[0] > MAX_FRAMES:
-        raise SimdiffError(f"the motion has {joints.shape[0]} frames; --keep takes up to {MAX_FRAMES} (9.8 s)")
-    keys = np.full_like(joints, np.nan)
-    kept = list(LOWER_BODY if half == "lower" else UPPER_BODY)
-    keys[:, kept] = joints[:, kept]
-    features, out = sample_keyframed(generator, keys, config, text_embeddings=generator.encode_text([text]),
-                                     env=None if env is None else tuple(env), seed=seed, skeleton=rest_offsets(joints))
-    return EditedMotion(out, features, float(np.linalg.norm(out - joints, axis=-1).mean()))
-
 
 @dataclass(frozen=True)
 class EditRequest:

@@ -120,7 +120,7 @@ def sample_motions(generator, request: GenerationRequest, timer: Timer, quiet: b
             for c, k in runs:
                 env = None if envs[c] is None else envs[c].as_tuple()
                 if request.timeline is not None:
-                    from simdiff.product.timeline import sample_timeline
+                    from simdiff.inference.timeline import sample_timeline
 
                     f, j = sample_timeline(generator, request.timeline, request.sampling, seed=request.seed + k,
                                            progress=progress)
@@ -296,7 +296,7 @@ def _timeline_record(request: GenerationRequest) -> list[dict] | None:
     """Each timeline segment: its text, frames [start, end) and environment."""
     if request.timeline is None:
         return None
-    from simdiff.product.timeline import spans
+    from simdiff.inference.timeline import spans
 
     return [{"text": seg.text, "frames": list(span), "environment": _env_dict(seg.env)}
             for seg, span in zip(request.timeline, spans(request.timeline))]

@@ -15,6 +15,7 @@ import numpy as np
 
 from simdiff.diffusion.config import MAX_SEED, SamplingConfig
 from simdiff.errors import SimdiffError
+from simdiff.inference.timeline import MAX_SEGMENT_FRAMES, Segment
 from simdiff.motion.skeleton import FPS, MAX_FRAMES, MIN_GENERATE_FRAMES
 from simdiff.sim.env import EARTH_GRAVITY, Environment
 
@@ -49,7 +50,7 @@ class GenerationRequest:
         force: environments outside the trained range were allowed.
         keyframes: (frames, 22, 3) joints to meet, NaN = free (:mod:`simdiff.inference.keyframes`), or None.
         keyframes_file: where they were read from.
-        timeline: the segments of ``--timeline`` (:mod:`simdiff.product.timeline`), or None; ``text`` is then
+        timeline: the segments of ``--timeline`` (:mod:`simdiff.inference.timeline`), or None; ``text`` is then
             their texts joined by ", then", ``frames`` their sum and ``envs`` Earth's (each segment has its own).
     """
 
@@ -244,24 +245,11 @@ def _timeline_request(text: str | None, timeline: str | Path, *, gravity: float 
     return replace(request, text=joined, frames=sum(s.frames for s in segments), timeline=segments)
 
 
-# Timelines (``generate --timeline``): checked here, sampled by :mod:`simdiff.product.timeline`.
+# Timelines (``generate --timeline``): checked here, sampled by :mod:`simdiff.inference.timeline`.
 
-CONTEXT_FRAMES: int = 10
-"""Frames (0.5 s) of the motion so far that each next segment continues from."""
-MAX_SEGMENT_FRAMES: int = MAX_FRAMES - CONTEXT_FRAMES
-"""A segment's longest own part: the network's 196 frames less the context."""
 MAX_SEGMENTS: int = 100
 """Most segments in one timeline."""
 KEYS: frozenset[str] = frozenset({"text", "seconds", "gravity", "wind"})
-
-
-@dataclass(frozen=True)
-class Segment:
-    """One prompt of a timeline: its text, its own frames at 20 fps and its environment φ."""
-
-    text: str
-    frames: int
-    env: Environment
 
 
 def read_timeline(path: str | Path, force: bool = False) -> tuple[Segment, ...]:

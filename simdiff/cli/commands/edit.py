@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from simdiff.cli.options import FPS_OPTION, SEED, real
-from simdiff.product.edit import HALVES
+from simdiff.inference.editing import HALVES
 from simdiff.sim.env import MAX_FORCED_WIND, MAX_GRAVITY, MIN_FORCED_GRAVITY
 
 EPILOG = """\
@@ -86,8 +86,8 @@ def run(args: argparse.Namespace) -> int:
 
         raise SimdiffError(f"no motion file {str(args.motion)!r}")
     from simdiff.cli.feedback import slow_notice
+    from simdiff.inference.editing import check_motion
     from simdiff.motion.io import load_joints
-    from simdiff.product.edit import check_motion
 
     with slow_notice(f"reading {args.motion}"):
         joints = check_motion(load_joints(args.motion, asf=args.asf, fps=args.fps), str(args.motion))

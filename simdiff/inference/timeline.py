@@ -3,7 +3,7 @@ motion of any length.
 
 The file (checked by :func:`simdiff.product.request.read_timeline`) is a JSON list of segments ``{"text": str,
 "seconds": number, "gravity"?: number, "wind"?: [x, y]}``. The first segment is sampled as ``generate`` samples one
-prompt; each next one continues from the last :data:`~simdiff.product.request.CONTEXT_FRAMES` frames written so far,
+prompt; each next one continues from the last :data:`CONTEXT_FRAMES` frames written so far,
 given as keyframes (:func:`simdiff.inference.keyframes.sample_keyframed`), so the seam carries the motion on. Cost
 is one sample per segment: linear in the total length.
 """
@@ -11,10 +11,26 @@ is one sample per segment: linear in the total length.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 
 import numpy as np
 
-from simdiff.product.request import CONTEXT_FRAMES, Segment
+from simdiff.motion.skeleton import MAX_FRAMES
+from simdiff.sim.env import Environment
+
+CONTEXT_FRAMES: int = 10
+"""Frames (0.5 s) of the motion so far that each next segment continues from."""
+MAX_SEGMENT_FRAMES: int = MAX_FRAMES - CONTEXT_FRAMES
+"""A segment's longest own part: the network's 196 frames less the context."""
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One prompt of a timeline: its text, its own frames at 20 fps and its environment φ."""
+
+    text: str
+    frames: int
+    env: Environment
 
 
 def segment_seed(seed: int, index: int) -> int:
