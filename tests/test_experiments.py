@@ -59,6 +59,7 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
         "fig5": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "SimDiff", "model": "adapters", **FAST}],
         "env_response": [{"name": "MDM", "model": "backbone", **FAST}],
         "contacts": [{"name": "MDM", "model": "backbone", **FAST}],
+        "editing": [{"name": "SimDiff", "model": "adapters", **FAST}],
         "retrack": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                     {"name": "SimDiff", "model": "adapters", **FAST}],
     }[kind]
@@ -73,8 +74,8 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
 
 def test_shipped_configs_are_the_experiments_with_relative_paths() -> None:
     paths = sorted(CONFIGS.glob("eval_*.json"))
-    assert [p.stem for p in paths] == ["eval_contacts", "eval_env_response", "eval_fig4", "eval_fig5", "eval_retrack",
-                                       "eval_table1", "eval_table2"]
+    assert [p.stem for p in paths] == ["eval_contacts", "eval_editing", "eval_env_response", "eval_fig4", "eval_fig5",
+                                       "eval_retrack", "eval_table1", "eval_table2"]
     for path in paths:
         raw = json.loads(path.read_text())
         assert raw["kind"] == raw["name"] == path.stem[5:]
@@ -510,3 +511,30 @@ def test_contacts_reports_each_type_with_and_without_cleanup_against_real_clips(
     assert model["with"]["bone_std_mm"]["max"] < 1.0 and model["without"]["bone_std_mm"]["max"] < 1.0  # rigid written joints
     md = (setup["root"] / "reports/contacts/report.md").read_text()
     assert "| walk | real (test" in md and "| jump | MDM, no cleanup |" in md
+
+
+def test_editing_reports_replays_keyframes_and_a_timeline(setup: dict[str, Path]) -> None:
+    corpus = setup["corpus"]
+    ids = sorted(p.stem for p in (corpus / "new_joints").glob("*.npy"))
+    test = set((corpus / "test.txt").read_text().split())
+    clips = [{"id": i, "motion_type": "jump" if int(i) % 3 == 2 else "walk", "mirror_of": None, "captions": ["x"],
+              "split": "test" if i in test else "train"} for i in ids]
+    (corpus / "manifest.json").write_text(json.dumps({"clips": clips}))
+    options = {"replay_clips": 1, "gravity": [-1.6], "seeds": 1, "keyframe_clips": 1, "keyframe_frames": 30,
+               "timeline": [{"text": "a person walks", "seconds": 1}, {"text": "a person jumps", "seconds": 0.5,
+                                                                          "gravity": -1.6}]}
+    try:
+        report = run_experiment(write(setup, "editing", editing=options), progress=False, text_encoder=hash_text)
+    finally:
+        (corpus / "manifest.json").unlink()
+    rows = {(r["part"], r.get("gravity", r.get("case"))): r for r in report["rows"]}
+    assert set(rows) == {("replay", -9.81), ("replay", -1.6), ("keyframes", "in-between"),
+                         ("keyframes", "continuation"), ("keyframes", "path"), ("keyframes", "pinned"),
+                         ("timeline", None)}
+    assert rows[("replay", -9.81)]["changed_m"]["mean"] < 0.01  # Earth gives the clip back
+    assert all(rows[("keyframes", c)]["worst_error_cm"] < 2.0 for c in ("in-between", "continuation", "path", "pinned"))
+    timeline = rows[("timeline", None)]
+    assert timeline["frames"] == 30 and len(timeline["seams"]) == 1
+    md = (setup["root"] / "reports/editing/report.md").read_text()
+    assert "| SimDiff | -1.6 |" in md and "editing_timeline.png" in md
+    assert (setup["root"] / "reports/editing/editing_replay.png").is_file()

@@ -15,6 +15,8 @@ Kinds (``configs/eval_<kind>.json``):
   Earth motion: sign agreement, slope ratio, additivity (:mod:`.env_response`).
 * ``contacts``: sliding, skate ratio, joint speeds and root accelerations of the written joints per motion type,
   with and without the foot cleanup, against real mocap of the type (:mod:`.contacts`).
+* ``editing``: real clips re-played under other gravities, keyframes taken from real clips, one timeline
+  (:mod:`.editing`).
 
 Each report folder holds ``report.json`` (config, resolved paths, provenance, budget, rows),
 ``report.md`` (tables, provenance), figures, and ``rows/`` (one file per finished row; a rerun
@@ -31,7 +33,7 @@ from typing import Any
 
 from simdiff.fsio import write_text
 from simdiff.errors import SimdiffError
-from simdiff.eval.experiments import contacts, env_response, fig4, fig5, retrack, table1, table2
+from simdiff.eval.experiments import contacts, editing, env_response, fig4, fig5, retrack, table1, table2
 from simdiff.eval.experiments.config import KINDS, ExperimentConfig, ModelSpec, load_config
 from simdiff.eval.experiments.provenance import load_average, now
 from simdiff.eval.experiments.report import duration, header
@@ -41,8 +43,8 @@ __all__ = ["KINDS", "ORDER", "ExperimentConfig", "ModelSpec", "Runner", "load_co
            "run_experiment"]
 
 MODULES: dict[str, ModuleType] = {"table1": table1, "table2": table2, "fig4": fig4, "fig5": fig5, "retrack": retrack,
-                                  "env_response": env_response, "contacts": contacts}
-ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack", "env_response", "contacts")
+                                  "env_response": env_response, "contacts": contacts, "editing": editing}
+ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack", "env_response", "contacts", "editing")
 """Run order of :func:`run_all`: table2 first, so table1 finds the best α and reuses its rows."""
 
 

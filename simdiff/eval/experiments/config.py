@@ -21,7 +21,7 @@ from typing import Any
 from simdiff.errors import SimdiffError
 from simdiff.eval.protocol import ProtocolConfig
 
-KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response", "contacts")
+KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response", "contacts", "editing")
 """Experiment kinds, named as in the issue (and the paper)."""
 ROLES: tuple[str, ...] = ("backbone", "adapters", "adapters_binary")
 """Model roles ``paths`` may name: MDM backbone, continuous (φ) adapters, categorical (binary) adapters."""
@@ -183,6 +183,27 @@ class ContactOptions:
 
 
 @dataclass
+class EditingOptions:
+    """The editing report (:mod:`simdiff.eval.experiments.editing`).
+
+    Attributes:
+        replay_type, replay_clips: motion type and number of the split's clips re-played (those with a flight);
+        gravity: the gravities they are re-played at (Earth is always added); seeds: seeds per clip;
+        keyframe_type, keyframe_clips, keyframe_frames: the clips whose first frames make the keyframes;
+        timeline: segments ``{"text", "seconds", "gravity"?, "wind"?}`` as in ``generate --timeline``.
+    """
+
+    replay_type: str = "jump"
+    replay_clips: int = 6
+    gravity: list[float] = field(default_factory=lambda: [-1.6, -3.7])
+    seeds: int = 1
+    keyframe_type: str = "walk"
+    keyframe_clips: int = 4
+    keyframe_frames: int = 100
+    timeline: list[dict[str, Any]] = field(default_factory=list)
+
+
+@dataclass
 class ExperimentConfig:
     """One experiment; see :mod:`simdiff.eval.experiments` for the kinds.
 
@@ -201,6 +222,7 @@ class ExperimentConfig:
             size: ``ddpm_replications`` protocol replications of whole batches; fewer: physics
             metrics and time only).
         envs: φ list (retrack); retrack_samples: motions per (method, φ); contacts: the contacts report;
+        editing: the editing report;
         include_ground_truth: retrack also re-tracks the test motions themselves.
         budgets: named override sets, e.g. ``{"quick": {"about": "...", "set": {"protocol.replications": 3}}}``.
         text_encoder: ``auto``, each model's own (the only value; tests inject a stand-in through
@@ -237,6 +259,7 @@ class ExperimentConfig:
     timing: TimingOptions = field(default_factory=TimingOptions)
     env_control: EnvControlOptions = field(default_factory=EnvControlOptions)
     contacts: ContactOptions = field(default_factory=ContactOptions)
+    editing: EditingOptions = field(default_factory=EditingOptions)
     projector: ProjectorSpec = field(default_factory=ProjectorSpec)
     costs: CostModel = field(default_factory=CostModel)
     budgets: dict[str, dict[str, Any]] = field(default_factory=dict)
