@@ -104,8 +104,8 @@ FPS_OPTION = real(MIN_FPS, MAX_FPS)
 """``--fps``: a frame rate in Hz."""
 
 
-def add_environment_options(p: argparse.ArgumentParser) -> None:
-    """``--gravity G`` (m/s², default Earth) and ``--wind X Y`` (N) for commands that simulate."""
+def add_environment_options(p: argparse.ArgumentParser | argparse._ArgumentGroup) -> None:
+    """``--gravity G`` (m/s², default Earth) and ``--wind X Y`` (N) for commands that simulate or edit."""
     p.add_argument("--gravity", type=real(MIN_FORCED_GRAVITY, MAX_GRAVITY), default=-9.81,
                    help=f"vertical gravity g_z in m/s², {MIN_FORCED_GRAVITY:g}..{MAX_GRAVITY:g} (default -9.81)")
     p.add_argument("--wind", type=real(-MAX_FORCED_WIND, MAX_FORCED_WIND), nargs=2, default=(0.0, 0.0),

@@ -6,9 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from simdiff.cli.options import FPS_OPTION, SEED, real
+from simdiff.cli.options import FPS_OPTION, SEED, add_environment_options
 from simdiff.inference.editing import HALVES
-from simdiff.sim.env import MAX_FORCED_WIND, MAX_GRAVITY, MIN_FORCED_GRAVITY
 
 EPILOG = """\
 outputs (in --out, default ./out/<motion>_edit/):
@@ -33,20 +32,17 @@ examples:
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "edit",
-        help="re-play an existing motion under another gravity and wind",
+        help="re-play an existing motion under another gravity and wind, or remake half of its body",
         description="Re-play a motion file (.npy joints or features, BVH, AMC with --asf, DeepMimic) under gravity\n"
                     "and wind with the default model (or --model / $SIMDIFF_MODEL): its path, timing and style\n"
-                    "are kept, and only what the environment changes changes.",
+                    "are kept, and only what the environment changes changes. With --keep lower|upper and --text,\n"
+                    "one half of the body is kept and the other made anew for the text.",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("motion", type=Path, metavar="MOTION", help="motion file to re-play")
     env = p.add_argument_group("environment φ")
-    env.add_argument("--gravity", type=real(MIN_FORCED_GRAVITY, MAX_GRAVITY), default=-9.81, metavar="G",
-                     help="vertical gravity in m/s², negative (default -9.81 Earth; Mars -3.7, Moon -1.6)")
-    env.add_argument("--wind", type=real(-MAX_FORCED_WIND, MAX_FORCED_WIND), nargs=2, default=(0.0, 0.0),
-                     metavar=("X", "Y"), help="horizontal wind force in newtons along +X and +Z (the character's left "
-                                              "and forward at frame 0) (default 0 0)")
+    add_environment_options(env)
     env.add_argument("--force", action="store_true",
                      help="allow environments outside the trained range (gravity -20..-1 m/s², |wind| <= 10 N)")
     inp = p.add_argument_group("input and sampling")
