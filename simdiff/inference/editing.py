@@ -49,14 +49,14 @@ def check_motion(joints: np.ndarray, name: str = "the motion") -> np.ndarray:
 
 
 def edit_motion(generator: MotionGenerator, joints: np.ndarray, config: SamplingConfig, env: Sequence[float], *,
-                seed: int = 0, text: str = "") -> EditedMotion:
+                seed: int = 0, text: str = "", progress=None) -> EditedMotion:
     """Re-play ``joints`` (T, 22, 3) metres, Y up, 20 fps under φ = ``env`` (g_z m/s², w_x N, w_y N).
 
     The model's answer to φ (:func:`simdiff.inference.replay.replay_features`, canonical frame, HumanML3D skeleton)
     is turned back into the input's frame and scale and added to its joints (smoothed like every written motion,
     :func:`simdiff.motion.rigid.smooth_positions`); the sum is fitted with rotations on the input's own skeleton
     and, where φ changed something, its planted feet are held by leg IK at ``config.foot_lock``. At Earth without
-    wind the input comes back (rigidly fitted).
+    wind the input comes back (rigidly fitted). ``progress`` as :func:`~simdiff.inference.replay.replay_features`'.
     """
     from simdiff.inference.replay import replay_features
     from simdiff.motion import quaternion as Q
@@ -73,7 +73,7 @@ def edit_motion(generator: MotionGenerator, joints: np.ndarray, config: Sampling
 
     joints = check_motion(joints)
     features = process_joints(joints).features
-    replay = replay_features(generator, features, config, env, seed=seed, text=text)
+    replay = replay_features(generator, features, config, env, seed=seed, text=text, progress=progress)
     edited = np.concatenate([replay.features, replay.features[-1:]])
     offsets = rest_offsets(joints)
     if not replay.difference.any():

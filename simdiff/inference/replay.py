@@ -9,7 +9,7 @@ without wind the motion comes back unchanged, and only what φ changes changes. 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -67,7 +67,7 @@ class Replay:
 
 @torch.no_grad()
 def _denoise_from(generator: MotionGenerator, x0: Tensor, config: SamplingConfig, text: Tensor | None, env: Tensor,
-                  seed: int) -> Tensor:
+                  seed: int, progress: Callable[[Iterable[int]], Iterable[int]] | None = None) -> Tensor:
     """Noise normalised ``x0`` (1, T, F) to the first timestep at or below ``config.edit_t`` and run the guided
     sampler from there under ``env`` (1, 3) and ``text`` (1, text_dim) (None: the null text, no text guidance);
     x₀ (1, T, F) normalised."""
@@ -89,14 +89,15 @@ def _denoise_from(generator: MotionGenerator, x0: Tensor, config: SamplingConfig
     # edit_t 999 here: the motion itself is the Earth sample that the steps above edit_t follow in generate
     model = GuidedDenoiser(generator.network, config.guidance if text is not None else 1.0,
                            env_scale=config.env_guidance, edit_t=999)
-    for t in steps:
+    for t in steps if progress is None else progress(steps):
         x0_hat = model(x, torch.full((1,), t, dtype=torch.long, device=x.device), cond)
         x = scheduler.step(x0_hat, t, x, generator=gen).prev_sample
     return x
 
 
 def replay_features(generator: MotionGenerator, features: np.ndarray, config: SamplingConfig, env: Sequence[float],
-                    *, seed: int = 0, text: str = "") -> Replay:
+                    *, seed: int = 0, text: str = "",
+                    progress: Callable[[Iterable[int]], Iterable[int]] | None = None) -> Replay:
     """The motion ``features`` (T, 263) un-normalised, re-played under φ = ``env`` (g_z m/s², w_x N, w_y N).
 
     Args:
@@ -104,6 +105,7 @@ def replay_features(generator: MotionGenerator, features: np.ndarray, config: Sa
         config: the sampling settings (sampler, steps, η, guidance, α, environment guidance, ``edit_t``).
         seed: the noise seed; window k uses seed + k.
         text: what the motion shows (optional); empty: the model's unconditional prediction.
+        progress: optional wrapper of each denoising loop's timesteps (two loops per window).
     """
     if generator.config.sim is None or generator.config.sim.mode != "continuous":
         raise SimdiffError("re-playing a motion under φ needs a SimDiff model with a continuous Sim Encoder")
@@ -122,8 +124,8 @@ def replay_features(generator: MotionGenerator, features: np.ndarray, config: Sa
     diff = np.zeros_like(feats)
     for k, (weights, (s, e)) in enumerate(zip(blend_weights(len(feats), spans), spans)):
         x0 = x[None, s:e]
-        moved = _denoise_from(generator, x0, config, emb, phi, seed + k)
-        still = _denoise_from(generator, x0, config, emb, earth, seed + k)
+        moved = _denoise_from(generator, x0, config, emb, phi, seed + k, progress)
+        still = _denoise_from(generator, x0, config, emb, earth, seed + k, progress)
         d = ((moved - still) * generator.std)[0].cpu().numpy()
         diff[s:e] += weights[s:e, None] * d
     out = feats + diff

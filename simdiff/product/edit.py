@@ -45,27 +45,29 @@ class EditRequest:
     keep: str | None = None
 
 
-def edit_file(request: EditRequest, out_dir: Path, *, model: Path | None = None,
-              device: str = "cpu") -> tuple[list[Path], str]:
+def edit_file(request: EditRequest, out_dir: Path, *, model: Path | None = None, device: str = "cpu",
+              quiet: bool = False) -> tuple[list[Path], str]:
     """Run ``request`` with the default (or given) model and write the edit, a side-by-side video and ``edit.json``
-    into ``out_dir``; (written paths, a one-line summary). A failed run leaves no folder it created behind."""
+    into ``out_dir``; (written paths, a one-line summary). A failed run leaves no folder it created behind. A
+    progress bar on stderr unless ``quiet``."""
     from simdiff.inference.default import check_model_dir
 
     folder = check_model_dir(model)
     created = not out_dir.exists()
     try:
-        return _edit_into(request, prepare_out_dir(out_dir), folder, model, device)
+        return _edit_into(request, prepare_out_dir(out_dir), folder, model, device, quiet)
     except BaseException:
         if created:
             shutil.rmtree(out_dir, ignore_errors=True)
         raise
 
 
-def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | None,
-               device: str) -> tuple[list[Path], str]:
+def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | None, device: str,
+               quiet: bool) -> tuple[list[Path], str]:
     """:func:`edit_file` once the output folder exists."""
     import time
 
+    from simdiff.diffusion.sampling import make_scheduler
     from simdiff.fsio import check_writable, output_set
     from simdiff.inference.default import load_default, sampling_config
     from simdiff.inference.device import torch_device
@@ -85,7 +87,24 @@ def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | 
     config = sampling_config(model)
     loaded = time.perf_counter()
     if request.keep is None:
-        edited = edit_motion(generator, joints, config, env.as_tuple(), seed=request.seed, text=request.text)
+        import sys
+
+        from tqdm.auto import tqdm
+
+        from simdiff.inference.replay import windows
+
+        steps = sum(1 for t in make_scheduler(config.sampler, config.steps, config.eta).timesteps
+                    if int(t) <= config.edit_t)
+        with tqdm(total=2 * steps * len(windows(len(joints) - 1)), desc="re-playing", unit="step", leave=False,
+                  disable=quiet, file=sys.stderr, dynamic_ncols=True) as bar:
+
+            def progress(ts):
+                for t in ts:
+                    yield t
+                    bar.update(1)
+
+            edited = edit_motion(generator, joints, config, env.as_tuple(), seed=request.seed, text=request.text,
+                                 progress=progress)
     else:
         edited = keep_half(generator, joints, config, env.as_tuple() if generator.is_simdiff else None, request.keep,
                            request.text, seed=request.seed)

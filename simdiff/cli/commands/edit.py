@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
 
     out_dir = args.out if args.out is not None else fresh_dir(Path("out") / f"{slug(args.motion.stem)}_edit")
     request = EditRequest(args.motion, joints, env, formats, text, args.seed, args.keep)
-    paths, summary = edit_file(request, out_dir, model=args.model, device=args.device)
+    paths, summary = edit_file(request, out_dir, model=args.model, device=args.device, quiet=args.quiet)
     for path in paths:
         print(path)
     if not args.quiet:
