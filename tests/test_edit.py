@@ -149,6 +149,7 @@ def test_edit_cli_bad_options_get_one_line(argv: list[str], needle: str, tiny_mo
     (np.zeros((40, 21, 3)), "22"),
     (np.zeros((1, 22, 3)), "frame"),
     (np.full((40, 22, 3), np.nan), "non-finite"),
+    (np.zeros((40, 22, 3)), "not a body in metres"),
 ])
 def test_edit_cli_bad_files_get_one_line(content: np.ndarray, needle: str, tiny_model: Path, tmp_path: Path,
                                          capsys) -> None:

@@ -158,3 +158,39 @@ def test_generate_bad_keyframes_get_one_line(content, extra: list[str], needle: 
     assert not (tmp_path / "o").exists()
     assert main(["generate", "a person walks", "--keyframes", str(tmp_path / "none.npy")]) == 2
     assert "none.npy" in capsys.readouterr().err
+
+
+def test_a_root_path_with_poses_and_a_late_partial_joint() -> None:
+    """Root x/z on every frame plus a whole pose (the root's y free) is fitted on the pose's skeleton; a partly-NaN
+    joint after a legal root path entry is still refused; coordinates beyond a kilometre are refused."""
+    w = synthetic.walk(40)
+    keys = free(40)
+    keys[:, 0, [0, 2]] = w[:, 0, [0, 2]]
+    keys[20, 1:] = w[20, 1:]
+    keys = check_keyframes(keys)
+    met = meet_keyframes(w + 0.05, keys)
+    given = np.isfinite(keys)
+    assert np.isfinite(met).all()
+    assert float(np.abs(np.where(given, met - np.nan_to_num(keys), 0.0)).max()) < 0.01
+    bad = free(40)
+    bad[0, 0, [0, 2]] = 0.0
+    bad[5, 5, 0] = 0.3
+    with pytest.raises(SimdiffError, match="joint 5 at frame 5 is partly NaN"):
+        check_keyframes(bad)
+    far = free(40)
+    far[:, 0, [0, 2]] = 1e200
+    with pytest.raises(SimdiffError, match="beyond 1000 m at frame 0"):
+        check_keyframes(far)
+
+
+def test_generate_warns_when_a_lone_joint_is_not_met(tiny_model: Path, tmp_path: Path, capsys) -> None:
+    w = synthetic.walk(30)
+    keys = free(30)
+    keys[0] = w[0]
+    keys[15, 20] = w[15, 20] + np.array([0.5, 0.4, 0.0])  # a wrist 64 cm off its arm's reach
+    np.save(tmp_path / "k.npy", keys)
+    assert main(["generate", "a person walks", "--keyframes", str(tmp_path / "k.npy"), "--steps", "2", "--model",
+                 str(tiny_model), "--format", "npy", "--out", str(tmp_path / "o"), "-q"]) == 0
+    record = json.loads((tmp_path / "o" / "generation.json").read_text())["keyframes"]
+    err = capsys.readouterr().err
+    assert (record["max_error_m"][0] > 0.02) == ("warning: a keyframe entry is" in err), err

@@ -46,6 +46,9 @@ def test_a_good_timeline_parses_into_segments() -> None:
     ([GOOD[0], {"text": "a person runs", "seconds": 2, "wind": [1]}], "wind must be [x, y]"),
     ([GOOD[0], {"text": "a person runs", "seconds": 2, "wind": [1, True]}], "wind must be a number"),
     ([GOOD[0], {"text": "a person runs", "seconds": float("nan")}], "seconds must be a finite number"),
+    ([{"text": "a person walks", "seconds": 1e308}], "seconds 1e+308 is outside"),
+    ([{"text": "a person walks", "seconds": 10**400}], "seconds must be a finite number, got an integer of 401 digits"),
+    ([{"text": "a person walks", "seconds": 2, "gravity": -(10**400)}], "gravity must be a finite number"),
 ])
 def test_bad_segments_are_named(data, needle: str) -> None:
     with pytest.raises(SimdiffError, match=None) as info:
@@ -78,6 +81,7 @@ def test_generate_timeline_writes_one_motion(tiny_model: Path, tmp_path: Path, c
 
 @pytest.mark.parametrize("extra, needle", [
     (["a person walks"], "leave TEXT out"),
+    (["--simulate"], "leave --simulate out"),
     (["--gravity", "-3.7"], "leave --gravity out"),
     (["--length", "2"], "leave --length out"),
 ])

@@ -37,7 +37,8 @@ class EditedMotion:
 
 
 def check_motion(joints: np.ndarray, name: str = "the motion") -> np.ndarray:
-    """``joints`` as float64 (T, 22, 3), T ≥ :data:`MIN_EDIT_FRAMES`, finite; one-line errors otherwise."""
+    """``joints`` as float64 (T, 22, 3), T ≥ :data:`MIN_EDIT_FRAMES`, finite, bones of a body in metres (averaging
+    0.02..1 m); one-line errors otherwise."""
     joints = np.asarray(joints, dtype=np.float64)
     if joints.ndim != 3 or joints.shape[1:] != (NUM_JOINTS, 3):
         raise SimdiffError(f"{name} must be (T, 22, 3) joints, got shape {joints.shape}")
@@ -45,6 +46,11 @@ def check_motion(joints: np.ndarray, name: str = "the motion") -> np.ndarray:
         raise SimdiffError(f"{name} has {joints.shape[0]} frames; editing needs at least {MIN_EDIT_FRAMES} (0.5 s)")
     if not np.all(np.isfinite(joints)):
         raise SimdiffError(f"{name} contains NaN or infinite values")
+    from simdiff.motion.rigid import bone_lengths
+
+    mean_bone = float(bone_lengths(joints).mean())
+    if not 0.02 <= mean_bone <= 1.0:  # a human's 21 bones average about 0.15 m
+        raise SimdiffError(f"{name}'s bones average {mean_bone:.3g} m; not a body in metres")
     return joints
 
 
@@ -98,9 +104,11 @@ HALVES: tuple[str, ...] = ("lower", "upper")
 
 def keep_half(generator: MotionGenerator, joints: np.ndarray, config: SamplingConfig, env: Sequence[float] | None,
               half: str, text: str, *, seed: int = 0) -> EditedMotion:
-    """``joints`` (T ≤ 196, 22, 3) with one half of the body (``half`` in :data:`HALVES`) kept, every frame, and the
-    other made anew for ``text`` under φ = ``env`` (None: a backbone-only model): the kept joints are keyframes
-    (:func:`simdiff.inference.keyframes.sample_keyframed`) and the result is fitted on the input's skeleton."""
+    """``joints`` (T ≤ 196, 22, 3) with one half of the body (``half`` in :data:`HALVES`) kept and the other made
+    anew for ``text`` under φ = ``env`` (None: a backbone-only model): the kept joints are keyframes
+    (:func:`simdiff.inference.keyframes.sample_keyframed`) and the result is fitted on the input's skeleton, which
+    holds the kept joints within a few centimetres (where the new half meets the kept one, the fit compromises: 1.3 cm
+    for kept legs, 3.8 cm for a kept upper body on a val walk)."""
     from simdiff.inference.keyframes import sample_keyframed
     from simdiff.motion.rigid import rest_offsets
     from simdiff.motion.skeleton import LOWER_BODY, MAX_FRAMES, UPPER_BODY

@@ -38,6 +38,8 @@ CORRECTION_SIGMA: float = 3.0
 without a jump."""
 MAX_BONE_SPREAD: float = 0.02
 """m: the most one bone's length may differ between the whole poses given (they are one body)."""
+MAX_COORDINATE: float = 1000.0
+"""m: the largest keyframe coordinate (a motion stays within a kilometre of the origin)."""
 MAX_KEYFRAME_SPEED: float = 20.0
 """m/s: two finite entries of one joint further apart than this over their frames cannot both be met."""
 
@@ -72,11 +74,15 @@ def check_keyframes(keys: np.ndarray, name: str = "the keyframes") -> np.ndarray
     finite = np.isfinite(keys)
     if not finite.any():
         raise SimdiffError(f"{name} are all NaN: nothing is constrained")
-    if (finite.sum(-1) % 3).any():
-        frame, joint = (int(v) for v in np.argwhere(finite.sum(-1) % 3)[0])
-        if not (joint == 0 and finite[frame, 0, [0, 2]].all() and not finite[frame, 0, 1]):
-            raise SimdiffError(f"{name}: joint {joint} at frame {frame} is partly NaN; give x, y and z (or, for the "
-                               "root, x and z alone)")
+    partly = (finite.sum(-1) % 3) > 0  # (T, 22)
+    partly[:, 0] &= ~(finite[:, 0, 0] & finite[:, 0, 2] & ~finite[:, 0, 1])  # the root's x/z alone is a path
+    if partly.any():
+        frame, joint = (int(v) for v in np.argwhere(partly)[0])
+        raise SimdiffError(f"{name}: joint {joint} at frame {frame} is partly NaN; give x, y and z (or, for the "
+                           "root, x and z alone)")
+    if np.abs(keys[finite]).max() > MAX_COORDINATE:
+        frame = int(np.argwhere(np.abs(np.nan_to_num(keys)) > MAX_COORDINATE)[0][0])
+        raise SimdiffError(f"{name} has a coordinate beyond {MAX_COORDINATE:g} m at frame {frame}; joints are metres")
     _check_reachable(keys, name)
     _check_skeleton(keys, name)
     return keys
@@ -208,7 +214,7 @@ class KeyframeGuide:
         return (x0 + self._smooth(z)).detach()
 
     def _smooth(self, z: Tensor) -> Tensor:
-        """(B, T, F) low-passed along T by the Gaussian kernel, reflected at the ends."""
+        """(B, T, F) low-passed along T by the Gaussian kernel, the end values repeated beyond the ends."""
         b, t, f = z.shape
         k = self.kernel
         pad = min(k.shape[-1] // 2, t - 1)
@@ -274,8 +280,12 @@ def meet_keyframes(joints: np.ndarray, keys: np.ndarray, skeleton: np.ndarray | 
     for j in np.flatnonzero(alone.any(0)):  # joints given without their whole pose: faded the same way, per joint
         frames = np.flatnonzero(alone[:, j])
         out[:, j + 1] += _faded(frames, keys[frames, j + 1] - out[frames, j + 1], n)
+    if skeleton is None and len(posed):  # the given poses' skeleton; a root given by x/z alone sits where it is put
+        given = keys[posed].copy()
+        given[:, 0] = np.where(np.isfinite(given[:, 0]), given[:, 0], out[posed, 0])
+        skeleton = rest_offsets(given)
     if skeleton is None:
-        skeleton = rest_offsets(keys[posed]) if len(posed) else rest_offsets(out)
+        skeleton = rest_offsets(out)
     return fit(out, skeleton).joints.astype(np.float32)
 
 

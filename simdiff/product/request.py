@@ -297,8 +297,8 @@ def parse_timeline(data: Any, name: str = "the timeline", force: bool = False) -
         except SimdiffError as exc:
             message = str(exc)
             raise SimdiffError(message if message.startswith(where) else f"{where}: {message}") from None
-        frames = round(seconds * FPS)
         low = MIN_GENERATE_FRAMES if i == 0 else 1
+        frames = round(seconds * FPS) if abs(seconds) <= MAX_FRAMES else -1
         if not low <= frames <= (MAX_FRAMES if i == 0 else MAX_SEGMENT_FRAMES):
             top = (MAX_FRAMES if i == 0 else MAX_SEGMENT_FRAMES) / FPS
             raise SimdiffError(f"{where}: seconds {seconds:g} is outside {low / FPS:g}..{top:g} (one segment is one "
@@ -310,4 +310,7 @@ def parse_timeline(data: Any, name: str = "the timeline", force: bool = False) -
 def _number(value: Any, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SimdiffError(f"{name} must be a number, got {value!r}")
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:
+        raise SimdiffError(f"{name} must be a finite number, got an integer of {len(str(value))} digits") from None

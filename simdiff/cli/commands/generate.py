@@ -46,8 +46,13 @@ examples:
   simdiff generate --timeline day.json
 
 --keyframes: frame 0 starts where the keyframes put the root and faces where their hips and shoulders face (at the
-origin facing +Z when not given); every finite entry is met within 2 cm.
+origin facing +Z when not given); whole poses and root entries are met within 2 cm, joints given alone as far as the
+skeleton allows (a warning says when one is off by more).
 """
+
+
+KEYFRAME_TOLERANCE: float = 0.02
+"""m: a keyframe entry further than this from the written motion gets a warning."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -156,6 +161,11 @@ def run(args: argparse.Namespace) -> int:
         num_samples=args.num_samples, sampling=sampling, compare=args.compare, formats=args.format, force=args.force,
         keyframes=args.keyframes, timeline=args.timeline,
     )
+    if args.simulate and request.timeline is not None:
+        from simdiff.errors import SimdiffError
+
+        raise SimdiffError("--simulate re-tracks a motion under one φ, and a timeline has one per segment; leave "
+                           "--simulate out")
     finisher = None
     if args.simulate:  # the simulator loads in its own process while this one loads torch and samples
         from simdiff.product.finisher import start_finisher
@@ -241,6 +251,10 @@ def _generate_into(args: argparse.Namespace, request: GenerationRequest, start: 
             print(f"simdiff: warning: sample {rec['index']} glides: it travels while no foot lifts {GLIDE_LIFT:.2f} m "
                   "(a frozen pose carried along); under a φ far from Earth or a strong --env-guidance the model "
                   "extrapolates", file=sys.stderr)
+    keyframes = meta.get("keyframes")
+    if keyframes and max(keyframes["max_error_m"]) > KEYFRAME_TOLERANCE:
+        print(f"simdiff: warning: a keyframe entry is {100 * max(keyframes['max_error_m']):.1f} cm from the motion; "
+              "joints given without their whole pose are met only as far as the skeleton allows", file=sys.stderr)
     for rec in meta["samples"] if args.simulate else []:
         sim = rec["simulated"]
         name = rec["files"].get("tracking", f"sample {rec['index']}").removesuffix("_tracking.json")
