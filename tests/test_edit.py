@@ -196,3 +196,17 @@ def test_keep_refuses_what_it_cannot_do(gen, tiny_model: Path, tmp_path: Path, c
                  "--format", "npy", "--out", str(tmp_path / "k"), "-q"]) == 0, capsys.readouterr().err
     meta = json.loads((tmp_path / "k" / "edit.json").read_text())
     assert meta["keep"] == "lower" and meta["text"] == "a person waves"
+
+
+def test_edit_reads_a_bvh_and_gives_it_back_at_earth(tiny_model: Path, tmp_path: Path, capsys) -> None:
+    from simdiff.motion.io import load_joints
+    from simdiff.motion.io.bvh_writer import write_bvh
+
+    src = tmp_path / "walk.bvh"
+    write_bvh(src, turned(synthetic.walk(60), 0.4, (1.0, -2.0)).astype(np.float32))
+    assert main(["edit", str(src), "--model", str(tiny_model), "--format", "npy,bvh", "--out", str(tmp_path / "o"),
+                 "-q"]) == 0, capsys.readouterr().err
+    read = load_joints(src)
+    edited = np.load(tmp_path / "o" / "edited_joints.npy")
+    assert edited.shape == read.shape and float(np.abs(edited - read).max()) < 0.01
+    assert np.abs(load_joints(tmp_path / "o" / "edited.bvh") - edited).max() < 0.01
