@@ -38,6 +38,10 @@ CORRECTION_SIGMA: float = 3.0
 without a jump."""
 MAX_BONE_SPREAD: float = 0.02
 """m: the most one bone's length may differ between the whole poses given (they are one body)."""
+MIN_BODY_JOINTS: int = 4
+"""Joints given at a frame without the root from which the body's position there is taken."""
+BLEND_FRAMES: int = 10
+"""Frames either side of a keyframe over which :func:`meet_keyframes` fades its pose correction."""
 MAX_COORDINATE: float = 1000.0
 """m: the largest keyframe coordinate (a motion stays within a kilometre of the origin)."""
 MAX_KEYFRAME_SPEED: float = 20.0
@@ -231,12 +235,6 @@ class KeyframeGuide:
         return self.pull(x0, POLISH_STEPS)
 
 
-MIN_BODY_JOINTS: int = 4
-"""Joints given at a frame without the root from which the body's position there is taken."""
-BLEND_FRAMES: int = 10
-"""Frames either side of a keyframe over which :func:`meet_keyframes` fades its pose correction."""
-
-
 def _interpolate(frames: np.ndarray, values: np.ndarray, length: int) -> np.ndarray:
     """Piecewise-linear (length, D) through ``values`` (K, D) at ``frames`` (K,), constant beyond the ends."""
     return np.stack([np.interp(np.arange(length), frames, values[:, d]) for d in range(values.shape[1])], axis=1)
@@ -287,6 +285,12 @@ def meet_keyframes(joints: np.ndarray, keys: np.ndarray, skeleton: np.ndarray | 
     if skeleton is None:
         skeleton = rest_offsets(out)
     return fit(out, skeleton).joints.astype(np.float32)
+
+
+def keyframe_error(joints: np.ndarray, keys: np.ndarray) -> float:
+    """The largest distance (m) of ``joints`` (T, 22, 3) from the finite entries of ``keys`` (T, 22, 3)."""
+    given = np.isfinite(keys)
+    return float(np.linalg.norm(np.where(given, joints - np.nan_to_num(keys), 0.0), axis=-1).max())
 
 
 def sample_keyframed(generator, keys: np.ndarray, config, *, text_embeddings: Tensor,

@@ -65,6 +65,17 @@ class Replay:
     difference: np.ndarray
 
 
+def _edit_steps(config: SamplingConfig) -> list[int]:
+    """The sampler's timesteps at or below ``config.edit_t``: where a re-play runs."""
+    timesteps = make_scheduler(config.sampler, config.steps, config.eta).timesteps
+    return [int(t) for t in timesteps if int(t) <= config.edit_t]
+
+
+def replay_step_count(config: SamplingConfig, frames: int) -> int:
+    """Network steps :func:`replay_features` takes for ``frames`` feature rows (two denoisings per window)."""
+    return 2 * len(_edit_steps(config)) * len(windows(frames))
+
+
 @torch.no_grad()
 def _denoise_from(generator: MotionGenerator, x0: Tensor, config: SamplingConfig, text: Tensor | None, env: Tensor,
                   seed: int, progress: Callable[[Iterable[int]], Iterable[int]] | None = None) -> Tensor:
@@ -74,7 +85,7 @@ def _denoise_from(generator: MotionGenerator, x0: Tensor, config: SamplingConfig
     from simdiff.model.condition import Condition
 
     scheduler = make_scheduler(config.sampler, config.steps, config.eta)
-    steps = [int(t) for t in scheduler.timesteps if int(t) <= config.edit_t]
+    steps = _edit_steps(config)
     if not steps:
         return x0
     gen = torch.Generator(device="cpu").manual_seed(int(seed))

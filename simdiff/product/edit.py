@@ -67,7 +67,6 @@ def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | 
     """:func:`edit_file` once the output folder exists."""
     import time
 
-    from simdiff.diffusion.sampling import make_scheduler
     from simdiff.fsio import check_writable, output_set
     from simdiff.inference.default import load_default, sampling_config
     from simdiff.inference.device import torch_device
@@ -91,11 +90,9 @@ def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | 
 
         from tqdm.auto import tqdm
 
-        from simdiff.inference.replay import windows
+        from simdiff.inference.replay import replay_step_count
 
-        steps = sum(1 for t in make_scheduler(config.sampler, config.steps, config.eta).timesteps
-                    if int(t) <= config.edit_t)
-        with tqdm(total=2 * steps * len(windows(len(joints) - 1)), desc="re-playing", unit="step", leave=False,
+        with tqdm(total=replay_step_count(config, len(joints) - 1), desc="re-playing", unit="step", leave=False,
                   disable=quiet, file=sys.stderr, dynamic_ncols=True) as bar:
 
             def progress(ts):

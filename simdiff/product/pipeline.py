@@ -285,9 +285,10 @@ def _keyframes_record(request: GenerationRequest, samples: list[Sample]) -> dict
     keys = request.keyframes
     if keys is None:
         return None
+    from simdiff.inference.keyframes import keyframe_error
+
     given = np.isfinite(keys)
-    worst = [float(np.linalg.norm(np.where(given, s.joints - np.nan_to_num(keys), 0.0), axis=-1).max())
-             for s in samples]
+    worst = [keyframe_error(s.joints, keys) for s in samples]
     return {"file": request.keyframes_file, "entries": int(given.all(-1).sum() + (given[:, 0].sum(-1) == 2).sum()),
             "max_error_m": [round(w, 4) for w in worst]}
 
