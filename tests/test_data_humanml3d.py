@@ -11,7 +11,7 @@ import pytest
 import torch
 from torch.utils.data import DataLoader
 
-from simdiff.data.humanml3d import HumanML3D, build_items, collate, read_captions, read_split
+from simdiff.data.humanml3d import HumanML3D, build_items, collate, normalise_caption, read_captions, read_split
 from simdiff.errors import MotionFormatError, SimdiffError
 
 FRAMES = {"000001": 80, "000002": 30, "000003": 150, "000004": 220, "000005": 100}
@@ -172,3 +172,15 @@ def test_a_split_is_any_id_list_in_the_folder_and_an_unknown_one_is_named(tmp_pa
         HumanML3D(root, "second_try")
     with pytest.raises(SimdiffError, match="unknown split '../c/train'"):
         HumanML3D(root, "../c/train")
+
+
+def test_unseen_in_keeps_only_captions_the_other_split_lacks(hml_dir: Path) -> None:
+    assert normalise_caption("  A person, walks-FORWARD. ") == "a person walks forward"
+    (hml_dir / "val.txt").write_text("000003\n000001\n")
+    (hml_dir / "train.txt").write_text("000005\n")
+    (hml_dir / "texts" / "000005.txt").write_text("A PERSON JUMPS!#x/OTHER#0.0#0.0\nsomeone strolls ahead#x/OTHER#0.0#0.0\n")
+    items = {it.name: [c.text for c in it.captions] for it in HumanML3D(hml_dir, "val", unseen_in="train").items}
+    # 000003's whole-clip "a person jumps" is a train caption once normalised; its segments keep theirs
+    assert items == {"000003_23_80": ["a person bends down"], "000003_100_150": ["a person sits"],
+                     "000001": ["a person walks forward."]}
+    assert len(HumanML3D(hml_dir, "val").items) == 4

@@ -60,6 +60,7 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
         "env_response": [{"name": "MDM", "model": "backbone", **FAST}],
         "contacts": [{"name": "MDM", "model": "backbone", **FAST}],
         "editing": [{"name": "SimDiff", "model": "adapters", **FAST}],
+        "following": [{"name": "SimDiff", "model": "adapters", **FAST}],
         "retrack": [{"name": "MDM", "model": "backbone", **FAST}, {"name": "PhysDiff", "model": "backbone", "physdiff": PHYS, **FAST},
                     {"name": "SimDiff", "model": "adapters", **FAST}],
     }[kind]
@@ -75,7 +76,7 @@ def write(setup: dict[str, Path], kind: str, name: str | None = None, **extra) -
 def test_shipped_configs_are_the_experiments_with_relative_paths() -> None:
     paths = sorted(CONFIGS.glob("eval_*.json"))
     assert [p.stem for p in paths] == ["eval_contacts", "eval_editing", "eval_env_response", "eval_fig4", "eval_fig5",
-                                       "eval_retrack", "eval_table1", "eval_table2"]
+                                       "eval_following", "eval_heldout", "eval_retrack", "eval_table1", "eval_table2"]
     for path in paths:
         raw = json.loads(path.read_text())
         assert raw["kind"] == raw["name"] == path.stem[5:]
@@ -538,3 +539,66 @@ def test_editing_reports_replays_keyframes_and_a_timeline(setup: dict[str, Path]
     md = (setup["root"] / "reports/editing/report.md").read_text()
     assert "| SimDiff | -1.6 |" in md and "editing_timeline.png" in md
     assert (setup["root"] / "reports/editing/editing_replay.png").is_file()
+
+
+def test_following_reports_pass_rates_on_real_clips_and_wordings(setup: dict[str, Path]) -> None:
+    corpus = setup["corpus"]
+    ids = sorted(p.stem for p in (corpus / "new_joints").glob("*.npy"))
+    test = set((corpus / "test.txt").read_text().split())
+    clips = [{"id": i, "mirror_of": None, "captions": ["a person jumps in place" if int(i) % 2 else "a person waves"],
+              "split": "test" if i in test else "train"} for i in ids]
+    (corpus / "manifest.json").write_text(json.dumps({"clips": clips}))
+    words = [{"category": "in place", "text": "a person jumps in place", "checks": ["travel:in_place"]},
+             {"category": "speed", "text": "a person walks slowly", "checks": ["speed:slower"],
+              "reference": "a person walks"}]
+    options = {"prompts": {"test": words}, "seeds": 2, "length": 40,
+               "ground_truth": [{"category": "in place", "check": "travel:in_place", "captions": "in place"},
+                                {"category": "turning", "check": "turn:around", "captions": "turns around"}]}
+    try:
+        report = run_experiment(write(setup, "following", following=options), progress=False, text_encoder=hash_text)
+    finally:
+        (corpus / "manifest.json").unlink()
+    rows = {r["category"]: r for r in report["rows"]}
+    gt = {r["check"]: r for r in rows["all"]["rules"]}
+    assert gt["travel:in_place"]["n"] == sum(1 for c in clips if c["split"] == "test" and int(c["id"]) % 2)
+    assert gt["turn:around"]["n"] == 0
+    assert [len(w["seeds"]) for w in rows["speed"]["wordings"]] == [2]
+    assert all(s["readings"][0].startswith("pelvis speed") for s in rows["speed"]["wordings"][0]["seeds"])
+    md = (setup["root"] / "reports/following/report.md").read_text()
+    assert "| turning | — (none) |" in md and "| speed | a person walks slowly | `speed:slower` |" in md
+    bad = {**options, "prompts": {"test": [{**words[1], "reference": ""}]}}
+    with pytest.raises(SimdiffError, match="needs a 'reference'"):
+        run_experiment(write(setup, "following", name="following_bad", following=bad), progress=False,
+                       text_encoder=hash_text)
+
+
+def test_heldout_measures_all_and_unseen_captions(setup: dict[str, Path]) -> None:
+    from simdiff.data.humanml3d import normalise_caption, read_captions
+
+    corpus = setup["corpus"]
+    texts = corpus / "texts"
+    train = (corpus / "train.txt").read_text().split()
+    test = (corpus / "test.txt").read_text().split()
+    seen = {normalise_caption(c.text) for i in train for c in read_captions(texts / f"{i}.txt")}
+    originals = {i: (texts / f"{i}.txt").read_text() for i in test}
+    try:  # a third of the test clips get a caption no train clip has; one more repeats a train caption in capitals
+        for k, i in enumerate(test):
+            if k % 3 == 0:
+                (texts / f"{i}.txt").write_text(f"Someone juggles {k} clubs#x/OTHER#0.0#0.0\n")
+        first = read_captions(texts / f"{train[0]}.txt")[0].text
+        (texts / f"{test[1]}.txt").write_text(f"{first.upper()}!#x/OTHER#0.0#0.0\n")
+        unseen = sum(1 for i in test if normalise_caption(read_captions(texts / f"{i}.txt")[0].text) not in seen)
+        proto = {**PROTO, "batch_size": 2, "replications": 2, "mm_prompts": 0, "physics": False}
+        report = run_experiment(write(setup, "heldout", protocol=proto,
+                                      models=[{"name": "MDM", "model": "backbone", **FAST}]),
+                                progress=False, text_encoder=hash_text)
+    finally:
+        for i, text in originals.items():
+            (texts / f"{i}.txt").write_text(text)
+    rows = {(r["method"], r["captions"]): r for r in report["rows"]}
+    assert set(rows) == {("Ground truth", "all"), ("Ground truth", "unseen"), ("MDM", "all"), ("MDM", "unseen")}
+    assert normalise_caption(first.upper() + "!") in seen and len(test) // 3 <= unseen < len(test)
+    assert rows[("MDM", "unseen")]["items"] == unseen and rows[("MDM", "all")]["items"] == len(test)
+    assert rows[("Ground truth", "unseen")]["distinct_captions"] == unseen
+    md = (setup["root"] / "reports/heldout/report.md").read_text()
+    assert f"| MDM | unseen | {unseen} ({unseen}) |" in md

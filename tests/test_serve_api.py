@@ -249,6 +249,29 @@ def test_no_model_answers_503_and_files_still_open(tmp_path, walk):
         srv.server_close()
 
 
+def test_far_prompts_carry_the_generate_warning(tmp_path, model_dir):
+    import shutil
+
+    from simdiff.inference.coverage import write_coverage_table
+
+    folder = tmp_path / "model"
+    shutil.copytree(model_dir, folder)
+    write_coverage_table(folder, ["a person walks forward.", "a person jumps."], HashTextEncoder())
+    srv = _start(MotionService(folder, text_encoder=HashTextEncoder(), steps=STEPS))
+    try:
+        status, out, _ = call(srv, "/api/generate", {"text": "a person jumps.", "seconds": 1.0})
+        assert status == 200 and out["meta"]["warnings"] == []
+        status, out, _ = call(srv, "/api/generate", {"text": "a person plays the violin", "seconds": 1.0})
+        assert status == 200 and len(out["meta"]["warnings"]) == 1
+        assert out["meta"]["warnings"][0].startswith('"a person plays the violin" is far from every training caption')
+        segments = [{"text": "a person jumps.", "seconds": 1}, {"text": "a person plays the violin", "seconds": 1}]
+        status, out, _ = call(srv, "/api/timeline", {"segments": segments})
+        assert status == 200 and [w.split('"')[1] for w in out["meta"]["warnings"]] == ["a person plays the violin"]
+    finally:
+        srv.shutdown()
+        srv.server_close()
+
+
 # -- files --------------------------------------------------------------------------------------
 
 
@@ -432,3 +455,230 @@ def test_generate_eta_from_sampling_json_or_the_request(server, model_dir):
     for bad, message in ((1.5, "eta must be in [0, 1], got 1.5"), ("x", "eta must be a finite number")):
         status, out, _ = call(server, "/api/generate", {**moon, "eta": bad})
         assert status == 400 and message in out["error"], out
+
+
+# -- re-play, timeline, pins --------------------------------------------------------------------
+
+
+def _tiny_generator(model_dir: Path) -> MotionGenerator:
+    gen = MotionGenerator.load(model_dir, load_text=False)
+    gen.text_encoder = HashTextEncoder()
+    return gen
+
+
+def test_answers_are_numbered_and_name_their_body(server):
+    status, out, _ = call(server, "/api/files/0")
+    assert status == 200 and isinstance(out["motion"], int) and out["body"] == f"/api/body/{out['motion']}.glb"
+    again = call(server, "/api/files/0")[1]
+    assert again["motion"] == out["motion"] + 1
+
+
+def test_edit_replays_a_motion_shown_as_simdiff_edit_does(server, model_dir):
+    from simdiff.inference.editing import edit_motion
+    from simdiff.motion.gravity_readout import read_gravity
+
+    opened = call(server, "/api/files/0")[1]
+    body = {"source": opened["motion"], "gravity": -1.6, "wind_x": 2.0, "seed": 4, "alpha": 1.5}
+    status, out, _ = call(server, "/api/edit", body)
+    assert status == 200, out
+    meta = out["meta"]
+    assert meta["source"] == "edit" and meta["params"] == {**body, "wind_y": 0.0, "text": ""}
+    assert meta["frames"] == 30 and meta["sampling"]["alpha"] == 1.5 and meta["sampling"]["steps"] == STEPS
+    assert meta["queue_position"] == 0 and isinstance(meta["id"], int) and out["motion"] > opened["motion"]
+    source = np.asarray(opened["joints"])  # the joints as the page has them
+    config = SamplingConfig(steps=STEPS, alpha=1.5)
+    expected = edit_motion(_tiny_generator(model_dir), source, config, (-1.6, 2.0, 0.0), seed=4)
+    np.testing.assert_allclose(np.asarray(out["joints"]), expected.joints, atol=1e-4)
+    read = {"input": read_gravity(source), "edited": read_gravity(expected.joints)}  # as edit.json reads them
+    assert set(meta["gravity_read"]) == {"input", "edited"}
+    for key, value in read.items():
+        assert meta["gravity_read"][key] == (None if value is None else pytest.approx(value))
+    assert meta["changed_m"] == pytest.approx(expected.changed_m, abs=1e-4) and meta["changed_m"] > 0.001
+    # at Earth without wind the motion comes back (fitted on its own skeleton); a re-play of a re-play works too
+    status, earth, _ = call(server, "/api/edit", {"source": opened["motion"]})
+    assert status == 200 and earth["meta"]["changed_m"] < 0.02
+    assert call(server, "/api/edit", {"source": out["motion"], "gravity": -3.7})[0] == 200
+
+
+def test_edit_refuses_a_source_it_does_not_keep_or_cannot_replay(server, walk, monkeypatch):
+    status, out, _ = call(server, "/api/edit", {"source": 999999})
+    assert status == 400 and out["error"].startswith("source 999999: no such motion here")
+    short = call(server, "/api/open?name=short.npy", npy_bytes(walk[:5]))[1]
+    status, out, _ = call(server, "/api/edit", {"source": short["motion"], "gravity": -3})
+    assert status == 400 and f"source {short['motion']} has 5 frames; editing needs at least 10" in out["error"]
+    tiny = call(server, "/api/open?name=tiny.npy", npy_bytes(walk * 0.01))[1]  # centimetres taken for metres
+    status, out, _ = call(server, "/api/edit", {"source": tiny["motion"], "gravity": -3})
+    assert status == 400 and "not a body in metres" in out["error"]
+    monkeypatch.setattr("simdiff.serve.edits.MAX_REPLAY_FRAMES", 20)
+    opened = call(server, "/api/files/0")[1]
+    status, out, _ = call(server, "/api/edit", {"source": opened["motion"], "gravity": -3})
+    assert status == 400 and "has 30 frames; the viewer re-plays up to 20 (1 s): use simdiff edit" in out["error"]
+
+
+@pytest.mark.parametrize("body, needle", [
+    ({}, "source must be the number of a motion shown"),
+    ({"source": "1"}, "source must be the number of a motion shown (an answer's \"motion\"), got '1'"),
+    ({"source": True}, "source must be the number of a motion shown"),
+    ({"source": 0}, "got 0"),
+    ({"source": 1.5}, "got 1.5"),
+    ({"source": 1, "gravity": -25}, "gravity must be in [-20, -1] m/s², got -25"),
+    ({"source": 1, "gravity": "moon"}, "gravity must be a finite number, got 'moon'"),
+    ({"source": 1, "wind_x": 11}, "wind_x must be in [-10, 10] N, got 11"),
+    ({"source": 1, "seed": -1}, "seed must be a non-negative integer"),
+    ({"source": 1, "edit_t": 1000}, "edit_t must be in [0, 999], got 1000"),
+    ({"source": 1, "text": 5}, "text must be a non-empty prompt, got 5"),
+    ({"source": 1, "seconds": 2}, "unknown field 'seconds'"),
+    ([1], "request body must be a JSON object, got list"),
+])
+def test_bad_edit_request_is_a_400_with_one_line(server, body, needle):
+    status, out, _ = call(server, "/api/edit", body)
+    assert status == 400 and needle in out["error"] and "\n" not in out["error"], out
+
+
+def test_edit_refuses_non_finite_json(server):
+    status, out, _ = call(server, "/api/edit", b'{"source": 1, "gravity": NaN}', content_type="application/json")
+    assert status == 400 and "NaN" in out["error"]
+
+
+def test_timeline_is_the_clis_timeline(server, model_dir):
+    from simdiff.inference.timeline import sample_timeline
+    from simdiff.product.request import parse_timeline
+
+    segments = [{"text": "a person walks forward", "seconds": 1.5},
+                {"text": "a person jumps", "seconds": 1, "gravity": -1.6, "wind": [0, 4]}]
+    status, out, _ = call(server, "/api/timeline", {"segments": segments, "seed": 3})
+    assert status == 200, out
+    meta = out["meta"]
+    assert meta["source"] == "timeline" and meta["frames"] == 50 and meta["seed"] == 3 and meta["env_used"]
+    assert meta["segments"] == [
+        {"text": "a person walks forward", "frames": [0, 30], "gravity": -9.81, "wind": [0.0, 0.0]},
+        {"text": "a person jumps", "frames": [30, 50], "gravity": -1.6, "wind": [0.0, 4.0]}]
+    _, joints = sample_timeline(_tiny_generator(model_dir), parse_timeline(segments), SamplingConfig(steps=STEPS),
+                                seed=3)
+    np.testing.assert_allclose(np.asarray(out["joints"]), joints, atol=1e-4)
+    assert isinstance(out["motion"], int) and out["body"].endswith(".glb")
+
+
+BAD_SEGMENTS = [
+    None,
+    [],
+    "walk",
+    [{"text": "walk"}],
+    [{"seconds": 2}],
+    [{"text": "   ", "seconds": 2}],
+    [{"text": "walk", "seconds": 20}],
+    [{"text": "walk", "seconds": 0.1}],
+    [{"text": "walk", "seconds": 2}, {"text": "run", "seconds": 9.5}],
+    [{"text": "walk", "seconds": 2, "gravity": 3}],
+    [{"text": "walk", "seconds": 2, "gravity": "moon"}],
+    [{"text": "walk", "seconds": 2, "wind": [20, 0]}],
+    [{"text": "walk", "seconds": 2, "wind": 3}],
+    [{"text": "walk", "seconds": 2, "prompt": "x"}],
+    [{"text": "walk", "seconds": 2}, "run"],
+    [{"text": 5, "seconds": 2}],
+    [{"text": "walk", "seconds": 10**30}],
+]
+
+
+@pytest.mark.parametrize("segments", BAD_SEGMENTS, ids=range(len(BAD_SEGMENTS)))
+def test_bad_timeline_is_refused_with_the_clis_message(server, segments):
+    from simdiff.product.request import parse_timeline
+
+    with pytest.raises(SimdiffError) as cli:
+        parse_timeline(segments)
+    status, out, _ = call(server, "/api/timeline", {"segments": segments} if segments is not None else {})
+    assert status == 400 and out["error"] == str(cli.value) and "\n" not in out["error"]
+
+
+@pytest.mark.parametrize("body, needle", [
+    ({"segments": [{"text": "walk", "seconds": 1}] * 9}, "the timeline has 9 segments; the viewer takes at most 8"),
+    ({"segments": [{"text": "walk", "seconds": 1}], "seed": -2}, "seed must be a non-negative integer"),
+    ({"segments": [{"text": "walk", "seconds": 1}], "gravity": -3}, "unknown field 'gravity'"),
+    ({"segments": [{"text": "walk", "seconds": 1}], "steps": 500}, "steps must be in [1, 200], got 500"),
+    ({"segments": [{"text": "\ud800", "seconds": 1}]}, "segment 0: text must be valid Unicode"),
+    ("walk", "request body must be a JSON object, got str"),
+])
+def test_bad_timeline_request_is_a_400_with_one_line(server, body, needle):
+    status, out, _ = call(server, "/api/timeline", body)
+    assert status == 400 and needle in out["error"] and "\n" not in out["error"], out
+
+
+def test_pins_start_and_end_in_a_shown_motions_poses(server, model_dir):
+    from simdiff.inference.keyframes import keyframe_error, sample_keyframed
+
+    opened = call(server, "/api/files/0")[1]
+    source = np.asarray(opened["joints"])
+    body = {"text": "a person walks", "seconds": 2, "seed": 1}
+    status, out, _ = call(server, "/api/generate", {**body, "pin_start": opened["motion"]})
+    assert status == 200, out
+    joints, meta = np.asarray(out["joints"]), out["meta"]
+    assert joints.shape == (40, 22, 3) and meta["pins"] == {"start": opened["motion"], "end": None}
+    assert meta["params"]["pin_start"] == opened["motion"] and meta["params"]["pin_end"] is None
+    assert meta["keyframe_error_cm"] < 2.0 and np.linalg.norm(joints[0] - source[0], axis=-1).max() < 0.02
+    keys = np.full((40, 22, 3), np.nan)
+    keys[0] = source[0]
+    gen = _tiny_generator(model_dir)
+    _, expected = sample_keyframed(gen, keys, SamplingConfig(steps=STEPS), text_embeddings=gen.encode_text([body["text"]]),
+                                   env=(-9.81, 0.0, 0.0), seed=1)  # what `generate --keyframes` samples
+    np.testing.assert_allclose(joints, expected, atol=1e-4)
+    assert meta["keyframe_error_cm"] == pytest.approx(100 * keyframe_error(joints, keys), abs=0.02)
+
+    status, out, _ = call(server, "/api/generate", {**body, "pin_start": opened["motion"], "pin_end": opened["motion"]})
+    assert status == 200, out
+    joints = np.asarray(out["joints"])
+    assert out["meta"]["pins"] == {"start": opened["motion"], "end": opened["motion"]}
+    assert np.linalg.norm(joints[[0, -1]] - source[[0, -1]], axis=-1).max() < 0.02
+    assert "pins" not in call(server, "/api/generate", body)[1]["meta"]
+
+
+def test_bad_pins_are_a_400_with_one_line(server, walk):
+    body = {"text": "a person walks", "seconds": 2}
+    for pin, needle in ((True, "pin_start must be the number of a motion shown"),
+                        ("1", "pin_start must be the number of a motion shown"),
+                        (-3, "got -3"), (999999, "pin_start 999999: no such motion here")):
+        status, out, _ = call(server, "/api/generate", {**body, "pin_start": pin})
+        assert status == 400 and needle in out["error"] and "\n" not in out["error"], out
+    status, out, _ = call(server, "/api/generate", {**body, "pin_end": 999998})
+    assert status == 400 and "pin_end 999998: no such motion here" in out["error"]
+    # a motion that crosses 20 m: its first and last pose cannot both be met within 0.5 s
+    far = walk.copy()
+    far[..., 0] += np.linspace(0.0, 20.0, len(walk))[:, None]
+    opened = call(server, "/api/open?name=far.npy", npy_bytes(far))[1]
+    pins = {"pin_start": opened["motion"], "pin_end": opened["motion"]}
+    status, out, _ = call(server, "/api/generate", {**body, "seconds": 0.5, **pins})
+    assert status == 400 and out["error"].startswith("the poses pinned on a 0.5 s motion: joint 0 moves"), out
+    assert "no motion reaches that" in out["error"]
+
+
+def test_motions_named_as_sources_stay_kept():
+    from simdiff.serve.wire import BodyCache
+
+    cache = BodyCache(3)
+    numbers = [cache.add(np.full((10, 22, 3), float(i))) for i in range(3)]
+    assert cache.joints(numbers[0])[0, 0, 0] == 0.0  # used: the last to go
+    cache.add(np.zeros((10, 22, 3)))
+    assert cache.joints(numbers[1]) is None and cache.joints(numbers[0]) is not None
+    assert cache.glb(numbers[0]) is not None and cache.joints(numbers[0]) is not None  # a built body keeps its joints
+
+
+def test_edit_and_timeline_share_the_generation_queue(model_dir, walk):
+    from simdiff.serve.edits import replay, timeline
+    from simdiff.serve.params import parse_replay, parse_timeline_request
+    from simdiff.serve.service import GenerationCancelled, QueueFull
+
+    service = MotionService(model_dir, text_encoder=HashTextEncoder(), steps=STEPS, max_queue=0)
+    source = service.answer(walk, {"source": "test"})["motion"]
+    edit = parse_replay({"source": source, "gravity": -2.0})
+    line = parse_timeline_request({"segments": [{"text": "walk", "seconds": 1}, {"text": "run", "seconds": 1}]})
+    with service.queued(None):  # one request running, none may wait
+        with pytest.raises(QueueFull):
+            replay(service, edit)
+        with pytest.raises(QueueFull):
+            timeline(service, line)
+    for run, params in ((replay, edit), (timeline, line)):  # cancelled at the third poll: during sampling
+        polls = iter(range(100))
+        with pytest.raises(GenerationCancelled, match="during sampling"):
+            run(service, params, cancelled=lambda polls=polls: next(polls) >= 2)
+        assert service.queue_status()["pending"] == 0 and service._lock.acquire(blocking=False)
+        service._lock.release()
+    assert replay(service, edit)["meta"]["id"] == 1  # cancelled runs take no number

@@ -1,6 +1,8 @@
 """``simdiff serve`` end to end in headless Chromium (Playwright): the page loads, generates,
 regenerates from the prompt and the gravity slider, plays/scrubs and opens an uploaded file; the WebGL view
 shows the skinned body, with the stick figure as a toggle; without WebGL the page falls back to the 2D stick figure.
+An open file is re-played under the sliders, a timeline of prompts is built and generated, and a pinned start pose
+holds the next generation's first frame.
 
 Skips when Playwright or a Chromium is missing. Chromium: ``$SIMDIFF_CHROMIUM``, else a system
 ``chromium`` (Debian: ``apt-get install chromium``), else Playwright's own download.
@@ -99,6 +101,12 @@ def sample_motion(tmp_path: Path) -> Path:
 def wait_for_new_motion(page, after_id: int) -> dict:
     page.wait_for_function(f"id => {STATE}.generation_id > id && {STATE}.status === 'ready'", arg=after_id,
                            timeout=TIMEOUT_MS)
+    return page.evaluate(STATE)
+
+
+def wait_for_shown(page, after: int) -> dict:
+    """The page state once a motion after the ``after``-th shown (any kind) is on screen."""
+    page.wait_for_function(f"n => {STATE}.shown > n && {STATE}.status === 'ready'", arg=after, timeout=TIMEOUT_MS)
     return page.evaluate(STATE)
 
 
@@ -278,3 +286,87 @@ def test_without_webgl_the_page_draws_the_stick_figure(playwright, server, tmp_p
         assert errors == []
     finally:
         chromium.close()
+
+
+def test_viewer_replays_a_file_builds_a_timeline_and_pins_a_pose(browser, server, tmp_path):
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    problems: list[str] = []
+    page.on("pageerror", lambda exc: problems.append(f"page error: {exc}"))
+    page.on("console", lambda msg: problems.append(f"console: {msg.text}")
+            if msg.type == "error" and "status of 400" not in msg.text else None)  # the bad row below is on purpose
+    page.goto(server.url)
+    wait_for_new_motion(page, 0)
+    assert page.is_hidden("#replay")  # nothing to re-play before a file is open
+    folder = screenshot_dir(tmp_path)
+
+    # open a file: the re-play button shows; the sliders re-play it instead of generating
+    motion = sample_motion(tmp_path)
+    page.set_input_files("#file-input", str(motion))
+    page.wait_for_function(f"{STATE}.source === 'upload' && {STATE}.status === 'ready'", timeout=TIMEOUT_MS)
+    opened = page.evaluate(STATE)
+    assert opened["file_motion"] == opened["motion"] and page.is_visible("#replay")
+    page.fill("#gravity", "-3")
+    slid = wait_for_shown(page, opened["shown"])
+    assert slid["source"] == "edit" and slid["params"]["source"] == opened["motion"]
+    assert slid["params"]["gravity"] == pytest.approx(-3.0) and slid["frames"] == opened["frames"]
+    assert slid["digest"] != opened["digest"] and slid["generation_id"] == opened["generation_id"]
+
+    # the button re-plays the open file (not the re-play on screen) under the sliders as they are
+    page.evaluate("(s => { s.value = '6'; s.dispatchEvent(new Event('input')); })(document.getElementById('wind_y'))")
+    page.click("#replay")
+    replayed = wait_for_shown(page, slid["shown"])
+    assert replayed["source"] == "edit" and replayed["params"]["source"] == opened["motion"]
+    assert replayed["params"]["wind_y"] == pytest.approx(6.0) and replayed["file_motion"] == opened["motion"]
+    assert replayed["meta"]["changed_m"] > 0 and set(replayed["meta"]["gravity_read"]) == {"input", "edited"}
+    assert motion.name in page.text_content("#caption") and "Re-played" in page.text_content("#status")
+    wait_for_body(page)
+    page.screenshot(path=str(folder / "viewer_replay.png"))
+
+    # a two-row timeline: the builder starts with the prompt box's row; add one, fill both, generate
+    page.click("#timeline-builder summary")
+    page.click("#add-segment")
+    rows = page.locator("#segments .segment")
+    assert rows.count() == 2
+    rows.nth(0).locator(".seg-text").fill("a person walks forward")
+    rows.nth(0).locator(".seg-seconds").fill("1.5")
+    rows.nth(1).locator(".seg-text").fill("a person jumps")
+    rows.nth(1).locator(".seg-seconds").fill("1")
+    rows.nth(1).locator(".seg-gravity").fill("-1.6")
+    rows.nth(1).locator(".seg-wind-x").fill("2")
+    page.click("#generate-timeline")
+    line = wait_for_shown(page, replayed["shown"])
+    assert line["source"] == "timeline" and line["frames"] == 50 and line["file_motion"] is None
+    assert [(s["text"], s["frames"], s["gravity"], s["wind"]) for s in line["meta"]["segments"]] == [
+        ("a person walks forward", [0, 30], -9.81, [0.0, 0.0]), ("a person jumps", [30, 50], -1.6, [2.0, 0.0])]
+    assert page.is_hidden("#replay") and "→" in page.text_content("#caption")
+    wait_for_body(page)
+    page.screenshot(path=str(folder / "viewer_timeline.png"))
+
+    # a bad row shows the server's one-line message, the motion stays
+    rows.nth(1).locator(".seg-seconds").fill("30")
+    page.click("#generate-timeline")
+    page.wait_for_function(f"{STATE}.status === 'error'", timeout=TIMEOUT_MS)
+    assert "the timeline: segment 1: seconds 30 is outside" in page.text_content("#error")
+    assert page.evaluate(f"{STATE}.motion") == line["motion"]
+    rows.nth(1).locator(".seg-remove").click()
+    assert rows.count() == 1
+
+    # pin the start pose of the timeline on screen, then generate: the next motion starts in that pose
+    first_pose = page.evaluate("window.simdiffPlayer.motion.joints[0]")
+    page.check("#pin_start")
+    assert page.evaluate(f"{STATE}.pins") == {"start": line["motion"], "end": None} and page.is_visible("#pin-note")
+    page.fill("#seconds", "2")
+    page.click("#generate")
+    pinned = wait_for_new_motion(page, line["generation_id"])
+    assert pinned["frames"] == 40 and pinned["meta"]["pins"] == {"start": line["motion"], "end": None}
+    assert pinned["params"]["pin_start"] == line["motion"] and pinned["meta"]["keyframe_error_cm"] < 2.0
+    start = np.asarray(page.evaluate("window.simdiffPlayer.motion.joints[0]"))
+    assert np.linalg.norm(start - np.asarray(first_pose), axis=-1).max() < 0.02
+    assert "Pinned start pose met within" in page.text_content("#status")
+    wait_for_body(page)
+    page.click("#play")
+    page.fill("#scrub", "0")
+    page.screenshot(path=str(folder / "viewer_pins.png"))
+    page.uncheck("#pin_start")
+    assert page.evaluate(f"{STATE}.pins") == {"start": None, "end": None} and page.is_hidden("#pin-note")
+    assert problems == [], problems

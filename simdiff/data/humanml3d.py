@@ -18,7 +18,9 @@ random, is cropped to a multiple of ``unit_length`` frames (2/3: ``len//4*4``, 1
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -160,6 +162,32 @@ def build_items(root: str | Path, ids: list[str], min_frames: int = MIN_FRAMES) 
     return items
 
 
+def normalise_caption(text: str) -> str:
+    """The form in which two captions count as the same: lower case, letters and digits only, single spaces."""
+    return " ".join(re.sub(r"[^a-z0-9]+", " ", text.lower()).split())
+
+
+def split_captions(root: str | Path, split: str) -> list[str]:
+    """The distinct captions of every clip listed in ``root/<split>.txt``, in file order."""
+    root = Path(root)
+    seen: dict[str, None] = {}
+    for clip_id in read_split(split_path(root, split)):
+        path = root / "texts" / f"{clip_id}.txt"
+        if path.is_file():
+            seen.update((c.text, None) for c in read_captions(path) if c.text.strip())
+    return list(seen)
+
+
+def unseen_items(items: list[Item], seen: set[str]) -> list[Item]:
+    """``items`` with only the captions whose normalised form is not in ``seen``; items left without one dropped."""
+    out = []
+    for item in items:
+        keep = tuple(c for c in item.captions if normalise_caption(c.text) not in seen)
+        if keep:
+            out.append(dataclasses.replace(item, captions=keep))
+    return out
+
+
 def crop_length(length: int, unit_length: int, rng: np.random.Generator) -> int:
     """MDM's crop: 2/3 ``length // u * u``, 1/3 ``(length // u - 1) * u`` (for u < 10)."""
     if unit_length >= 10:
@@ -184,6 +212,8 @@ class HumanML3D(Dataset):
         seed: seeds the caption/crop generator; each DataLoader worker (and each epoch of
             non-persistent workers) derives its own stream from it and the worker's seed.
         min_frames: shortest clip kept (MDM: 40; lower for a lower-frame-rate corpus).
+        unseen_in: a split name: keep only the captions no clip of that split has (normalised,
+            :func:`normalise_caption`), and the items left with one (the held-out captions of a test split).
     """
 
     def __init__(
@@ -195,6 +225,7 @@ class HumanML3D(Dataset):
         max_frames: int = MAX_FRAMES,
         seed: int = 0,
         min_frames: int = MIN_FRAMES,
+        unseen_in: str | None = None,
     ) -> None:
         self.root = Path(root)
         if not self.root.is_dir():
@@ -213,6 +244,9 @@ class HumanML3D(Dataset):
         self.random_offset = True  # False: every crop starts at the item's first frame (twins stay aligned)
         self.seed = seed
         self.items = build_items(self.root, ids, min_frames)
+        if unseen_in is not None:
+            seen = {normalise_caption(t) for t in split_captions(self.root, unseen_in)}
+            self.items = unseen_items(self.items, seen)
         self._rng: np.random.Generator | None = None
         self._rng_key: int | None = None
 

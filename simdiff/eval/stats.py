@@ -65,3 +65,15 @@ def bootstrap_interval(units: Sequence[object], statistic: Callable[[list[object
     tail = (1.0 - confidence) / 2.0 * 100.0
     lo, hi = np.percentile(draws, [tail, 100.0 - tail])
     return est, float(lo), float(hi)
+
+
+def wilson_interval(passed: int, n: int, confidence: float = CONFIDENCE) -> tuple[float, float]:
+    """(low, high) Wilson score interval of a pass rate ``passed``/``n`` (n ≥ 1); stays inside [0, 1] and is not
+    empty at 0 or n passes, unlike the normal approximation."""
+    if n < 1 or not 0 <= passed <= n:
+        raise SimdiffError(f"a pass rate needs 0 <= passed <= n and n >= 1, got {passed}/{n}")
+    z = float(sps.norm.ppf((1.0 + confidence) / 2.0))
+    p = passed / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return float(max(0.0, centre - half)), float(min(1.0, centre + half))

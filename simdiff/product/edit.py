@@ -45,6 +45,26 @@ class EditRequest:
     keep: str | None = None
 
 
+def _continuous(generator) -> bool:
+    return generator.config.sim is not None and generator.config.sim.mode == "continuous"
+
+
+def check_replay_model(generator, folder: Path) -> None:
+    """Refuse a model (a :class:`~simdiff.inference.generator.MotionGenerator` loaded from ``folder``) without φ as
+    numbers: it cannot re-play a motion under gravity and wind."""
+    if not _continuous(generator):
+        raise SimdiffError(f"{folder} has no continuous environment input (φ as numbers); it cannot re-play a "
+                           "motion under gravity and wind")
+
+
+def gravity_readings(before: np.ndarray, after: np.ndarray) -> dict[str, dict[str, float] | None]:
+    """``{input, edited}``: the gravity read from the flights of the input and the edited joints (T, 22, 3)
+    (:func:`simdiff.motion.gravity_readout.read_gravity`; None where no flight is readable)."""
+    from simdiff.motion.gravity_readout import read_gravity
+
+    return {"input": read_gravity(before), "edited": read_gravity(after)}
+
+
 def edit_file(request: EditRequest, out_dir: Path, *, model: Path | None = None, device: str = "cpu",
               quiet: bool = False) -> tuple[list[Path], str]:
     """Run ``request`` with the default (or given) model and write the edit, a side-by-side video and ``edit.json``
@@ -70,18 +90,15 @@ def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | 
     from simdiff.fsio import check_writable, output_set
     from simdiff.inference.default import load_default, sampling_config
     from simdiff.inference.device import torch_device
-    from simdiff.motion.gravity_readout import read_gravity
     from simdiff.product.pipeline import describe_env
 
     check_writable(out_dir / "edit.json")  # a read-only folder fails now, not after sampling
     start = time.perf_counter()
     joints, env = request.joints, request.env
     generator = load_default(model, torch_device(device), load_text=bool(request.text))
-    continuous = generator.config.sim is not None and generator.config.sim.mode == "continuous"
-    if request.keep is None and not continuous:
-        raise SimdiffError(f"{folder} has no continuous environment input (φ as numbers); it cannot re-play a "
-                           "motion under gravity and wind")
-    if request.keep is not None and generator.is_simdiff and not continuous:
+    if request.keep is None:
+        check_replay_model(generator, folder)
+    elif generator.is_simdiff and not _continuous(generator):
         raise SimdiffError(f"{folder} has categorical environments; use a model with φ as numbers")
     config = sampling_config(model)
     loaded = time.perf_counter()
@@ -106,7 +123,6 @@ def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | 
         edited = keep_half(generator, joints, config, env.as_tuple() if generator.is_simdiff else None, request.keep,
                            request.text, seed=request.seed)
     sampled = time.perf_counter()
-    before, after = read_gravity(joints), read_gravity(edited.joints)
     label = describe_env(env) if request.keep is None else f"{request.keep} body kept: {request.text}"
     with output_set(out_dir, last="edit.json") as stage:  # every file appears together, or none
         written = write_motion(stage / "edited", edited.joints, edited.features, request.formats)
@@ -120,7 +136,7 @@ def _edit_into(request: EditRequest, out_dir: Path, folder: Path, model: Path | 
             "environment": {"gravity": env.gravity, "wind": [env.wind_x, env.wind_y]},
             "keep": request.keep, "text": request.text, "seed": request.seed, "sampling": config.to_dict(),
             "model": str(folder), "changed_m": round(edited.changed_m, 4),
-            "gravity_read": {"input": before, "edited": after},
+            "gravity_read": gravity_readings(joints, edited.joints),
             "files": sorted(p.name for p in paths),
             "seconds": {"load_model": round(loaded - start, 3), "sample": round(sampled - loaded, 3),
                         "write": round(time.perf_counter() - sampled, 3)},

@@ -27,6 +27,7 @@ from simdiff.product.simulate import SimulatedMotion, load_simulator, simulate_f
 from simdiff.sim.env import Environment
 
 if TYPE_CHECKING:
+    from simdiff.inference.coverage import PromptCoverage
     from simdiff.product.finisher import Finisher
 
 FEATURES_NOTE = ("(T, 263) float32 un-normalised HumanML3D features, one row per joint frame as the model "
@@ -229,9 +230,29 @@ def model_provenance(model_dir: Path) -> dict:
     return {"trained_on": [p.to_dict() for p in prov.trained_on], "weights_licence": prov.weights_licence, **extra}
 
 
+def prompt_coverage(generator, request: GenerationRequest, model_dir: Path) -> list[PromptCoverage] | None:
+    """The prompt (each timeline segment's text) against the model's training captions
+    (:mod:`simdiff.inference.coverage`); None when the model folder has no caption table."""
+    from simdiff.inference.coverage import check_prompts
+
+    texts = [seg.text for seg in request.timeline] if request.timeline is not None else [request.text]
+    return check_prompts(model_dir, texts, generator.encode_text, generator.config.text_encoder)
+
+
+def _coverage_record(coverage: list[PromptCoverage] | None) -> dict | None:
+    """``generation.json``'s ``prompt_coverage``: the threshold and each prompt's best match (None: not checked)."""
+    if coverage is None:
+        return None
+    from simdiff.inference.coverage import COVERAGE_NAME, FAR_BELOW
+
+    return {"table": COVERAGE_NAME, "far_below": FAR_BELOW, "prompts": [c.to_dict() for c in coverage]}
+
+
 def metadata(request: GenerationRequest, generator, model_dir: Path, samples: list[Sample],
-             files: list[dict[str, Path]], videos: list[Path], timer: Timer) -> dict:
-    """The ``generation.json`` record of one run (file names relative to the output folder)."""
+             files: list[dict[str, Path]], videos: list[Path], timer: Timer,
+             coverage: list[PromptCoverage] | None = None) -> dict:
+    """The ``generation.json`` record of one run (file names relative to the output folder); ``coverage``: the
+    prompts checked against the training captions (:func:`prompt_coverage`), None when not checked."""
     from simdiff.motion.foot_lock import CLEANUP_VERSION
 
     cfg = generator.config
@@ -269,6 +290,7 @@ def metadata(request: GenerationRequest, generator, model_dir: Path, samples: li
         "foot_cleanup": CLEANUP_VERSION if request.sampling.foot_lock else None,
         "keyframes": _keyframes_record(request, samples),
         "timeline": _timeline_record(request),
+        "prompt_coverage": _coverage_record(coverage),
         "features_layout": FEATURES_NOTE,
         "joints_layout": "(T, 22, 3) float32 metres, Y-up, 20 fps, HumanML3D joint order; forward kinematics of "
                          "rotations on one fixed skeleton per motion (bone lengths constant)",
@@ -373,10 +395,11 @@ def previous_outputs(out_dir: Path) -> set[str]:
 
 def run_generation(generator, request: GenerationRequest, out_dir: Path, model_dir: Path, timer: Timer,
                    quiet: bool = False, simulate: bool = False,
-                   force: bool = False, finisher: Finisher | None = None) -> tuple[dict, list[Path]]:
+                   force: bool = False, finisher: Finisher | None = None,
+                   coverage: list[PromptCoverage] | None = None) -> tuple[dict, list[Path]]:
     """Sample (and with ``simulate`` re-track under φ: in ``finisher``'s processes when given, which
-    should have been started before the model loaded), write every file and ``generation.json``;
-    returns (metadata, written paths in print order)."""
+    should have been started before the model loaded), write every file and ``generation.json`` (with
+    ``coverage``, :func:`prompt_coverage`'s answer, when given); returns (metadata, written paths in print order)."""
     warm = warm_simulator() if simulate and finisher is None else None
     failure: SimdiffError | None = None
     samples = sample_motions(generator, request, timer, quiet)
@@ -390,7 +413,7 @@ def run_generation(generator, request: GenerationRequest, out_dir: Path, model_d
     earlier = previous_outputs(out_dir)
     with output_set(out_dir, last="generation.json") as stage:  # every file appears together, or none
         files, videos = write_outputs(samples, request, stage, timer, quiet)
-        meta = metadata(request, generator, model_dir, samples, files, videos, timer)
+        meta = metadata(request, generator, model_dir, samples, files, videos, timer, coverage)
         if simulate:  # where the finish ran: its CPU seconds are the worker's (in each sample's tracking)
             meta["simulate_workers"] = finisher.workers if finisher is not None else 0
         if failure is not None:

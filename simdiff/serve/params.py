@@ -1,19 +1,22 @@
-"""Validated parameters of one generation request (the viewer's sliders and prompt box).
+"""Validated parameters of the viewer's requests: a generation (prompt box, sliders, pinned poses), a re-play of
+a motion on screen under φ, a timeline of prompts.
 
 Ranges match the ``simdiff generate`` CLI: gravity g_z ∈ [−20, −1] m/s², |wind| ≤ 10 N,
-adapter strength α ∈ [0, 2], length 0.5 .. 9.8 s at 20 fps.
+adapter strength α ∈ [0, 2], length 0.5 .. 9.8 s at 20 fps; a timeline's segments are checked by
+:func:`simdiff.product.request.parse_timeline`, as ``generate --timeline``'s.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from simdiff.errors import SimdiffError
+from simdiff.inference.timeline import Segment
 from simdiff.motion.skeleton import FPS, MAX_FRAMES, MIN_GENERATE_FRAMES
-from simdiff.product.request import MAX_PROMPT_CHARS, check_text
+from simdiff.product.request import MAX_PROMPT_CHARS, check_text, parse_timeline
 from simdiff.sim.env import EARTH_GRAVITY, GRAVITY_RANGE, MAX_WIND
 
 ALPHA_RANGE: tuple[float, float] = (0.0, 2.0)
@@ -31,6 +34,11 @@ ENV_GUIDANCE_RANGE: tuple[float, float] = (0.0, 10.0)
 """Environment guidance s_e bounds (1 = off)."""
 MAX_TEXT: int = MAX_PROMPT_CHARS
 """Longest prompt in characters (the same limit as ``simdiff generate``)."""
+MAX_REPLAY_FRAMES: int = 60 * FPS
+"""Longest motion ``POST /api/edit`` re-plays (60 s: 8 network windows, about 8 default generations);
+``simdiff edit`` takes longer ones."""
+MAX_TIMELINE_SEGMENTS: int = 8
+"""Most segments of one ``POST /api/timeline`` (one sample each); ``generate --timeline`` takes more."""
 
 
 SAMPLING_FIELDS: tuple[str, ...] = ("steps", "eta", "guidance", "alpha", "env_guidance", "edit_t", "foot_lock")
@@ -52,6 +60,8 @@ class GenerateParams:
         steps, eta, guidance, alpha, env_guidance, edit_t, foot_lock: the
             :class:`~simdiff.diffusion.config.SamplingConfig` fields, or None for the model's ``sampling.json``
             value, as ``simdiff generate``.
+        pin_start, pin_end: None, or the number of a motion shown (an answer's ``motion``) whose first (last)
+            pose the motion must start (end) in: keyframes of the motion's length, NaN but for that frame.
     """
 
     text: str
@@ -68,6 +78,8 @@ class GenerateParams:
     env_guidance: float | None = None
     edit_t: int | None = None
     foot_lock: float | None = None
+    pin_start: int | None = None
+    pin_end: int | None = None
 
     def sampling(self) -> dict[str, Any]:
         """The sampling fields this request sets (the others are the model's)."""
@@ -88,7 +100,8 @@ def limits() -> dict[str, Any]:
     return {
         "gravity": list(GRAVITY_RANGE), "wind": MAX_WIND, "alpha": list(ALPHA_RANGE), "seconds": MAX_SECONDS,
         "min_seconds": MIN_SECONDS, "fps": FPS, "steps": MAX_STEPS, "guidance": list(GUIDANCE_RANGE), "text": MAX_TEXT,
-        "env_guidance": list(ENV_GUIDANCE_RANGE), "edit_t": [0, 999],
+        "env_guidance": list(ENV_GUIDANCE_RANGE), "edit_t": [0, 999], "replay_seconds": MAX_REPLAY_FRAMES / FPS,
+        "timeline_segments": MAX_TIMELINE_SEGMENTS,
     }
 
 
@@ -128,45 +141,53 @@ def _check_range(key: str, value: float, low: float, high: float, unit: str = ""
         raise SimdiffError(f"{key} must be in [{low:g}, {high:g}]{unit}, got {shown}")
 
 
-def parse_generate(body: Any) -> GenerateParams:
-    """Validate a ``POST /api/generate`` JSON body.
-
-    Args:
-        body: the decoded JSON object ``{text, gravity, wind_x, wind_y, seconds, seed, simulate, steps, eta,
-            guidance, alpha, env_guidance, edit_t, foot_lock}``; everything but ``text`` is optional.
-    Raises:
-        SimdiffError: one line naming the bad field and value.
-    """
+def check_fields(body: Any, known: set[str]) -> dict[str, Any]:
+    """``body`` if it is a JSON object with no field outside ``known``; else a one-line error."""
     if not isinstance(body, dict):
         raise SimdiffError(f"request body must be a JSON object, got {type(body).__name__}")
-    known = set(GenerateParams.__dataclass_fields__)
     unknown = sorted(set(body) - known)
     if unknown:
         raise SimdiffError(f"unknown field {_show(unknown[0])} (known: {', '.join(sorted(known))})")
-    text = body.get("text")
-    if not isinstance(text, str) or not text.strip():
-        raise SimdiffError(f"text must be a non-empty prompt, got {_show(text)}")
-    if not text.isascii():
+    return body
+
+
+def parse_text(value: Any, key: str = "text") -> str:
+    """A prompt: a non-empty string of valid Unicode, white space collapsed (:func:`check_text`)."""
+    if not isinstance(value, str) or not value.strip():
+        raise SimdiffError(f"{key} must be a non-empty prompt, got {_show(value)}")
+    _check_unicode(value, key)
+    return check_text(value)
+
+
+def _check_unicode(value: str, key: str) -> None:
+    """JSON's ``\\ud800`` decodes to a lone surrogate, which no encoder takes: refuse it here."""
+    if not value.isascii():
         try:
-            text.encode("utf-8")
+            value.encode("utf-8")
         except UnicodeEncodeError:
-            raise SimdiffError("text must be valid Unicode (it holds a lone surrogate escape)") from None
-    text = check_text(text)
-    defaults = GenerateParams(text=text)
-    gravity = _number(body, "gravity", defaults.gravity)
-    _check_range("gravity", gravity, *GRAVITY_RANGE, " m/s²")
-    wind = {}
+            raise SimdiffError(f"{key} must be valid Unicode (it holds a lone surrogate escape)") from None
+
+
+def parse_env(body: Mapping[str, Any]) -> dict[str, float]:
+    """``{gravity, wind_x, wind_y}`` (m/s², N, N; default Earth without wind) within the sliders' ranges."""
+    env = {"gravity": _number(body, "gravity", EARTH_GRAVITY)}
+    _check_range("gravity", env["gravity"], *GRAVITY_RANGE, " m/s²")
     for key in ("wind_x", "wind_y"):
-        wind[key] = _number(body, key, 0.0)
-        _check_range(key, wind[key], -MAX_WIND, MAX_WIND, " N")
-    seconds = _number(body, "seconds", defaults.seconds)
-    _check_range("seconds", seconds, MIN_SECONDS, MAX_SECONDS)
+        env[key] = _number(body, key, 0.0)
+        _check_range(key, env[key], -MAX_WIND, MAX_WIND, " N")
+    return env
+
+
+def parse_seed(body: Mapping[str, Any]) -> int:
+    """The noise seed, 0 ≤ seed < 2**63 (default 0)."""
     seed = _integer(body, "seed", 0)
     if seed is None or not 0 <= seed < 2**63:
         raise SimdiffError(f"seed must be a non-negative integer below 2**63, got {_show(seed)}")
-    simulate = body.get("simulate", False)
-    if not isinstance(simulate, bool):
-        raise SimdiffError(f"simulate must be true or false, got {_show(simulate)}")
+    return seed
+
+
+def parse_sampling(body: Mapping[str, Any]) -> dict[str, Any]:
+    """The :data:`SAMPLING_FIELDS` a request gives (None: the model's), each within its range."""
     sampling: dict[str, Any] = {}
     for key, (low, high) in {"steps": (1, MAX_STEPS), "edit_t": (0, 999)}.items():
         value = _integer(body, key, None)
@@ -178,5 +199,107 @@ def parse_generate(body: Any) -> GenerateParams:
         if body.get(key) is not None:
             sampling[key] = _number(body, key, 0.0)
             _check_range(key, sampling[key], low, high)
-    return GenerateParams(text=text, gravity=gravity, seconds=seconds, seed=seed, simulate=simulate, **wind,
-                          **sampling)
+    return sampling
+
+
+def parse_motion(body: Mapping[str, Any], key: str) -> int | None:
+    """A reference to a motion shown: the whole number ``motion`` of an earlier answer (None when not given)."""
+    value = body.get(key)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value < 2**31:
+        raise SimdiffError(f"{key} must be the number of a motion shown (an answer's \"motion\"), got {_show(value)}")
+    return value
+
+
+def parse_generate(body: Any) -> GenerateParams:
+    """Validate a ``POST /api/generate`` JSON body.
+
+    Args:
+        body: the decoded JSON object ``{text, gravity, wind_x, wind_y, seconds, seed, simulate, steps, eta,
+            guidance, alpha, env_guidance, edit_t, foot_lock, pin_start, pin_end}``; everything but ``text`` is
+            optional.
+    Raises:
+        SimdiffError: one line naming the bad field and value.
+    """
+    check_fields(body, set(GenerateParams.__dataclass_fields__))
+    text = parse_text(body.get("text"))
+    env = parse_env(body)
+    seconds = _number(body, "seconds", GenerateParams.seconds)
+    _check_range("seconds", seconds, MIN_SECONDS, MAX_SECONDS)
+    simulate = body.get("simulate", False)
+    if not isinstance(simulate, bool):
+        raise SimdiffError(f"simulate must be true or false, got {_show(simulate)}")
+    return GenerateParams(text=text, seconds=seconds, seed=parse_seed(body), simulate=simulate, **env,
+                          **parse_sampling(body), pin_start=parse_motion(body, "pin_start"),
+                          pin_end=parse_motion(body, "pin_end"))
+
+
+@dataclass(frozen=True)
+class ReplayParams:
+    """One ``POST /api/edit``: the motion ``source`` (an answer's ``motion`` number) re-played under φ.
+
+    Attributes:
+        source: the motion's number.
+        gravity, wind_x, wind_y: φ in m/s², N, N.
+        seed: noise seed (window k of a long motion uses seed + k).
+        text: what the motion shows (optional; empty: no text guidance), as ``simdiff edit --text``.
+        settings: the sampling fields the request gives (:func:`parse_sampling`).
+    """
+
+    source: int
+    gravity: float = EARTH_GRAVITY
+    wind_x: float = 0.0
+    wind_y: float = 0.0
+    seed: int = 0
+    text: str = ""
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def sampling(self) -> dict[str, Any]:
+        """The sampling fields this request sets (the others are the model's)."""
+        return {k: v for k, v in self.settings.items() if v is not None}
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain JSON-able values (the sampling fields given at the top level)."""
+        return {"source": self.source, "gravity": self.gravity, "wind_x": self.wind_x, "wind_y": self.wind_y,
+                "seed": self.seed, "text": self.text, **self.sampling()}
+
+
+def parse_replay(body: Any) -> ReplayParams:
+    """Validate a ``POST /api/edit`` body ``{source, gravity, wind_x, wind_y, seed, text, steps, eta, guidance,
+    alpha, env_guidance, edit_t, foot_lock}`` (all but ``source`` optional); one line naming the bad value."""
+    check_fields(body, {"source", "gravity", "wind_x", "wind_y", "seed", "text", *SAMPLING_FIELDS})
+    source = parse_motion(body, "source")
+    if source is None:
+        raise SimdiffError("source must be the number of a motion shown (an answer's \"motion\"), got nothing")
+    text = "" if body.get("text") in (None, "") else parse_text(body["text"])
+    return ReplayParams(source, **parse_env(body), seed=parse_seed(body), text=text, settings=parse_sampling(body))
+
+
+@dataclass(frozen=True)
+class TimelineParams:
+    """One ``POST /api/timeline``: segments (:class:`~simdiff.inference.timeline.Segment`), seed, sampling fields."""
+
+    segments: tuple[Segment, ...]
+    seed: int = 0
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def sampling(self) -> dict[str, Any]:
+        """The sampling fields this request sets (the others are the model's)."""
+        return {k: v for k, v in self.settings.items() if v is not None}
+
+
+def parse_timeline_request(body: Any) -> TimelineParams:
+    """Validate a ``POST /api/timeline`` body ``{segments: [{text, seconds, gravity?, wind?: [x, y]}, ...], seed,
+    steps, eta, guidance, alpha, env_guidance, edit_t, foot_lock}``: the segments as ``generate --timeline``
+    checks a file's (:func:`~simdiff.product.request.parse_timeline`, the same one-line messages), at most
+    :data:`MAX_TIMELINE_SEGMENTS` of them."""
+    check_fields(body, {"segments", "seed", *SAMPLING_FIELDS})
+    segments = body.get("segments")
+    if isinstance(segments, list) and len(segments) > MAX_TIMELINE_SEGMENTS:
+        raise SimdiffError(f"the timeline has {len(segments)} segments; the viewer takes at most "
+                           f"{MAX_TIMELINE_SEGMENTS} (simdiff generate --timeline takes more)")
+    for i, segment in enumerate(segments if isinstance(segments, list) else []):
+        if isinstance(segment, dict) and isinstance(segment.get("text"), str):
+            _check_unicode(segment["text"], f"the timeline: segment {i}: text")
+    return TimelineParams(parse_timeline(segments), parse_seed(body), parse_sampling(body))

@@ -5,26 +5,30 @@ Routes:
     ``GET /api/info``: model status, listed files, slider ranges and limits, skeleton.
     ``POST /api/generate`` (``application/json``): ``{text, gravity, wind_x, wind_y, seconds, seed, simulate}`` and
     optionally the sampling settings ``steps, eta, guidance, alpha, env_guidance, edit_t, foot_lock`` (left out:
-    the model's ``sampling.json`` values, as ``simdiff generate``)
-    → ``{joints, fps, parents, meta, body}``.
+    the model's ``sampling.json`` values, as ``simdiff generate``) and ``pin_start``, ``pin_end``: a motion's number
+    whose first (last) pose it starts (ends) in (``meta.keyframe_error_cm``) → ``{joints, fps, parents, meta, motion, body}``.
+    ``POST /api/edit`` (JSON): ``{source, gravity, wind_x, wind_y, seed}``: motion ``source`` re-played under φ as
+    ``simdiff edit`` → same; ``POST /api/timeline`` (JSON): ``{segments: [{text, seconds, gravity?, wind?: [x, y]}],
+    seed}``, checked as a ``generate --timeline`` file → its one motion, same (both also take the sampling settings).
     ``POST /api/open?name=FILE`` (``application/octet-stream``, the file's bytes) → same.
     ``GET /api/files/<i>``: the i-th file named on the command line → same.
     ``GET /api/body/<n>.glb`` (``body`` of an answer): that motion's skinned body, a ``model/gltf-binary`` file.
-    ``HEAD`` answers like ``GET`` without the body.
+    ``HEAD`` answers like ``GET`` without the body. An answer's ``motion`` numbers it; the last few motions' joints
+    stay on the server, so ``source`` and the pins name a motion shown without sending it (:mod:`simdiff.serve.edits`).
 
-Every error is one JSON line ``{"error": "..."}``, never an HTML page, a traceback or a temporary path:
-400 bad input (malformed, non-object, too deeply nested or non-UTF-8 JSON; ``NaN``, ``Infinity``,
-out-of-range numbers or wrong types in any field; unknown fields; a bad upload name or file, file index,
-``Content-Length``, ``Host`` or request line); 403 a foreign ``Host`` (DNS rebinding) or ``Origin``
-(cross-site POST); 404 no such page, file or endpoint; 405 a method other than GET, HEAD and POST (with
-``Allow: GET, HEAD, POST``); 408 the request did not arrive within its deadline, or was closed to make room for
-another; 411 a POST without ``Content-Length`` (chunked transfer encoding is not accepted); 413 a body over its
-limit (answered before it is read) or a motion over ``MAX_OPEN_FRAMES`` frames; 414 a request line over
-:data:`MAX_REQUEST_LINE`; 415 the wrong ``Content-Type``; 422 the sampler produced non-finite values with
-these settings; 429 the generation queue is full (with ``queue``: requests ahead, ``limit``, and
-``Retry-After``); 431 request line and headers over :data:`MAX_HEAD_BYTES` or over 100 header lines; 500 a
-bug in the server (the answer names the exception type, the log gets one line); 503 no model, or every
-connection slot is serving a request, or other uploads are being read (with ``Retry-After``); 505 an HTTP version other than 1.x.
+Every error is one JSON line ``{"error": "..."}``, never an HTML page, a traceback or a temporary path: 400 bad input
+(malformed, non-object, too deeply nested or non-UTF-8 JSON; ``NaN``, ``Infinity``, out-of-range numbers or wrong
+types in any field; unknown fields; a bad upload name or file, file index, motion number, timeline, pinned pose,
+``Content-Length``, ``Host`` or request line); 403 a foreign ``Host`` (DNS rebinding) or ``Origin`` (cross-site POST);
+404 no such page, file or endpoint; 405 a method other than GET, HEAD and POST (with ``Allow: GET, HEAD, POST``); 408
+the request did not arrive within its deadline, or was closed to make room for another; 411 a POST without
+``Content-Length`` (chunked transfer encoding is not accepted); 413 a body over its limit (answered before it is read)
+or a motion over ``MAX_OPEN_FRAMES`` frames; 414 a request line over :data:`MAX_REQUEST_LINE`; 415 the wrong
+``Content-Type``; 422 the sampler produced non-finite values with these settings; 429 the generation queue is full
+(with ``queue``: requests ahead, ``limit``, and ``Retry-After``); 431 request line and headers over
+:data:`MAX_HEAD_BYTES` or over 100 header lines; 500 a bug in the server (the answer names the exception type, the log
+gets one line); 503 no model, or every connection slot is serving a request, or other uploads are being read (with
+``Retry-After``); 505 an HTTP version other than 1.x.
 
 Limits (module constants, read when a server is built, so tests can set them small):
 
@@ -37,9 +41,10 @@ Limits (module constants, read when a server is built, so tests can set them sma
   for a JSON body, :data:`MAX_UPLOAD_BYTES` for an upload (copied to a temporary file as it arrives, then read
   by at most :data:`~simdiff.serve.service.UPLOADS_AT_ONCE` readers at a time), and an opened motion of at most
   :data:`~simdiff.serve.service.MAX_OPEN_FRAMES` frames (10 minutes: an answer of at most about 6 MB, its body about 5 MB).
-* Generation requests wait in a bounded queue (:class:`~simdiff.serve.service.MotionService`), ask for at most
-  :data:`~simdiff.serve.params.MAX_STEPS` sampler steps, and are dropped, waiting or at the next sampler step,
-  when their client closes its connection.
+* Generations, re-plays and timelines wait in one bounded queue (:class:`~simdiff.serve.service.MotionService`), ask
+  for at most :data:`~simdiff.serve.params.MAX_STEPS` sampler steps, :data:`~simdiff.serve.params.MAX_REPLAY_FRAMES`
+  frames re-played, :data:`~simdiff.serve.params.MAX_TIMELINE_SEGMENTS` timeline segments, and are dropped, waiting
+  or at the next sampler step, when their client closes its connection.
 
 Requests from other sites are refused: the ``Host`` header must name this server (against DNS
 rebinding) and POSTs need a JSON/octet-stream content type plus a same-origin ``Origin``.
@@ -68,7 +73,7 @@ from simdiff.serve.connections import (
     linger,
     peer_closed,
 )
-from simdiff.serve.params import parse_generate
+from simdiff.serve.edits import POSTS
 from simdiff.serve.service import (
     MAX_OPEN_FRAMES,
     GenerationCancelled,
@@ -107,7 +112,7 @@ MAX_REQUEST_LINE: int = 8 * 1024
 MAX_HEAD_BYTES: int = 32 * 1024
 """Longest request line plus headers in bytes; longer: 431."""
 MAX_JSON_BYTES: int = 64 * 1024
-"""Largest ``POST /api/generate`` body; larger: 413."""
+"""Largest JSON body (``/api/generate``, ``/api/edit``, ``/api/timeline``); larger: 413."""
 MAX_UPLOAD_BYTES: int = 32 * 1024 * 1024
 """Largest ``POST /api/open`` upload (a 10-minute motion is 3 MB of float32 joints, 13 MB of features, a few
 MB to tens of MB of BVH text); larger: 413 before the body is read."""
@@ -205,11 +210,10 @@ class ViewerHandler(BaseHTTPRequestHandler):
     def do_GET(self) -> None:
         self._dispatch(self._get)
 
+    do_HEAD = do_GET
+
     def do_POST(self) -> None:
         self._dispatch(self._post)
-
-    def do_HEAD(self) -> None:
-        self._dispatch(self._get)
 
     def _get(self, path: str, query: dict[str, list[str]]) -> None:
         self._request_complete()
@@ -238,12 +242,11 @@ class ViewerHandler(BaseHTTPRequestHandler):
     def _post(self, path: str, query: dict[str, list[str]]) -> None:
         self._check_origin()
         service = self.server.service
-        if path == "/api/generate":
+        if path in POSTS:  # generate, edit, timeline
             request = parse_json(self._body("application/json", MAX_JSON_BYTES))
-            self._log_api(f"generate {request!r}"[:200])
-            params = parse_generate(request)
+            self._log_api(f"{path[5:]} {request!r}"[:200])
             connection = self.connection
-            self._json(service.generate(params, cancelled=lambda: peer_closed(connection)))
+            self._json(POSTS[path](service, request, lambda: peer_closed(connection)))
         elif path == "/api/open":
             names = query.get("name") or [""]
             if len(names) > 1:
@@ -271,7 +274,7 @@ class ViewerHandler(BaseHTTPRequestHandler):
             self._error(exc.status, str(exc))
         except QueueFull as exc:
             self._error(HTTPStatus.TOO_MANY_REQUESTS, str(exc), {"queue": exc.waiting, "limit": exc.limit})
-        except ModelUnavailable as exc:
+        except (ModelUnavailable, UploadsBusy) as exc:
             self._error(HTTPStatus.SERVICE_UNAVAILABLE, str(exc))
         except GenerationCancelled as exc:
             self.close_connection = True
@@ -280,8 +283,6 @@ class ViewerHandler(BaseHTTPRequestHandler):
             self._error(HTTPStatus.UNPROCESSABLE_ENTITY, str(exc))
         except MotionTooLong as exc:
             self._error(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, str(exc))
-        except UploadsBusy as exc:
-            self._error(HTTPStatus.SERVICE_UNAVAILABLE, str(exc))
         except SimdiffError as exc:
             self._error(HTTPStatus.BAD_REQUEST, str(exc))
         except TimeoutError:

@@ -12,6 +12,7 @@ import tempfile
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,8 +21,14 @@ import numpy as np
 
 from simdiff import __version__
 from simdiff.diffusion.config import SamplingConfig
-from simdiff.errors import NonFiniteResult, SimdiffError
+from simdiff.errors import SimdiffError
 from simdiff.motion.skeleton import FPS
+from simdiff.serve.edits import (
+    check_finite,
+    pin_report,
+    pinned_keyframes,
+    sample_generation,
+)
 from simdiff.serve.params import GenerateParams, limits
 from simdiff.serve.payload import motion_payload, skeleton_info
 from simdiff.serve.wire import BodyCache
@@ -45,7 +52,8 @@ UPLOADS_AT_ONCE: int = 2
 MAX_NAME_BYTES: int = 255
 """Longest upload file name in UTF-8 bytes (a file system's limit)."""
 MAX_BODIES: int = 4
-"""Motions whose skinned body ``GET /api/body/<n>.glb`` still answers (see :class:`~simdiff.serve.wire.BodyCache`)."""
+"""Motions whose skinned body (``GET /api/body/<n>.glb``) and joints (a ``source`` or pin) the server keeps
+(see :class:`~simdiff.serve.wire.BodyCache`)."""
 
 
 class ModelUnavailable(SimdiffError):
@@ -227,7 +235,8 @@ class MotionService:
         """``POST /api/generate``: one motion from the prompt and φ; requests run one at a time.
 
         At most ``max_queue`` requests wait behind the running one; the answer's ``meta`` gives the
-        request's ``queue_position`` (requests ahead when it arrived) and ``waited_s``.
+        request's ``queue_position`` (requests ahead when it arrived) and ``waited_s``. Pinned poses
+        (``pin_start``, ``pin_end``) make it a keyframed sample (:func:`~simdiff.serve.edits.pinned_keyframes`).
 
         Args:
             params: the validated request.
@@ -238,21 +247,51 @@ class MotionService:
             ModelUnavailable: no loadable model.
             GenerationCancelled: ``cancelled()`` turned True.
             NonFiniteResult: the sampler produced NaN or infinite values.
-            SimdiffError: the model rejected the request.
+            SimdiffError: the model rejected the request, or a pin names no motion kept or a pose out of reach.
+        """
+        keys = pinned_keyframes(self.motion, params)  # refused before it queues
+        with self.queued(cancelled) as (position, queued):
+            return self._generate_admitted(params, keys, position, queued)
+
+    @contextmanager
+    def queued(self, cancelled: Callable[[], bool] | None) -> Iterator[tuple[int, float]]:
+        """A place in the generation queue for one request's whole run: (requests ahead, ``perf_counter`` when
+        it queued); ``cancelled`` is what :meth:`turn` and :meth:`checked_steps` poll meanwhile.
+
+        Raises:
+            QueueFull: ``max_queue`` requests are already waiting.
         """
         with self._admit:
             if self._pending > self.max_queue:
                 raise QueueFull(self._pending, self.max_queue)
             position = self._pending  # requests ahead of this one
             self._pending += 1
-        queued = time.perf_counter()
         self._request.cancelled = cancelled
         try:
-            return self._generate_admitted(params, position, queued)
+            yield position, time.perf_counter()
         finally:
             self._request.cancelled = None
             with self._admit:
                 self._pending -= 1
+
+    @contextmanager
+    def turn(self) -> Iterator[Any]:
+        """The model, held by this request alone (waiting for the running one, cancellable; loaded on first use).
+
+        Raises:
+            GenerationCancelled: the client went away while waiting.
+            ModelUnavailable: no loadable model.
+        """
+        self._wait_turn()
+        try:
+            yield self._load_locked()
+        finally:
+            self._lock.release()
+
+    def next_id(self) -> int:
+        """The next motion's ``meta.id`` (the model's motions so far; call during :meth:`turn`)."""
+        self._count += 1
+        return self._count
 
     def queue_status(self) -> dict[str, int]:
         """``{pending, limit}``: generation requests running or waiting, and how many may wait."""
@@ -273,43 +312,30 @@ class MotionService:
             self._lock.release()
             raise
 
-    def _steps(self, steps: Iterable[Any]) -> Iterator[Any]:
+    def checked_steps(self, steps: Iterable[Any]) -> Iterator[Any]:
         """The sampler's timesteps through ``progress``, checking for cancellation before each step."""
         for step in self._progress(steps) if self._progress is not None else steps:
             self._check_cancelled("during sampling")
             yield step
 
-    def _generate_admitted(self, params: GenerateParams, position: int, queued: float) -> dict[str, Any]:
-        from simdiff.motion.rigid import joints_from_features
-
-        self._wait_turn()
-        try:
-            generator = self._load_locked()
-            uses_env = generator.is_simdiff
-            start = time.perf_counter()
-            waited = start - queued
-            config = self.sampling(params)
-            try:
-                out = generator.generate([params.text], params.frames, config,
-                                         env=(params.gravity, params.wind_x, params.wind_y) if uses_env else None,
-                                         seed=params.seed, progress=self._steps)
-            except GenerationCancelled:
-                raise
-            elapsed = time.perf_counter() - start
-            self._count += 1
-            number = self._count
-        finally:
-            self._lock.release()
-        features = out.clips()[0].detach().cpu().numpy().astype(np.float32)
-        _check_finite(features)
-        joints = joints_from_features(features, config.foot_lock)  # the joints every command writes
-        _check_finite(joints)
+    def _generate_admitted(self, params: GenerateParams, keys: np.ndarray | None, position: int,
+                           queued: float) -> dict[str, Any]:
+        from simdiff.inference.coverage import prompt_warnings
         from simdiff.product.pipeline import floor_contact
 
+        with self.turn() as generator:
+            uses_env = generator.is_simdiff
+            start = time.perf_counter()
+            config = self.sampling(params)
+            env = (params.gravity, params.wind_x, params.wind_y) if uses_env else None
+            joints = sample_generation(generator, params, keys, config, env, self.checked_steps)
+            elapsed, number = time.perf_counter() - start, self.next_id()
+            warnings = prompt_warnings(self.model_dir, [params.text], generator)
         meta = {"source": "generate", "id": number, "params": params.as_dict(), "model": str(self.model_dir),
+                "warnings": warnings,
                 "kind": self._kind(generator.config), "env_used": uses_env, "sampling": config.to_dict(),
                 "elapsed_s": round(elapsed, 3), **floor_contact(joints),
-                "queue_position": position, "waited_s": round(waited, 3)}
+                "queue_position": position, "waited_s": round(start - queued, 3), **pin_report(params, keys, joints)}
         if params.simulate:
             from simdiff.product.pipeline import normalizer_of
             from simdiff.product.simulate import simulate_finish
@@ -319,18 +345,32 @@ class MotionService:
             self._check_cancelled("before the simulation")
             env = Environment(params.gravity, params.wind_x, params.wind_y) if uses_env else None
             sim = simulate_finish(np.asarray(joints), env, normalizer=normalizer_of(generator))
-            _check_finite(sim.joints)
+            check_finite(sim.joints)
             meta["simulated"] = sim.tracking
             meta["generated_joints"] = np.round(np.asarray(joints, dtype=np.float64), DECIMALS).tolist()
             meta["elapsed_s"] = round(time.perf_counter() - start, 3)
-            return self._answer(sim.joints, meta)
-        return self._answer(joints, meta)
+            return self.answer(sim.joints, meta)
+        return self.answer(joints, meta)
 
-    def _answer(self, joints: np.ndarray, meta: dict[str, Any]) -> dict[str, Any]:
-        """:func:`motion_payload` plus ``body``: where the page gets the motion's skinned body (:meth:`body`)."""
+    def answer(self, joints: np.ndarray, meta: dict[str, Any]) -> dict[str, Any]:
+        """:func:`motion_payload` plus ``motion`` (its number, for requests that name it as a source) and ``body``:
+        where the page gets the motion's skinned body (:meth:`body`)."""
         payload = motion_payload(joints, meta)
-        payload["body"] = f"/api/body/{self.bodies.add(np.asarray(payload['joints']))}.glb"
+        payload["motion"] = self.bodies.add(np.asarray(payload["joints"]))
+        payload["body"] = f"/api/body/{payload['motion']}.glb"
         return payload
+
+    def motion(self, number: int, key: str = "source") -> np.ndarray:
+        """(T, 22, 3) joints of the answer numbered ``number`` as sent (a request's ``key`` names it).
+
+        Raises:
+            SimdiffError: it is not among the last :data:`MAX_BODIES` motions (each use keeps it there).
+        """
+        joints = self.bodies.joints(number)
+        if joints is None:
+            raise SimdiffError(f"{key} {number}: no such motion here (the server keeps the last {MAX_BODIES} "
+                               "motions shown); open or generate it again")
+        return joints.copy()  # the kept joints stay as sent
 
     def body(self, number: int) -> bytes | None:
         """``GET /api/body/<number>.glb``: the skinned body of an answer, built from its joints as sent; None when
@@ -348,7 +388,7 @@ class MotionService:
             raise SimdiffError(f"no listed file {index} (there are {len(self.files)})")
         item = self.files[index]
         _check_frames(item.name, int(item.joints.shape[0]))
-        return self._answer(item.joints, {"source": "file", "name": item.name, "path": str(item.path)})
+        return self.answer(item.joints, {"source": "file", "name": item.name, "path": str(item.path)})
 
     @staticmethod
     def upload_name(name: str) -> str:
@@ -425,13 +465,7 @@ class MotionService:
         finally:
             self._uploads.release()
         _check_frames(name, int(joints.shape[0]))
-        return self._answer(joints, {"source": "upload", "name": name, "bytes": size})
-
-
-def _check_finite(values: Any) -> None:
-    if not np.all(np.isfinite(np.asarray(values))):
-        raise NonFiniteResult("the sampler produced non-finite values with these settings; try other settings "
-                              "(fewer steps, lower guidance) or another seed")
+        return self.answer(joints, {"source": "upload", "name": name, "bytes": size})
 
 
 def _check_frames(name: str, frames: int | None) -> None:

@@ -56,8 +56,9 @@ def numbered(path: str, prefix: str, suffix: str, what: str, hint: str = "") -> 
 class BodyCache:
     """The joints of the last ``size`` motions sent to the page, by number, and their skinned bodies as ``.glb``
     bytes: built on first request by :func:`~simdiff.motion.rigid.fit` on the motion's own skeleton from the
-    joints exactly as sent (so that body and stick figure agree), then kept. Memory is bounded by ``size``
-    motions; one body is built at a time."""
+    joints exactly as sent (so that body and stick figure agree), then kept. The joints stay too: a request may
+    name the motion as its source (:meth:`joints`), which also keeps it among the last ``size``. Memory is
+    bounded by ``size`` motions; one body is built at a time."""
 
     def __init__(self, size: int) -> None:
         self.size = size
@@ -75,6 +76,16 @@ class BodyCache:
                 self._items.popitem(last=False)
             return self._count
 
+    def joints(self, number: int) -> np.ndarray | None:
+        """The (T, 22, 3) joints of motion ``number`` as sent (None when unknown or no longer kept); it becomes the
+        most recently used, the last to be dropped."""
+        with self._lock:
+            item = self._items.get(number)
+            if item is None:
+                return None
+            self._items.move_to_end(number)
+            return item[0]
+
     def glb(self, number: int) -> bytes | None:
         """The body of motion ``number``; None when it is unknown or no longer kept."""
         from simdiff.motion.io.gltf_writer import glb_bytes
@@ -88,7 +99,6 @@ class BodyCache:
                 return None
             if item[1] is None:
                 item[1] = glb_bytes(fit(item[0], None), FPS)
-                item[0] = None  # the body is all that is asked for from now on
             return item[1]
 
 

@@ -26,18 +26,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     t.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     t.set_defaults(func=run_train)
     r = group.add_parser("run", help="run one experiment config (configs/eval_*.json) into reports/<name>/",
-                         description="Measure table1, table2, fig4, fig5, retrack, env_response, contacts or editing from a JSON config into "
+                         description="Measure table1, table2, fig4, fig5, retrack, env_response, contacts, editing, following or heldout from a JSON config into "
                                      "<out-dir>/<name>/ (report.md, report.json, figures). Finished rows are cached, so an "
                                      "interrupted run resumes; a row whose settings changed is measured again.")
     r.add_argument("config", type=Path, help="experiment config (configs/eval_<kind>.json)")
     _common(r)
     r.set_defaults(func=run_experiment)
-    a = group.add_parser("all", help="run table2, table1, fig4, fig5, retrack, env_response, contacts and editing in sequence",
-                         description="Run the seven experiments in order (table2 first: table1 takes its best α and reuses "
+    a = group.add_parser("all", help="run table2, table1, fig4, fig5, retrack, env_response, contacts, editing, following and heldout in sequence",
+                         description="Run every experiment in order (table2 first: table1 takes its best α and reuses "
                                      "its rows) from <configs>/eval_<kind>.json. --budget quick is the ~30-minute CPU "
                                      "preset each config defines; full is the configs as written.")
     a.add_argument("--configs", type=Path, default=Path("configs"), help="folder with eval_<kind>.json (default configs)")
-    a.add_argument("--only", nargs="+", metavar="KIND", help="run only these experiments (table1 table2 fig4 fig5 retrack env_response contacts editing)")
+    a.add_argument("--only", nargs="+", metavar="KIND", help="run only these experiments (table1 table2 fig4 fig5 retrack env_response contacts editing following heldout)")
     _common(a)
     a.set_defaults(func=run_all)
 

@@ -18,7 +18,10 @@ from simdiff.product.request import MAX_SAMPLES
 from simdiff.sim.env import MAX_FORCED_WIND, MAX_GRAVITY, MIN_FORCED_GRAVITY
 
 if TYPE_CHECKING:
+    from simdiff.inference.coverage import PromptCoverage
+    from simdiff.inference.generator import MotionGenerator
     from simdiff.product.finisher import Finisher
+    from simdiff.product.pipeline import Timer
     from simdiff.product.request import GenerationRequest
 
 EPILOG = """\
@@ -28,7 +31,7 @@ outputs (in --out, default ./out/<prompt>/), per sample K = 0, 1, ...:
   sampleK.bvh            BVH animation (metres, Y-up, 20 fps; Blender: scale 1)
   sampleK.gif            stick-figure animation (.mp4 with --format npy,bvh,mp4)
   generation.json        prompt, environment, seed, sampler, steps, guidance, alpha, foot lock, env guidance,
-                         model, timings
+                         model, the prompt's best match among the training captions, timings
 with --simulate, also (the final sample re-tracked in the simulator under the same φ):
   sampleK_simulated_joints.npy  (T', 22, 3) the simulator's motion (T' = T unless it fell or a flight
                                 lasted longer/shorter under φ); sampleK_simulated.bvh with bvh
@@ -48,6 +51,9 @@ examples:
 --keyframes: frame 0 starts where the keyframes put the root and faces where their hips and shoulders face (at the
 origin facing +Z when not given); whole poses and root entries are met within 2 cm, joints given alone as far as the
 skeleton allows (a warning says when one is off by more).
+
+a prompt (or timeline segment) far from every caption the model trained on gets a warning naming the nearest ones:
+the model has probably not learned that motion (the model folder's captions.safetensors; `simdiff train coverage`).
 """
 
 
@@ -136,6 +142,24 @@ def _note(args: argparse.Namespace, message: str) -> None:
     """A one-line note on stderr (hidden by --quiet)."""
     if not args.quiet:
         print(f"simdiff: {message}", file=sys.stderr)
+
+
+def _check_prompts(args: argparse.Namespace, generator: MotionGenerator, request: GenerationRequest, folder: Path,
+                   timer: Timer) -> list[PromptCoverage] | None:
+    """Warn (one line each) about the prompts far from every caption the model trained on; a note when the
+    model folder has no caption table. Returns :func:`simdiff.product.pipeline.prompt_coverage`'s answer."""
+    from simdiff.inference.coverage import COVERAGE_NAME
+    from simdiff.product.pipeline import prompt_coverage
+
+    with timer.stage("check_prompt"):
+        coverage = prompt_coverage(generator, request, folder)
+    if coverage is None:
+        _note(args, f"{folder} has no {COVERAGE_NAME}: the prompt is not checked against its training captions "
+                    "(`simdiff train coverage CORPUS --model DIR` writes it)")
+    for checked in coverage or []:
+        if checked.far:
+            print(f"simdiff: warning: {checked.warning()}", file=sys.stderr)
+    return coverage
 
 
 def shipped_sampling() -> SamplingConfig:
@@ -229,6 +253,9 @@ def _generate_into(args: argparse.Namespace, request: GenerationRequest, start: 
     _note(args, f"loading model {folder}")
     with timer.stage("load_model"):
         generator = load_default(args.model, device)
+    from simdiff.text.cache import CachedTextEncoder
+
+    generator.text_encoder = CachedTextEncoder(generator.text_encoder, device)  # the prompt check's encoding is reused
     if not generator.is_simdiff:
         ignored = [name for name, value in (("--gravity", args.gravity), ("--wind", args.wind),
                                             ("--alpha", args.alpha), ("--compare", args.compare)) if value is not None]
@@ -238,8 +265,9 @@ def _generate_into(args: argparse.Namespace, request: GenerationRequest, start: 
         request = request.with_envs(request.envs[:1])
     elif generator.config.sim.mode != "continuous":
         raise SimdiffError(f"{folder} has categorical environments; use `simdiff sample --env-index` with it")
+    coverage = _check_prompts(args, generator, request, folder, timer)
     meta, paths = run_generation(generator, request, out_dir, folder, timer, args.quiet,
-                                 simulate=args.simulate, force=args.force, finisher=finisher)
+                                 simulate=args.simulate, force=args.force, finisher=finisher, coverage=coverage)
     from simdiff.motion.metrics import FLOOR_CLEARANCE, GLIDE_LIFT
 
     for rec in meta["samples"]:

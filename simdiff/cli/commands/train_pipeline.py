@@ -52,6 +52,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="stored precision (float16: half the size, within about 1e-3)")
     t.set_defaults(func=run_text_table)
 
+    c = group.add_parser("coverage", help="write a model folder's table of training captions (generate warns on "
+                                          "prompts far from all of them)",
+                         description="Encode the distinct captions of CORPUS's --split with the model's text encoder "
+                                     "and write MODEL/captions.safetensors (float16); `simdiff generate` then warns when "
+                                     "a prompt is far from every one of them. The pipeline's export writes it itself.")
+    c.add_argument("corpus", type=Path, help="the HumanML3D-layout corpus the model trained on")
+    c.add_argument("--model", type=Path, required=True, help="model folder (model.safetensors + config.json)")
+    c.add_argument("--split", default="train", help="the split the model trained on (default: train)")
+    c.set_defaults(func=run_coverage)
+
     u = group.add_parser("unpack", help="restore a pack as a HumanML3D-layout corpus folder")
     u.add_argument("pack", type=Path, help="pack folder")
     u.add_argument("--out", type=Path, required=True, help="corpus folder to write")
@@ -143,4 +153,18 @@ def run_text_table(args: argparse.Namespace) -> int:
     info = write_caption_table(captions, load_text_encoder(args.encoder), args.out, dtype=args.dtype)
     print(f"wrote {info['captions']} captions × {info['dim']} ({info['dtype']}): "
           f"{int(info['bytes']) / 2**20:.2f} MiB in {args.out}")
+    return 0
+
+
+def run_coverage(args: argparse.Namespace) -> int:
+    from simdiff.inference import coverage
+    from simdiff.inference.default import check_model_dir
+    from simdiff.model.checkpoint import read_config
+    from simdiff.text.base import load_text_encoder
+
+    folder = check_model_dir(args.model)
+    captions = coverage.training_captions(args.corpus, args.split)
+    info = coverage.write_coverage_table(folder, captions, load_text_encoder(read_config(folder).text_encoder))
+    print(f"wrote {info['captions']} captions × {info['dim']} (float16): {int(info['bytes']) / 2**20:.2f} MiB in "
+          f"{folder / coverage.COVERAGE_NAME}")
     return 0

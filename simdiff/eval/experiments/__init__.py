@@ -17,6 +17,9 @@ Kinds (``configs/eval_<kind>.json``):
   with and without the foot cleanup, against real mocap of the type (:mod:`.contacts`).
 * ``editing``: real clips re-played under other gravities, keyframes taken from real clips, one timeline
   (:mod:`.editing`).
+* ``following``: prompt following per category (direction, turning, counts, in place, body side, speed, posture,
+  sequences) by kinematic detectors, on real clips and on held-out wordings (:mod:`.following`).
+* ``heldout``: text fidelity on the test captions no train clip has, next to all test captions (:mod:`.heldout`).
 
 Each report folder holds ``report.json`` (config, resolved paths, provenance, budget, rows),
 ``report.md`` (tables, provenance), figures, and ``rows/`` (one file per finished row; a rerun
@@ -33,7 +36,8 @@ from typing import Any
 
 from simdiff.fsio import write_text
 from simdiff.errors import SimdiffError
-from simdiff.eval.experiments import contacts, editing, env_response, fig4, fig5, retrack, table1, table2
+from simdiff.eval.experiments import (contacts, editing, env_response, fig4, fig5, following, heldout, retrack,
+                                      table1, table2)
 from simdiff.eval.experiments.config import KINDS, ExperimentConfig, ModelSpec, load_config
 from simdiff.eval.experiments.provenance import load_average, now
 from simdiff.eval.experiments.report import duration, header
@@ -43,8 +47,10 @@ __all__ = ["KINDS", "ORDER", "ExperimentConfig", "ModelSpec", "Runner", "load_co
            "run_experiment"]
 
 MODULES: dict[str, ModuleType] = {"table1": table1, "table2": table2, "fig4": fig4, "fig5": fig5, "retrack": retrack,
-                                  "env_response": env_response, "contacts": contacts, "editing": editing}
-ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack", "env_response", "contacts", "editing")
+                                  "env_response": env_response, "contacts": contacts, "editing": editing,
+                                  "following": following, "heldout": heldout}
+ORDER: tuple[str, ...] = ("table2", "table1", "fig4", "fig5", "retrack", "env_response", "contacts", "editing",
+                          "following", "heldout")
 """Run order of :func:`run_all`: table2 first, so table1 finds the best α and reuses its rows."""
 
 
@@ -60,7 +66,7 @@ def run(runner: Runner) -> dict[str, Any]:
 
     plans = module.plan(runner)
     if any(runner.status(p)[0] == "measure" for p in plans):
-        runner.preflight(needs_evaluator=c.kind in ("table1", "table2"), needs_corpus=c.kind != "env_response")
+        runner.preflight(needs_evaluator=c.kind in ("table1", "table2", "heldout"), needs_corpus=c.kind != "env_response")
     threads = torch.get_num_threads()
     if c.threads:
         torch.set_num_threads(c.threads)

@@ -21,7 +21,8 @@ from typing import Any
 from simdiff.errors import SimdiffError
 from simdiff.eval.protocol import ProtocolConfig
 
-KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response", "contacts", "editing")
+KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response", "contacts", "editing",
+                          "following", "heldout")
 """Experiment kinds, named as in the issue (and the paper)."""
 ROLES: tuple[str, ...] = ("backbone", "adapters", "adapters_binary")
 """Model roles ``paths`` may name: MDM backbone, continuous (φ) adapters, categorical (binary) adapters."""
@@ -204,6 +205,27 @@ class EditingOptions:
 
 
 @dataclass
+class FollowingOptions:
+    """The prompt-following report (:mod:`simdiff.eval.experiments.following`).
+
+    Attributes:
+        wordings: the prompt set measured: ``test`` (held-out wordings, reported) or ``val`` (settings are chosen on).
+        prompts: set name → ``[{"category", "text", "checks": [...], "reference"?}]``; checks as in
+            :mod:`simdiff.eval.detectors`, all must pass; ``reference`` is the same request without the speed word
+            (``speed:`` checks compare against it, same seed).
+        ground_truth: ``[{"category", "check", "captions": regex, "exclude"?: regex}]``: the split's original clips
+            with a matching caption, checked by the detector (its error on real motion).
+        seeds: seeds per wording; length: frames per motion (20 fps).
+    """
+
+    wordings: str = "test"
+    prompts: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
+    ground_truth: list[dict[str, Any]] = field(default_factory=list)
+    seeds: int = 4
+    length: int = 196
+
+
+@dataclass
 class ExperimentConfig:
     """One experiment; see :mod:`simdiff.eval.experiments` for the kinds.
 
@@ -222,7 +244,7 @@ class ExperimentConfig:
             size: ``ddpm_replications`` protocol replications of whole batches; fewer: physics
             metrics and time only).
         envs: φ list (retrack); retrack_samples: motions per (method, φ); contacts: the contacts report;
-        editing: the editing report;
+        editing: the editing report; following: the prompt-following report;
         include_ground_truth: retrack also re-tracks the test motions themselves.
         budgets: named override sets, e.g. ``{"quick": {"about": "...", "set": {"protocol.replications": 3}}}``.
         text_encoder: ``auto``, each model's own (the only value; tests inject a stand-in through
@@ -260,6 +282,7 @@ class ExperimentConfig:
     env_control: EnvControlOptions = field(default_factory=EnvControlOptions)
     contacts: ContactOptions = field(default_factory=ContactOptions)
     editing: EditingOptions = field(default_factory=EditingOptions)
+    following: FollowingOptions = field(default_factory=FollowingOptions)
     projector: ProjectorSpec = field(default_factory=ProjectorSpec)
     costs: CostModel = field(default_factory=CostModel)
     budgets: dict[str, dict[str, Any]] = field(default_factory=dict)
@@ -426,7 +449,7 @@ def claim_problems(config: ExperimentConfig) -> list[str]:
     from simdiff.eval.protocol import claim_problems as protocol_problems
 
     out: list[str] = []
-    if config.kind in ("table1", "table2"):
+    if config.kind in ("table1", "table2", "heldout"):
         out += [f"protocol.{p}" for p in protocol_problems(config.protocol, None)]
     if config.kind == "table1" and "ddpm" in config.samplers and 0 < config.ddpm_samples < 32:
         out.append(f"ddpm_samples={config.ddpm_samples} < 32")

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import Any
 
 import torch
 
 from simdiff.runinfo import now, run_info
 
-__all__ = ["load_average", "now", "provenance"]
+__all__ = ["folder_stamp", "load_average", "now", "provenance"]
 
 
 def load_average() -> list[float] | None:
@@ -29,3 +30,15 @@ def provenance(seed: int, device: str, command: list[str] | None = None) -> dict
         "device_name": torch.cuda.get_device_name(dev) if dev.type == "cuda" else "cpu",
         "load_avg_start": load_average()})
     return {**info, "cwd": os.getcwd(), "seed": seed}
+
+
+def folder_stamp(path: str) -> dict[str, Any]:
+    """A folder as (absolute path, size and mtime of its weights): re-measure when a model is retrained."""
+    p = Path(path).expanduser().resolve() if path else Path()
+    out: dict[str, Any] = {"path": str(p)}
+    for name in ("model.safetensors", "finest.tar"):
+        f = p / name if p.is_dir() else p
+        if f.is_file():
+            out.update(size=f.stat().st_size, mtime_ns=f.stat().st_mtime_ns)
+            break
+    return out

@@ -31,11 +31,12 @@ from simdiff.motion.metrics import physics_metrics
 from simdiff.motion.rigid import batch_joints_from_features, decode_inputs
 from simdiff.errors import SimdiffError
 from simdiff.eval.experiments.config import ExperimentConfig, ModelSpec
-from simdiff.eval.experiments.provenance import provenance
+from simdiff.eval.experiments.provenance import folder_stamp, provenance
 from simdiff.eval.protocol import GenerateFn, ProtocolConfig, evaluate_t2m, finish_summary, generator_fn
 from simdiff.text.base import EncoderCache
 
 EARTH: tuple[float, float, float] = (-9.81, 0.0, 0.0)
+CAPTION_SETS: tuple[str, ...] = ("all", "unseen")
 FPS: float = 20.0
 
 
@@ -94,7 +95,9 @@ class Runner:
         self._models: dict[str, Any] = {}
         self._encoders = EncoderCache(self.config.device, text_encoder)
         self._evaluator: Any = None
-        self._dataset: Any = None
+        self._datasets: dict[str, Any] = {}
+        self.captions = "all"
+        """The caption set protocol rows draw (:data:`CAPTION_SETS`); an experiment sets it around a row."""
         self._lengths: np.ndarray | None = None
         self.notes: dict[str, Any] = {}
         """Facts an experiment fixes while planning and reports when finishing (table1: the best α used)."""
@@ -173,14 +176,16 @@ class Runner:
 
     @property
     def dataset(self) -> Any:
-        if self._dataset is None:
+        """The split's items; with :attr:`captions` ``unseen``, only captions no train item has (normalised)."""
+        if self.captions not in self._datasets:
             from simdiff.data.humanml3d import HumanML3D
 
             corpus = Path(self.config.corpus).expanduser()
             if not corpus.is_dir():
                 raise SimdiffError(f"corpus folder {corpus} not found (set it with --corpus DIR)")
-            self._dataset = HumanML3D(corpus, self.config.split, seed=self.config.seed)
-        return self._dataset
+            unseen = "train" if self.captions == "unseen" else None
+            self._datasets[self.captions] = HumanML3D(corpus, self.config.split, seed=self.config.seed, unseen_in=unseen)
+        return self._datasets[self.captions]
 
     def _pool_projector(self, anchor_stance: bool) -> Any:
         """A persistent simulator pool with the config's parallelism and residual bound."""
@@ -244,12 +249,12 @@ class Runner:
         """Corpus, split, evaluator, seed and text encoder (part of every protocol row's fingerprint)."""
         e = self.config.evaluator
         return {"corpus": str(Path(self.config.corpus).expanduser().resolve()), "split": self.config.split,
-                "evaluator": {**dataclasses.asdict(e), "path": _stamp(e.path)}, "seed": self.config.seed,
+                "evaluator": {**dataclasses.asdict(e), "path": folder_stamp(e.path)}, "seed": self.config.seed,
                 "text_encoder": self.config.text_encoder}
 
     def method_inputs(self, spec: ModelSpec, sampler: str, alpha: float | None, env: Any = None) -> dict[str, Any]:
         """Model file, sampler, α, φ and PhysDiff settings of one method row."""
-        out: dict[str, Any] = {"model": _stamp(str(self.config.model_path(spec))),
+        out: dict[str, Any] = {"model": folder_stamp(str(self.config.model_path(spec))),
                                "sampling": self.sampling(spec, sampler, alpha).to_dict(),
                                "env": None if env is None else [float(v) for v in env],
                                "env_index": spec.env_index, "device": self.config.device}
@@ -486,15 +491,3 @@ class Runner:
             bar.set_postfix_str(f"{plan.key} (~{plan.estimate_s / 60:.1f} min)")
             rows.append(self.fetch(plan))
         return rows
-
-
-def _stamp(path: str) -> dict[str, Any]:
-    """A folder as (absolute path, size and mtime of its weights): re-measure when a model is retrained."""
-    p = Path(path).expanduser().resolve() if path else Path()
-    out: dict[str, Any] = {"path": str(p)}
-    for name in ("model.safetensors", "finest.tar"):
-        f = p / name if p.is_dir() else p
-        if f.is_file():
-            out.update(size=f.stat().st_size, mtime_ns=f.stat().st_mtime_ns)
-            break
-    return out

@@ -18,6 +18,12 @@ async function request(url, options = {}) {
   return body;
 }
 
+const post = (url, body) => request(url, {
+  method: "POST",
+  headers: { "Content-Type": "application/json" },
+  body: JSON.stringify(body),
+});
+
 let uploadLimit = Infinity;  // bytes; from /api/info: a larger file is refused here, before it is sent
 
 export const api = {
@@ -28,12 +34,15 @@ export const api = {
     return info;
   },
 
-  /** Generate one motion: {text, gravity, wind_x, wind_y, seconds, seed, simulate, alpha, env_guidance, guidance, foot_lock} → {joints, fps, parents, meta}. */
-  generate: (params) => request("/api/generate", {
-    method: "POST",
-    headers: { "Content-Type": "application/json" },
-    body: JSON.stringify(params),
-  }),
+  /** Generate one motion: {text, gravity, wind_x, wind_y, seconds, seed, simulate, alpha, env_guidance, guidance,
+   *  foot_lock, pin_start?, pin_end?} → {joints, fps, parents, meta, motion, body}. */
+  generate: (params) => post("/api/generate", params),
+
+  /** Re-play a motion shown (its answer's `motion` number) under φ: {source, gravity, wind_x, wind_y, seed, ...} → same. */
+  edit: (params) => post("/api/edit", params),
+
+  /** One motion through a timeline: {segments: [{text, seconds, gravity?, wind?: [x, y]}], seed, ...} → same. */
+  timeline: (params) => post("/api/timeline", params),
 
   /** Upload a motion file (.npy joints or features, .bvh, DeepMimic) → same shape as generate. */
   open: (file) => file.size > uploadLimit

@@ -17,8 +17,13 @@ const state = {
   frame: 0,
   playing: false,
   generation_id: 0,    // generated motions shown so far
-  params: null,        // parameters of the motion on screen (generated ones)
-  source: null,        // "generate" | "file" | "upload"
+  shown: 0,            // motions shown so far (generated, opened, re-played, timelines)
+  params: null,        // parameters of the motion on screen (generated and re-played ones)
+  source: null,        // "generate" | "file" | "upload" | "edit" (a re-play) | "timeline"
+  motion: null,        // the server's number of the motion on screen (an answer's `motion`)
+  file_motion: null,   // number of the open file's motion, which "Re-play" and the sliders re-play; null: no file open
+  file_name: null,
+  pins: { start: null, end: null },  // numbers of the motions whose first / last pose the next generation pins
   digest: null,        // checksum of the joints on screen (changes when the motion does)
   meta: null,
   model: null,
@@ -79,6 +84,7 @@ function showError(message) {
   state.error = message;
   $("error").textContent = message;
   $("error").hidden = false;
+  $("error").scrollIntoView({ block: "nearest" });  // the panel may be scrolled to the timeline builder
   setStatus("error", "");
 }
 
@@ -88,33 +94,62 @@ function digest(joints) {
   return Math.round(sum * 1e4) / 1e4;
 }
 
+const envText = (p) => `g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N`;
+const gravityText = (read) => (read ? `${read.gravity.toFixed(1)} m/s²` : "none (no flight)");
+
 function show(motion) {
   player.load(motion);
   showBody(motion);
   const meta = motion.meta;
-  Object.assign(state, { frames: motion.joints.length, source: meta.source, digest: digest(motion.joints), meta, error: null });
+  Object.assign(state, { frames: motion.joints.length, source: meta.source, digest: digest(motion.joints), meta, error: null,
+    motion: motion.motion ?? null, shown: state.shown + 1 });
   $("error").hidden = true;
+  const waited = meta.queue_position ? ` after waiting ${meta.waited_s.toFixed(1)} s behind ${meta.queue_position} request(s)` : "";
   let caption;
   if (meta.source === "generate") {
     const p = meta.params;
     state.params = p;
     state.generation_id += 1;
-    caption = `“${p.text}”` + (meta.env_used ? ` · g ${p.gravity.toFixed(2)} m/s² · wind (${p.wind_x.toFixed(1)}, ${p.wind_y.toFixed(1)}) N · α ${meta.sampling.alpha}` + (meta.sampling.env_guidance !== 1 ? ` · environment guidance ${meta.sampling.env_guidance}` : "") : "");
+    caption = `“${p.text}”` + (meta.env_used ? ` · ${envText(p)} · α ${meta.sampling.alpha}` + (meta.sampling.env_guidance !== 1 ? ` · environment guidance ${meta.sampling.env_guidance}` : "") : "");
     if (meta.simulated) caption += ` · simulated finish (${meta.simulated.status}, joint error ${Math.round(meta.simulated.err_mm)} mm)`;
-    const waited = meta.queue_position ? ` after waiting ${meta.waited_s.toFixed(1)} s behind ${meta.queue_position} request(s)` : "";
-    setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s${waited}.`);
+    const pinned = meta.pins ? ` Pinned ${[meta.pins.start !== null ? "start" : "", meta.pins.end !== null ? "end" : ""].filter(Boolean).join(" and ")} pose met within ${meta.keyframe_error_cm.toFixed(1)} cm.` : "";
+    if (meta.pins) caption += " · pinned pose";
+    setStatus("ready", `Generated ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s${waited}.${pinned}`);
+    setFile(null);
+  } else if (meta.source === "edit") {
+    state.params = meta.params;
+    caption = `${state.file_name ?? `motion ${meta.params.source}`} re-played · ${envText(meta.params)} · α ${meta.sampling.alpha}`;
+    const read = meta.gravity_read;
+    const flights = read.input || read.edited
+      ? ` Gravity read from the flights: ${gravityText(read.input)} before, ${gravityText(read.edited)} after.`
+      : " No flight to read gravity from.";
+    setStatus("ready", `Re-played ${meta.frames} frames in ${meta.elapsed_s.toFixed(2)} s${waited}: joints moved `
+      + `${(100 * meta.changed_m).toFixed(1)} cm on average.${flights}`);
+  } else if (meta.source === "timeline") {
+    state.params = null;
+    caption = meta.segments.map((s) => `“${s.text}”` + (meta.env_used && (s.gravity !== -9.81 || s.wind[0] || s.wind[1]) ? ` (g ${s.gravity}, wind ${s.wind[0]}, ${s.wind[1]})` : "")).join(" → ");
+    setStatus("ready", `Generated a timeline of ${meta.segments.length} prompts: ${meta.frames} frames (${meta.seconds.toFixed(2)} s) in ${meta.elapsed_s.toFixed(2)} s${waited}.`);
+    setFile(null);
   } else {
     state.params = null;
     caption = meta.name;
     setStatus("ready", `Opened ${meta.name}: ${meta.frames} frames (${meta.seconds.toFixed(2)} s).`);
+    setFile(motion.motion ?? null, meta.name);
   }
+  if (meta.warnings?.length) $("status").textContent += ` Warning: ${meta.warnings.join(" ")}`;
   $("caption").textContent = caption;
 }
 
-// -- generation: one request at a time, the latest parameters win ------------------------------
+/** The open file (its motion's number) that "Re-play" and the sliders re-play; null when a generated motion replaced it. */
+function setFile(number, name = null) {
+  Object.assign(state, { file_motion: number, file_name: number === null ? null : name });
+  $("replay").hidden = number === null;
+}
+
+// -- generation: one request at a time, the latest one wins ------------------------------------
 
 let busy = false;
-let pending = null;
+let pending = null;  // the next request: {verb, call}; a newer one replaces it
 /** Foot-lock strength when the box is ticked: the model's own (1 if it has none). */
 let footLock = 1;
 
@@ -127,20 +162,24 @@ function readParams() {
     seconds: value("seconds"), seed: Math.round(value("seed")),
     simulate: Boolean($("simulate") && $("simulate").checked),
     foot_lock: $("foot_lock") && $("foot_lock").checked ? footLock : 0,
+    ...(state.pins.start !== null ? { pin_start: state.pins.start } : {}),
+    ...(state.pins.end !== null ? { pin_end: state.pins.end } : {}),
   };
 }
 
-async function generate() {
-  pending = readParams();
+/** Run `call` (an API request answering a motion) after the running one; `verb` says what it does. */
+async function submit(verb, call) {
+  pending = { verb, call };
   if (busy) return;
   busy = true;
   try {
     while (pending) {
-      const params = pending;
+      const job = pending;
       pending = null;
-      setStatus("generating", state.model && !state.model.loaded ? "Loading the model and generating…" : "Generating…");
+      const loading = state.model && !state.model.loaded;
+      setStatus("generating", loading ? `Loading the model and ${job.verb}…` : `${job.verb[0].toUpperCase()}${job.verb.slice(1)}…`);
       try {
-        show(await api.generate(params));
+        show(await job.call());
         if (state.model) state.model.loaded = true;
       } catch (err) {
         showError(err.message);
@@ -149,6 +188,93 @@ async function generate() {
   } finally {
     busy = false;
   }
+}
+
+function generate() {
+  const params = readParams();
+  submit("generating", () => api.generate(params));
+}
+
+/** The open file re-played under the sliders' gravity and wind (and α, environment guidance, foot lock, seed). */
+function replay() {
+  if (state.file_motion === null) return showError("Re-play needs a motion file open: open one first");
+  const { gravity, wind_x, wind_y, alpha, env_guidance, seed, foot_lock } = readParams();
+  const params = { source: state.file_motion, gravity, wind_x, wind_y, alpha, env_guidance, seed, foot_lock };
+  submit("re-playing", () => api.edit(params));
+}
+
+/** Sliders act on what is on screen: an open file is re-played, anything else generated from the prompt. */
+function regenerate() {
+  if (state.file_motion !== null && state.model && state.model.env) replay();
+  else generate();
+}
+
+// -- pins: the first / last pose of the motion on screen when the box is ticked ------------------
+
+function bindPin(end) {
+  const box = $(end ? "pin_end" : "pin_start");
+  const key = end ? "end" : "start";
+  box.addEventListener("change", () => {
+    if (box.checked && state.motion === null) {
+      box.checked = false;
+      showError(`Pin ${key} pose needs a motion on screen: generate or open one first`);
+    }
+    state.pins[key] = box.checked ? state.motion : null;
+    const notes = ["start", "end"].filter((k) => state.pins[k] !== null).map((k) => `${k} pose of motion ${state.pins[k]}`);
+    $("pin-note").textContent = notes.length ? `Pinned: the ${notes.join(" and the ")} (${$("caption").textContent || "on screen"}).` : "";
+    $("pin-note").hidden = !notes.length;
+  });
+}
+
+// -- timeline builder ------------------------------------------------------------------------
+
+const SEGMENT_FIELDS = [["seg-seconds", "s", "0.1"], ["seg-gravity", "g", "0.01"], ["seg-wind-x", "wind x", "0.1"], ["seg-wind-y", "wind y", "0.1"]];
+
+/** Add a row (prompt, seconds, gravity, optional wind) to the timeline builder. */
+function addSegment(text = "", seconds = 3, gravity = -9.81) {
+  const row = document.createElement("div");
+  row.className = "segment";
+  const prompt = Object.assign(document.createElement("input"), { className: "seg-text", type: "text", value: text, placeholder: "prompt", maxLength: 500 });
+  prompt.setAttribute("aria-label", "segment prompt");
+  const numbers = document.createElement("div");
+  numbers.className = "numbers";
+  for (const [cls, name, step] of SEGMENT_FIELDS) {
+    const label = document.createElement("label");
+    const input = Object.assign(document.createElement("input"), { className: cls, type: "number", step });
+    if (cls === "seg-seconds") input.value = String(seconds);
+    else if (cls === "seg-gravity") input.value = String(gravity);
+    else input.placeholder = "0";
+    label.append(name, input);
+    numbers.append(label);
+  }
+  const remove = Object.assign(document.createElement("button"), { type: "button", className: "seg-remove", textContent: "×", title: "remove this row" });
+  remove.addEventListener("click", () => row.remove());
+  numbers.append(remove);
+  row.append(prompt, numbers);
+  $("segments").append(row);
+  return row;
+}
+
+/** The rows as the API's segments; blank numbers are left out (the server names what is missing or wrong). */
+function readTimeline() {
+  const number = (row, cls) => { const v = row.querySelector(`.${cls}`).value; return v === "" ? null : Number(v); };
+  const segments = [...$("segments").querySelectorAll(".segment")].map((row) => {
+    const segment = { text: row.querySelector(".seg-text").value };
+    const seconds = number(row, "seg-seconds");
+    const gravity = number(row, "seg-gravity");
+    const wind = [number(row, "seg-wind-x"), number(row, "seg-wind-y")];
+    if (seconds !== null) segment.seconds = seconds;
+    if (gravity !== null) segment.gravity = gravity;
+    if (wind[0] !== null || wind[1] !== null) segment.wind = wind.map((w) => w ?? 0);
+    return segment;
+  });
+  const { alpha, env_guidance, guidance, foot_lock, seed } = readParams();
+  return { segments, seed, alpha, env_guidance, guidance, foot_lock };
+}
+
+function generateTimeline() {
+  const params = readTimeline();
+  submit("generating the timeline", () => api.timeline(params));
 }
 
 async function openWith(label, load) {
@@ -175,7 +301,7 @@ function configure(info) {
     const label = () => { $(`${id}-value`).textContent = String(Number(Number(input.value).toFixed(3))); };
     label();
     input.addEventListener("input", label);
-    input.addEventListener("change", generate);
+    input.addEventListener("change", regenerate);
     input.disabled = ENV_SLIDERS.includes(id) && !info.model.env;
   }
   $("env-note").hidden = info.model.env || !info.model.found;
@@ -188,12 +314,16 @@ function configure(info) {
   const m = info.model;
   $("model-info").textContent = (m.error ? m.error : `Model: ${m.path} (${m.kind})`) + ($("model-info").dataset.note ? ` ${$("model-info").dataset.note}` : "");
   $("generate").disabled = !m.found || Boolean(m.error);
+  $("generate-timeline").disabled = $("generate").disabled;
+  $("replay").disabled = $("generate").disabled || !m.env;
+  if (!m.env) $("replay").title = "this model has no physics adapters: it cannot re-play a motion under gravity and wind";
+  addSegment(defaults.text, 3, defaults.gravity);
   for (const b of $("gravity-presets").querySelectorAll("button")) {
     b.disabled = !m.env;
     b.addEventListener("click", () => {
       $("gravity").value = b.dataset.gravity;
       $("gravity").dispatchEvent(new Event("input"));
-      generate();
+      regenerate();
     });
   }
   const list = $("file-list");
@@ -213,6 +343,11 @@ function bindControls() {
     if (e.key === "Enter" && !e.shiftKey) { e.preventDefault(); generate(); }
   });
   $("play").addEventListener("click", () => player.toggle());
+  $("replay").addEventListener("click", replay);
+  $("add-segment").addEventListener("click", () => addSegment());
+  $("generate-timeline").addEventListener("click", generateTimeline);
+  bindPin(false);
+  bindPin(true);
   $("scrub").addEventListener("input", () => {
     const frame = Number($("scrub").value);  // read first: pausing redraws the timeline
     player.pause();

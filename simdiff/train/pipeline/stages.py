@@ -205,6 +205,7 @@ def export_settings(ctx: PipelineContext) -> dict[str, Any]:
 def run_export(ctx: PipelineContext) -> dict[str, Any]:
     import json
 
+    from simdiff.inference.coverage import training_captions, write_coverage_table
     from simdiff.model.provenance import PROVENANCE_NAME, read_provenance
     from simdiff.model.shards import shard_model_folder
 
@@ -220,6 +221,7 @@ def run_export(ctx: PipelineContext) -> dict[str, Any]:
         shutil.copyfile(src / name, model / name)
     write_json(model / "sampling.json", {"alpha": ctx.config.export.alpha, "guidance": ctx.config.evaluation.guidance,
                                          "steps": ctx.config.evaluation.steps, "sampler": ctx.config.evaluation.sampler})
+    captions = write_coverage_table(model, training_captions(ctx.corpus_dir(), "train"), ctx.text())
     shards: list[str] = []
     if ctx.config.export.shard_mib > 0:
         shards = shard_model_folder(model, out / "sharded", int(ctx.config.export.shard_mib * 2**20))
@@ -232,7 +234,7 @@ def run_export(ctx: PipelineContext) -> dict[str, Any]:
                                        "evaluation": evaluation})
     provenance = read_provenance(model)
     write_text(model / "README.md", _readme(ctx, markers, evaluation, provenance))
-    return {"model": str(model), "shards": shards,
+    return {"model": str(model), "shards": shards, "captions": captions["captions"],
             "weights_licence": provenance.weights_licence if provenance is not None else "unknown"}
 
 

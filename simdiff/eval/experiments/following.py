@@ -1,0 +1,159 @@
+"""Prompt following: pass rates of kinematic checks per category, on real clips and on generated motions.
+
+* **Ground truth**: the split's original clips whose captions match a rule of ``following.ground_truth`` are
+  checked with the rule's detector (:mod:`simdiff.eval.detectors`): the detector's pass rate on real motion that
+  was described that way. A category with no matching clip is one the corpus lacks (or never words that way).
+* **Models**: every wording of the measured set (``following.wordings``; ``test`` = held-out wordings) × seeds, at
+  Earth gravity without wind, decoded to the written joints as ``simdiff generate`` writes them; a motion passes
+  when all its checks pass. ``speed:`` checks compare with the same seed of the wording's ``reference``.
+
+Pass rates carry a 95 % Wilson interval over motions (seeds of one wording are not independent draws of wordings:
+read the per-wording table too).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from simdiff.errors import SimdiffError
+from simdiff.eval.detectors import parse_check, run_check, thresholds
+from simdiff.eval.experiments.config import ModelSpec
+from simdiff.eval.experiments.runner import EARTH, RowPlan, Runner, safe
+from simdiff.eval.stats import wilson_interval
+
+TITLE = "Prompt following — kinematic checks per category, real clips and generated motions"
+
+
+def _prompts(runner: Runner) -> list[dict[str, Any]]:
+    o = runner.config.following
+    prompts = o.prompts.get(o.wordings)
+    if not prompts:
+        raise SimdiffError(f"following.prompts has no wordings set {o.wordings!r}; sets: {', '.join(o.prompts) or 'none'}")
+    for p in prompts:
+        if not isinstance(p, dict) or not p.get("text") or not p.get("category") or not p.get("checks"):
+            raise SimdiffError(f"following prompt {p!r} needs 'category', 'text' and 'checks'")
+        for check in p["checks"]:
+            parse_check(check)
+            if check.startswith("speed:") and not p.get("reference"):
+                raise SimdiffError(f"following prompt {p['text']!r}: {check} needs a 'reference' wording")
+    return prompts
+
+
+def measure_ground_truth(runner: Runner) -> dict[str, Any]:
+    """Per rule: the matching clips of the split, how many pass, and the readings of those that fail."""
+    corpus = Path(runner.config.corpus).expanduser()
+    manifest = json.loads((corpus / "manifest.json").read_text(encoding="utf-8"))
+    clips = [c for c in manifest["clips"] if not c.get("mirror_of") and c.get("split") == runner.config.split]
+    rules = []
+    for rule in runner.config.following.ground_truth:
+        parse_check(rule["check"])
+        if rule["check"].startswith("speed:"):
+            raise SimdiffError(f"ground-truth rule {rule['check']!r}: speed checks need a paired motion")
+        pattern = re.compile(rule["captions"], re.IGNORECASE)
+        exclude = re.compile(rule["exclude"], re.IGNORECASE) if rule.get("exclude") else None
+        passed, failed = 0, []
+        matched = [c for c in clips if any(pattern.search(t) and not (exclude and exclude.search(t))
+                                           for t in c.get("captions", []))]
+        for c in matched:
+            verdict = run_check(np.load(corpus / "new_joints" / f"{c['id']}.npy", allow_pickle=False), rule["check"])
+            passed += verdict.passed
+            if not verdict.passed:
+                failed.append(f"{c['id']}: {verdict.reading}")
+        rules.append({"category": rule["category"], "check": rule["check"], "n": len(matched), "passed": passed,
+                      "failed": failed[:5]})
+    return {"rules": rules}
+
+
+def measure_model(runner: Runner, spec: ModelSpec, category: str) -> dict[str, Any]:
+    """Every wording of ``category`` × seeds; per wording the verdicts of every seed."""
+    from simdiff.motion.rigid import batch_joints_from_features
+
+    o = runner.config.following
+    alpha = runner.alpha(spec) if runner.is_simdiff(spec) else None
+    fn = runner.generate_fn(spec, "ddim", alpha, EARTH)
+
+    def motions(text: str) -> np.ndarray:  # the same noise for every wording: seeds = batch positions
+        feats, _ = runner.generate(fn, [text] * o.seeds, [o.length] * o.seeds, runner.config.seed)
+        return batch_joints_from_features(feats, [o.length] * o.seeds, fn.foot_lock)
+
+    out = []
+    for p in (p for p in _prompts(runner) if p["category"] == category):
+        joints = motions(p["text"])
+        reference = motions(p["reference"]) if p.get("reference") else [None] * o.seeds
+        seeds = []
+        for j, ref in zip(joints, reference):
+            verdicts = [run_check(j, check, ref) for check in p["checks"]]
+            seeds.append({"passed": all(v.passed for v in verdicts), "readings": [v.reading for v in verdicts]})
+        out.append({"text": p["text"], "checks": p["checks"], "seeds": seeds})
+    return {"wordings": out}
+
+
+def plan(runner: Runner) -> list[RowPlan]:
+    c, o = runner.config, runner.config.following
+    if o.seeds < 1 or not 40 <= o.length <= 196:
+        raise SimdiffError(f"following needs seeds >= 1 and 40 <= length <= 196, got {o.seeds} and {o.length}")
+    prompts = _prompts(runner)
+    plans = [RowPlan("ground_truth", {"method": "ground truth", "category": "all"},
+                     {"row": "following_gt", "rules": o.ground_truth, "detectors": thresholds(), **runner.data_inputs()}, 10.0,
+                     measure_ground_truth)]
+    for spec in c.models:
+        base = runner.method_inputs(spec, "ddim", runner.alpha(spec) if runner.is_simdiff(spec) else None, EARTH)
+        for category in dict.fromkeys(p["category"] for p in prompts):
+            mine = [p for p in prompts if p["category"] == category]
+            n = sum(2 if p.get("reference") else 1 for p in mine) * o.seeds
+            inputs = {"row": "following", "prompts": mine, "seeds": o.seeds, "length": o.length, "seed": c.seed,
+                      "detectors": thresholds(), **base}
+            plans.append(RowPlan(safe(f"{spec.name}_{category}"), {"method": spec.name, "category": category}, inputs,
+                                 runner.motion_seconds(spec, "ddim", n),
+                                 lambda r, spec=spec, category=category: measure_model(r, spec, category)))
+    return plans
+
+
+def _rate(passed: int, n: int) -> str:
+    if not n:
+        return "— (none)"
+    lo, hi = wilson_interval(passed, n)
+    return f"{passed / n:.0%} [{lo:.0%}–{hi:.0%}] ({passed}/{n})"
+
+
+def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
+    o = runner.config.following
+    rows = report["rows"]
+    gt = next((r for r in rows if r["method"] == "ground truth"), {"rules": []})
+    models = [r for r in rows if r["method"] != "ground truth"]
+    categories = list(dict.fromkeys([r["category"] for r in gt["rules"]] + [r["category"] for r in models]))
+    methods = list(dict.fromkeys(r["method"] for r in models))
+    lines = [(f"Wordings: the `{o.wordings}` set of `configs/eval_following.json` ({o.seeds} seeds each, {o.length} "
+             f"frames, Earth, no wind); real clips: the {runner.config.split} split's originals whose captions match "
+             "a rule. A motion passes when every check of its wording passes. Pass rate [95 % Wilson interval] "
+             "(passed/n). Detectors and thresholds: `simdiff/eval/detectors.py`."), "",
+             "| category | real clips | " + " | ".join(methods) + " |", "|---|---|" + "---|" * len(methods)]
+    for cat in categories:
+        rules = [r for r in gt["rules"] if r["category"] == cat]
+        real = _rate(sum(r["passed"] for r in rules), sum(r["n"] for r in rules))
+        cells = []
+        for m in methods:
+            seeds = [s for r in models if r["method"] == m and r["category"] == cat
+                     for w in r["wordings"] for s in w["seeds"]]
+            cells.append(_rate(sum(s["passed"] for s in seeds), len(seeds)))
+        lines.append(f"| {cat} | {real} | " + " | ".join(cells) + " |")
+    lines += ["", "Real clips per detector (caption rule → check):", "", "| category | check | pass | failing (first) |",
+              "|---|---|---|---|"]
+    for r in gt["rules"]:
+        lines.append(f"| {r['category']} | `{r['check']}` | {_rate(r['passed'], r['n'])} | "
+                     f"{'; '.join(r['failed'][:2]) or '—'} |")
+    for m in methods:
+        lines += ["", f"{m}, per wording (readings of the first two seeds):", "",
+                  "| category | wording | checks | passed | readings |", "|---|---|---|---|---|"]
+        for r in (r for r in models if r["method"] == m):
+            for w in r["wordings"]:
+                k = sum(s["passed"] for s in w["seeds"])
+                readings = " / ".join("; ".join(s["readings"]) for s in w["seeds"][:2])
+                lines.append(f"| {r['category']} | {w['text']} | {', '.join(f'`{c}`' for c in w['checks'])} | "
+                             f"{k}/{len(w['seeds'])} | {readings} |")
+    return lines
