@@ -231,7 +231,7 @@ class _BlockingService(MotionService):
         self.release = threading.Event()
         self.started = threading.Event()
 
-    def _generate_admitted(self, params, position, queued):
+    def _generate_admitted(self, params, keys, position, queued):
         self.started.set()
         self.release.wait(10)
         return {"joints": [], "meta": {"queue_position": position}}

@@ -7,8 +7,8 @@
   Earth gravity without wind, decoded to the written joints as ``simdiff generate`` writes them; a motion passes
   when all its checks pass. ``speed:`` checks compare with the same seed of the wording's ``reference``.
 
-Pass rates carry a 95 % Wilson interval over motions (seeds of one wording are not independent draws of wordings:
-read the per-wording table too).
+Real clips' pass rates carry a 95 % Wilson interval; a model's, a 95 % percentile bootstrap over wordings (the seeds
+of one wording are not independent draws of what users write).
 """
 
 from __future__ import annotations
@@ -115,10 +115,28 @@ def plan(runner: Runner) -> list[RowPlan]:
 
 
 def _rate(passed: int, n: int) -> str:
+    """Real clips (independent): pass rate with its Wilson interval."""
     if not n:
         return "— (none)"
     lo, hi = wilson_interval(passed, n)
     return f"{passed / n:.0%} [{lo:.0%}–{hi:.0%}] ({passed}/{n})"
+
+
+def _wording_rate(wordings: list[dict[str, Any]]) -> str:
+    """Generated motions: pass rate with a bootstrap interval over wordings (a wording's seeds are not independent
+    draws of what users write)."""
+    from simdiff.eval.stats import bootstrap_interval
+
+    seeds = [s["passed"] for w in wordings for s in w["seeds"]]
+    if not seeds:
+        return "— (none)"
+
+    def share(units: list[Any]) -> float:
+        runs = [s["passed"] for w in units for s in w["seeds"]]
+        return float(np.mean(runs)) if runs else float("nan")
+
+    _, lo, hi = bootstrap_interval(wordings, share)
+    return f"{np.mean(seeds):.0%} [{lo:.0%}–{hi:.0%}] ({sum(seeds)}/{len(seeds)}, {len(wordings)} wordings)"
 
 
 def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
@@ -130,17 +148,14 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     methods = list(dict.fromkeys(r["method"] for r in models))
     lines = [(f"Wordings: the `{o.wordings}` set of `configs/eval_following.json` ({o.seeds} seeds each, {o.length} "
              f"frames, Earth, no wind); real clips: the {runner.config.split} split's originals whose captions match "
-             "a rule. A motion passes when every check of its wording passes. Pass rate [95 % Wilson interval] "
-             "(passed/n). Detectors and thresholds: `simdiff/eval/detectors.py`."), "",
+             "a rule. A motion passes when every check of its wording passes. Pass rate [95 % interval: Wilson over "
+             "real clips; bootstrap over wordings for models] (passed/n). Detectors and thresholds: `simdiff/eval/detectors.py`."), "",
              "| category | real clips | " + " | ".join(methods) + " |", "|---|---|" + "---|" * len(methods)]
     for cat in categories:
         rules = [r for r in gt["rules"] if r["category"] == cat]
         real = _rate(sum(r["passed"] for r in rules), sum(r["n"] for r in rules))
-        cells = []
-        for m in methods:
-            seeds = [s for r in models if r["method"] == m and r["category"] == cat
-                     for w in r["wordings"] for s in w["seeds"]]
-            cells.append(_rate(sum(s["passed"] for s in seeds), len(seeds)))
+        cells = [_wording_rate([w for r in models if r["method"] == m and r["category"] == cat for w in r["wordings"]])
+                 for m in methods]
         lines.append(f"| {cat} | {real} | " + " | ".join(cells) + " |")
     lines += ["", "Real clips per detector (caption rule → check):", "", "| category | check | pass | failing (first) |",
               "|---|---|---|---|"]
