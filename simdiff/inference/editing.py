@@ -103,24 +103,43 @@ HALVES: tuple[str, ...] = ("lower", "upper")
 
 
 def keep_half(generator: MotionGenerator, joints: np.ndarray, config: SamplingConfig, env: Sequence[float] | None,
-              half: str, text: str, *, seed: int = 0) -> EditedMotion:
-    """``joints`` (T ≤ 196, 22, 3) with one half of the body (``half`` in :data:`HALVES`) kept and the other made
-    anew for ``text`` under φ = ``env`` (None: a backbone-only model): the kept joints are keyframes
+              half: str, text: str, *, seed: int = 0, progress=None) -> EditedMotion:
+    """``joints`` (T, 22, 3) with one half of the body (``half`` in :data:`HALVES`) kept and the other made anew for
+    ``text`` under φ = ``env`` (None: a backbone-only model): the kept joints are keyframes
     (:func:`simdiff.inference.keyframes.sample_keyframed`) and the result is fitted on the input's skeleton, which
     holds the kept joints within a few centimetres (where the new half meets the kept one, the fit compromises: 1.3 cm
-    for kept legs, 3.8 cm for a kept upper body on a val walk)."""
+    for kept legs, 3.8 cm for a kept upper body on a val walk).
+
+    A motion longer than 196 frames is made in windows (:func:`simdiff.inference.replay.windows`, seed + k for
+    window k): each later window also has the whole body of its overlap with the one before as keyframes, and the two
+    are cross-faded over that overlap, so the new half continues across the seam."""
     from simdiff.inference.keyframes import sample_keyframed
-    from simdiff.motion.rigid import rest_offsets
-    from simdiff.motion.skeleton import LOWER_BODY, MAX_FRAMES, UPPER_BODY
+    from simdiff.inference.replay import windows
+    from simdiff.motion.features import process_joints
+    from simdiff.motion.rigid import rest_offsets, rigidify
+    from simdiff.motion.skeleton import LOWER_BODY, UPPER_BODY
 
     if half not in HALVES:
         raise SimdiffError(f"--keep must be one of {', '.join(HALVES)}, got {half!r}")
     joints = check_motion(joints)
-    if joints.shape[0] > MAX_FRAMES:
-        raise SimdiffError(f"the motion has {joints.shape[0]} frames; --keep takes up to {MAX_FRAMES} (9.8 s)")
-    keys = np.full_like(joints, np.nan)
     kept = list(LOWER_BODY if half == "lower" else UPPER_BODY)
-    keys[:, kept] = joints[:, kept]
-    features, out = sample_keyframed(generator, keys, config, text_embeddings=generator.encode_text([text]),
-                                     env=None if env is None else tuple(env), seed=seed, skeleton=rest_offsets(joints))
-    return EditedMotion(out, features, float(np.linalg.norm(out - joints, axis=-1).mean()))
+    skeleton, embedding = rest_offsets(joints), generator.encode_text([text])
+    out = np.zeros_like(joints, dtype=np.float64)
+    done = 0  # frames of ``out`` made so far
+    for k, (s, e) in enumerate(windows(len(joints))):
+        keys = np.full((e - s, *joints.shape[1:]), np.nan)
+        keys[:, kept] = joints[s:e, kept]
+        keys[: done - s] = out[s:done]  # the overlap with the window before, whole body
+        _, part = sample_keyframed(generator, keys, config, text_embeddings=embedding,
+                                   env=None if env is None else tuple(env), seed=seed + k, skeleton=skeleton,
+                                   progress=progress)
+        fade = np.linspace(0.0, 1.0, done - s + 2)[1:-1, None, None]  # 0 → 1 over the overlap, ends excluded
+        out[s:done] = (1.0 - fade) * out[s:done] + fade * part[: done - s]
+        out[done:e] = part[done - s:]
+        done = e
+    if len(joints) > len(keys):
+        out = rigidify(out, skeleton)  # the cross-fade mixes two fits: one skeleton again
+    out = out.astype(np.float32)
+    features = process_joints(out).features
+    return EditedMotion(out, np.concatenate([features, features[-1:]]).astype(np.float32),
+                        float(np.linalg.norm(out - joints, axis=-1).mean()))

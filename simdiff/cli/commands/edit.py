@@ -53,7 +53,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           "answer to φ)")
     inp.add_argument("--keep", choices=HALVES, metavar="lower|upper",
                      help="keep this half of the body (lower: pelvis and legs; upper: pelvis, spine, head and arms) and "
-                          "make the other anew for --text (motions up to 9.8 s)")
+                          "make the other anew for --text (longer than 9.8 s: in windows that continue each other)")
     inp.add_argument("--seed", type=SEED, default=0, metavar="S", help="noise seed (default 0)")
     out = p.add_argument_group("output")
     out.add_argument("--out", type=Path, metavar="DIR", help="output folder, files in it are replaced (default "
