@@ -122,6 +122,9 @@ def test_bad_tables_and_inputs_are_one_line(tmp_path: Path) -> None:
         write_coverage_table(tmp_path, ["", " "], HashTextEncoder())
     with pytest.raises(SimdiffError, match="0 captions"):
         CaptionIndex([], torch.zeros(0, 8), "hash", "t.safetensors")
+    minilm = SimpleNamespace(text_encoder=SimpleNamespace(name="minilm"), encode_text=lambda t: torch.ones(len(t), 8))
+    (skipped,) = prompt_warnings(tmp_path, ["a person jumps."], minilm)  # a foreign table costs a line, not the motion
+    assert skipped.startswith("the prompt check was skipped: ") and "holds 'hash' embeddings" in skipped
 
 
 def test_training_captions_read_one_split(tiny_corpus: Path) -> None:

@@ -184,3 +184,5 @@ def test_unseen_in_keeps_only_captions_the_other_split_lacks(hml_dir: Path) -> N
     assert items == {"000003_23_80": ["a person bends down"], "000003_100_150": ["a person sits"],
                      "000001": ["a person walks forward."]}
     assert len(HumanML3D(hml_dir, "val").items) == 4
+    with pytest.raises(SimdiffError, match="no item of split 'val' has a caption that 'val' lacks"):
+        HumanML3D(hml_dir, "val", unseen_in="val")

@@ -56,6 +56,13 @@ def test_body_side_posture_and_order() -> None:
     squat[20:40, 0, 1] = 0.6 * stand
     assert passes(squat, "posture:crouch") and passes(squat, "posture:sit_stand") and not passes(squat, "posture:sit")
     assert passes(squat, "count:squats=1") and not passes(still, "posture:crouch")
+    brief = still.copy()
+    brief[20:25, 0, 1] = 0.6 * stand  # a quarter-second dip: a squat's bottom, not a seat
+    assert passes(brief, "posture:crouch") and not passes(brief, "posture:sit_stand")
+    hover = still.copy()
+    hover[20:24, 0, 1] = hover[26:30, 0, 1] = 0.7 * stand  # down, just over the threshold for 0.1 s, down again
+    hover[24:26, 0, 1] = 0.76 * stand
+    assert run_check(hover, "count:squats=1").passed
     hop = jump(60, airtime=0.5, start=40).astype(np.float64)
     walked = walk(60, speed=1.2).astype(np.float64)
     both = np.concatenate([walked, hop + (walked[-1, 0] - hop[0, 0]) * [1, 0, 1]])
@@ -66,16 +73,26 @@ def test_speed_is_paired_with_its_reference() -> None:
     slow, plain = walk(80, speed=0.6), walk(80, speed=1.2)
     assert passes(slow, "speed:slower", plain) and passes(plain, "speed:faster", slow)
     assert not passes(plain, "speed:slower", plain)
+    standing = walk(80, speed=0.0)
+    verdict = run_check(standing, "speed:slower", plain)
+    assert not verdict.passed and "no pace" in verdict.reading  # ignoring the prompt by standing still is no pass
     with pytest.raises(SimdiffError, match="needs a reference motion"):
         run_check(plain, "speed:slower")
 
 
 @pytest.mark.parametrize("bad", ["direction:up", "turn", "count:jumps=two", "order:jump<jump", "side:leg=middle",
-                                 "nonsense", "circle:x"])
+                                 "nonsense", "circle:x", "order:sit<crouch"])
 def test_a_bad_check_is_one_line_naming_it(bad: str) -> None:
     with pytest.raises(SimdiffError) as err:
         parse_check(bad)
     assert repr(bad) in str(err.value) and "\n" not in str(err.value)
+
+
+def test_non_finite_motions_are_refused() -> None:
+    broken = walk(40).astype(np.float64)
+    broken[10, 3, 1] = np.nan
+    with pytest.raises(SimdiffError, match="NaN"):
+        run_check(broken, "count:jumps=0")
 
 
 def test_wilson_interval() -> None:

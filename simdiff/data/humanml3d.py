@@ -247,6 +247,8 @@ class HumanML3D(Dataset):
         if unseen_in is not None:
             seen = {normalise_caption(t) for t in split_captions(self.root, unseen_in)}
             self.items = unseen_items(self.items, seen)
+            if not self.items:
+                raise SimdiffError(f"{self.root}: no item of split {split!r} has a caption that {unseen_in!r} lacks")
         self._rng: np.random.Generator | None = None
         self._rng_key: int | None = None
 

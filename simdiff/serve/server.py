@@ -7,7 +7,7 @@ Routes:
     optionally the sampling settings ``steps, eta, guidance, alpha, env_guidance, edit_t, foot_lock`` (left out:
     the model's ``sampling.json`` values, as ``simdiff generate``) and ``pin_start``, ``pin_end``: a motion's number
     whose first (last) pose it starts (ends) in (``meta.keyframe_error_cm``) → ``{joints, fps, parents, meta, motion, body}``.
-    ``POST /api/edit`` (JSON): ``{source, gravity, wind_x, wind_y, seed}``: motion ``source`` re-played under φ as
+    ``POST /api/edit`` (JSON): ``{source, gravity, wind_x, wind_y, seed, text}``: motion ``source`` re-played under φ as
     ``simdiff edit`` → same; ``POST /api/timeline`` (JSON): ``{segments: [{text, seconds, gravity?, wind?: [x, y]}],
     seed}``, checked as a ``generate --timeline`` file → its one motion, same (both also take the sampling settings).
     ``POST /api/open?name=FILE`` (``application/octet-stream``, the file's bytes) → same.

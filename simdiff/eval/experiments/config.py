@@ -23,7 +23,7 @@ from simdiff.eval.protocol import ProtocolConfig
 
 KINDS: tuple[str, ...] = ("table1", "table2", "fig4", "fig5", "retrack", "env_response", "contacts", "editing",
                           "following", "heldout")
-"""Experiment kinds, named as in the issue (and the paper)."""
+"""Experiment kinds: the paper's tables and figures, then the project's own reports."""
 ROLES: tuple[str, ...] = ("backbone", "adapters", "adapters_binary")
 """Model roles ``paths`` may name: MDM backbone, continuous (φ) adapters, categorical (binary) adapters."""
 SAMPLERS: tuple[str, ...] = ("ddpm", "ddim")

@@ -51,6 +51,8 @@ def measure_ground_truth(runner: Runner) -> dict[str, Any]:
     clips = [c for c in manifest["clips"] if not c.get("mirror_of") and c.get("split") == runner.config.split]
     rules = []
     for rule in runner.config.following.ground_truth:
+        if not isinstance(rule, dict) or not all(rule.get(k) for k in ("category", "check", "captions")):
+            raise SimdiffError(f"ground-truth rule {rule!r} needs 'category', 'check' and 'captions'")
         parse_check(rule["check"])
         if rule["check"].startswith("speed:"):
             raise SimdiffError(f"ground-truth rule {rule['check']!r}: speed checks need a paired motion")
@@ -60,7 +62,10 @@ def measure_ground_truth(runner: Runner) -> dict[str, Any]:
         matched = [c for c in clips if any(pattern.search(t) and not (exclude and exclude.search(t))
                                            for t in c.get("captions", []))]
         for c in matched:
-            verdict = run_check(np.load(corpus / "new_joints" / f"{c['id']}.npy", allow_pickle=False), rule["check"])
+            path = corpus / "new_joints" / f"{c['id']}.npy"
+            if not path.is_file():
+                raise SimdiffError(f"{path}: missing (the corpus's manifest lists clip {c['id']!r})")
+            verdict = run_check(np.load(path, allow_pickle=False), rule["check"])
             passed += verdict.passed
             if not verdict.passed:
                 failed.append(f"{c['id']}: {verdict.reading}")
@@ -149,7 +154,7 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     lines = [(f"Wordings: the `{o.wordings}` set of `configs/eval_following.json` ({o.seeds} seeds each, {o.length} "
              f"frames, Earth, no wind); real clips: the {runner.config.split} split's originals whose captions match "
              "a rule. A motion passes when every check of its wording passes. Pass rate [95 % interval: Wilson over "
-             "real clips; bootstrap over wordings for models] (passed/n). Detectors and thresholds: `simdiff/eval/detectors.py`."), "",
+             "real clips; bootstrap over wordings for models, coarse with 3–5 wordings: read the per-wording table] (passed/n). Detectors and thresholds: `simdiff/eval/detectors.py`."), "",
              "| category | real clips | " + " | ".join(methods) + " |", "|---|---|" + "---|" * len(methods)]
     for cat in categories:
         rules = [r for r in gt["rules"] if r["category"] == cat]

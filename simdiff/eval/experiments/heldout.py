@@ -70,10 +70,11 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     rows = report["rows"]
     gt = {r["captions"]: r for r in rows if r["method"] == "Ground truth"}
     lines = [(f"The {c.split} split; `all`: every item with all its captions; `unseen`: the items with a caption no "
-             "train clip has (normalised), with only those captions. Every number: mean ± 95 % CI over "
-             f"{c.protocol.replications} replications of {runner.samples_per_replication(c.protocol)} motions or the "
-             "set's whole batches of 32 (n × R per row). R@3 / GT: the method's R@3 over ground truth's on the same "
-             "set. DDIM, Earth gravity, no wind."), "",
+              "train clip has (normalised), with only those captions. Mean ± 95 % CI over the replications; n × R: "
+              "motions per replication × replications (at most the set's whole batches). R@3 / GT: the method's R@3 "
+              "over ground truth's on the same set. DDIM; Earth gravity and no wind unless the method names φ. The "
+              "sets differ in make-up as well as in captions (items per motion type below), so a drop from `all` to "
+              "`unseen` is not only the captions' novelty."), "",
              "| method | captions | items (distinct captions) | n × R | " + " | ".join(l for _, l in T2M_METRICS)
              + " | R@3 / GT |", "|---|---|---|---|" + "---|" * (len(T2M_METRICS) + 1)]
     for r in rows:
