@@ -17,7 +17,8 @@ from simdiff.inference.default import DEFAULT_MODEL_DIR, sampling_config
 
 def test_the_shipped_model_samples_as_documented() -> None:
     assert sampling_config(DEFAULT_MODEL_DIR) == SamplingConfig(
-        sampler="ddim", steps=50, eta=1.0, guidance=3.0, alpha=0.925, env_guidance=1.1, edit_t=950, foot_lock=1.0)
+        sampler="ddim", steps=16, eta=1.0, guidance=3.0, guidance_min_t=749, alpha=0.925, env_guidance=1.1,
+        edit_t=950, foot_lock=1.0)
     stored = json.loads((DEFAULT_MODEL_DIR / "sampling.json").read_text())
     assert stored == sampling_config(DEFAULT_MODEL_DIR).to_dict()
 
@@ -33,6 +34,7 @@ def test_the_shipped_model_samples_as_documented() -> None:
     ({"alpha": math.inf}, "--alpha must be a finite number, got inf"),
     ({"env_guidance": -1}, "--env-guidance must be in \\[0, 10\\], got -1"),
     ({"edit_t": 1000}, "--edit-t must be a whole number in 0..999, got 1000"),
+    ({"guidance_min_t": -1}, "--guidance-min-t must be a whole number in 0..999, got -1"),
     ({"edit_t": True}, "--edit-t must be a whole number in 0..999, got True"),
     ({"foot_lock": 1.5}, r"--foot-lock must be in \[0, 1\], got 1.5"),
 ])
@@ -50,6 +52,8 @@ def test_updated_keeps_what_is_not_given_and_switches_sampler_defaults() -> None
     assert shipped.updated(sampler="ddpm", steps=100).steps == 100
     with pytest.raises(SimdiffError, match="--eta 1 is DDIM's noise scale"):
         shipped.updated(sampler="ddpm", eta=1.0)
+    assert shipped.updated(steps=50, guidance_min_t=0) == SamplingConfig(
+        **{**shipped.to_dict(), "steps": 50, "guidance_min_t": 0})  # the 50-step path of the model's card
 
 
 @pytest.mark.parametrize("text, message", [

@@ -139,3 +139,22 @@ def test_condition_stacked() -> None:
     assert a.stacked(b).uncond.tolist() == [False, False, False, True, False, False]
     with pytest.raises(ValueError, match="env"):
         a.stacked(Condition(text=a.text))
+
+
+def test_below_guidance_min_t_every_row_takes_its_conditional_pass_alone() -> None:
+    sd, sizes = simdiff_net(), []
+
+    def counting(x: torch.Tensor, t: torch.Tensor, c: Condition) -> torch.Tensor:
+        sizes.append(x.shape[0])
+        return sd(x, t, c)
+
+    x, c = torch.randn(3, 8, 263), cond()
+    with torch.no_grad():
+        above = GuidedDenoiser(counting, 2.5, edit_t=500, min_t=300)(x, torch.full((3,), 300), c)
+        assert sizes == [4, 4, 2] and torch.allclose(above, GuidedDenoiser(sd, 2.5, edit_t=500)(x, torch.full((3,), 300), c))
+        sizes.clear()
+        below = GuidedDenoiser(counting, 2.5, edit_t=500, min_t=301)(x, torch.full((3,), 300), c)
+        assert sizes == [2, 2, 1]  # half the rows: the unconditional passes are gone
+        t = torch.full((3,), 300)
+        assert torch.allclose(below[1], sd(x[1:2], t[:1], earth(c.select(torch.tensor([1])), alpha=0.0))[0], atol=1e-5)
+        assert torch.allclose(below[0], sd(x[:1], t[:1], c.select(torch.tensor([0])))[0], atol=1e-5)

@@ -558,12 +558,14 @@ def test_following_reports_pass_rates_on_real_clips_and_wordings(setup: dict[str
         report = run_experiment(write(setup, "following", following=options), progress=False, text_encoder=hash_text)
     finally:
         (corpus / "manifest.json").unlink()
-    rows = {r["category"]: r for r in report["rows"]}
-    gt = {r["check"]: r for r in rows["all"]["rules"]}
+    rows = {r["method"]: r for r in report["rows"]}  # one row per model, every category's wordings in it
+    gt = {r["check"]: r for r in rows["ground truth"]["rules"]}
     assert gt["travel:in_place"]["n"] == sum(1 for c in clips if c["split"] == "test" and int(c["id"]) % 2)
     assert gt["turn:around"]["n"] == 0
-    assert [len(w["seeds"]) for w in rows["speed"]["wordings"]] == [2]
-    assert all(s["readings"][0].startswith("pelvis speed") for s in rows["speed"]["wordings"][0]["seeds"])
+    model = [r for r in report["rows"] if r["method"] != "ground truth"][0]
+    speed = [w for w in model["wordings"] if w["category"] == "speed"]
+    assert [len(w["seeds"]) for w in speed] == [2] and [w["category"] for w in model["wordings"]] == ["in place", "speed"]
+    assert all(s["readings"][0].startswith("pelvis speed") for s in speed[0]["seeds"])
     md = (setup["root"] / "reports/following/report.md").read_text()
     assert "| turning | — (none) |" in md and "| speed | a person walks slowly | `speed:slower` |" in md
     bad = {**options, "prompts": {"test": [{**words[1], "reference": ""}]}}

@@ -38,6 +38,8 @@ class SamplingConfig:
         steps: denoising steps, 1..1000.
         eta: DDIM's η in [0, 1] (0: deterministic; 1: fresh noise at every step); 0 with DDPM.
         guidance: classifier-free guidance scale s ≥ 0 (1: off).
+        guidance_min_t: the text guidance runs at timesteps ≥ this (0..999) and the conditional prediction alone
+            below it, one network pass instead of two (0: guidance at every step).
         alpha: adapter strength α of SimDiff models (0: backbone only).
         env_guidance: environment guidance s_e ≥ 0 (1: off); continuous-φ models only.
         edit_t: the last timestep (0..999) at which a motion under another gravity than Earth's still follows its
@@ -49,6 +51,7 @@ class SamplingConfig:
     steps: int = 50
     eta: float = 0.0
     guidance: float = 2.5
+    guidance_min_t: int = 0
     alpha: float = 1.0
     env_guidance: float = 1.0
     edit_t: int = 950
@@ -66,17 +69,20 @@ class SamplingConfig:
         set_(self, "guidance", _number("--guidance", self.guidance, *GUIDANCE_RANGE))
         set_(self, "alpha", _number("--alpha", self.alpha, *ALPHA_RANGE))
         set_(self, "env_guidance", _number("--env-guidance", self.env_guidance, *ENV_GUIDANCE_RANGE))
+        set_(self, "guidance_min_t", _whole("--guidance-min-t", self.guidance_min_t, 0, 999))
         set_(self, "edit_t", _whole("--edit-t", self.edit_t, 0, 999))
         set_(self, "foot_lock", _number("--foot-lock", self.foot_lock, 0.0, 1.0))
 
     def updated(self, **given: Any) -> "SamplingConfig":
         """A copy with the options in ``given`` that are not None (checked). Switching the sampler without giving
-        ``steps`` or ``eta`` takes the new sampler's steps (:data:`SAMPLER_STEPS`) and η 0."""
+        ``steps``, ``eta`` or ``guidance_min_t`` takes the new sampler's steps (:data:`SAMPLER_STEPS`), η 0 and
+        guidance at every step."""
         given = {k: v for k, v in given.items() if v is not None}
         sampler = given.get("sampler", self.sampler)
         if sampler != self.sampler:
             given.setdefault("steps", SAMPLER_STEPS.get(sampler, self.steps))
             given.setdefault("eta", 0.0)
+            given.setdefault("guidance_min_t", 0)
         return replace(self, **given)
 
     def to_dict(self) -> dict[str, Any]:

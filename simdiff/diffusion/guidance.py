@@ -59,12 +59,14 @@ class GuidedDenoiser:
         env_scale: environment guidance s_e; 1 disables it. Continuous-φ models only.
         edit_t: the last timestep (0..999) at which rows off Earth's gravity follow their Earth sample.
         reference_env: φ_ref = (g_z m/s², w_x N, w_y N).
+        min_t: text guidance at timesteps ≥ ``min_t`` only; below, x₀(c) alone (one pass instead of two).
     """
 
     def __init__(self, denoiser: Denoiser, scale: float = 2.5, batched: bool = True, env_scale: float = 1.0,
-                 edit_t: int = 950, reference_env: Sequence[float] = REFERENCE_ENV) -> None:
+                 edit_t: int = 950, reference_env: Sequence[float] = REFERENCE_ENV, min_t: int = 0) -> None:
         self.denoiser = denoiser
         self.scale = float(scale)
+        self.min_t = int(min_t)
         self.batched = batched
         self.env_scale = float(env_scale)
         self.edit_t = int(edit_t)
@@ -99,7 +101,7 @@ class GuidedDenoiser:
 
     def _text_guided(self, x: Tensor, timesteps: Tensor, cond: Condition) -> tuple[Tensor, Tensor]:
         """(x₀(c) (B, T, F), its classifier-free guided x̃₀ (B, T, F)) under ``cond``'s φ and α."""
-        if self.scale == 1.0:
+        if self.scale == 1.0 or int(timesteps.max()) < self.min_t:
             out = self.denoiser(x, timesteps, cond)
             return out, out
         if self.batched:

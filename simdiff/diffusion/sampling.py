@@ -68,7 +68,8 @@ def sample(
         (b, num_frames, nfeats), generator=generator, device=generator.device if generator else device
     ).to(device)
     scheduler = make_scheduler(config.sampler, config.steps, config.eta)
-    model = GuidedDenoiser(denoiser, config.guidance, batched_cfg, env_scale=config.env_guidance, edit_t=config.edit_t)
+    model = GuidedDenoiser(denoiser, config.guidance, batched_cfg, env_scale=config.env_guidance, edit_t=config.edit_t,
+                           min_t=config.guidance_min_t)
     hooked = None if hook_timesteps is None else {int(t) for t in hook_timesteps}
     steps: Iterable[Tensor] = scheduler.timesteps
     if progress is not None:

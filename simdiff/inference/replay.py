@@ -99,7 +99,7 @@ def _denoise_from(generator: MotionGenerator, x0: Tensor, config: SamplingConfig
         cond = Condition(text=text, frame_mask=mask, alpha=config.alpha, env=env)
     # edit_t 999 here: the motion itself is the Earth sample that the steps above edit_t follow in generate
     model = GuidedDenoiser(generator.network, config.guidance if text is not None else 1.0,
-                           env_scale=config.env_guidance, edit_t=999)
+                           env_scale=config.env_guidance, edit_t=999, min_t=config.guidance_min_t)
     for t in steps if progress is None else progress(steps):
         x0_hat = model(x, torch.full((1,), t, dtype=torch.long, device=x.device), cond)
         x = scheduler.step(x0_hat, t, x, generator=gen).prev_sample

@@ -102,13 +102,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--num-samples", type=integer(1, MAX_SAMPLES), default=1, metavar="K", help="samples to generate (default 1)")
     smp.add_argument("--sampler", choices=SAMPLERS, help=f"diffusion sampler (default {cfg.sampler})")
     smp.add_argument("--steps", type=integer(1, MAX_STEPS), metavar="N",
-                     help=f"diffusion steps, 1..1000 (default {cfg.steps}; {SAMPLER_STEPS['ddpm']} with a "
-                          "--sampler switched to ddpm)")
+                     help=f"diffusion steps, 1..1000 (default {cfg.steps}; with a --sampler switched to another: "
+                          + ", ".join(f"{k} {v}" for k, v in SAMPLER_STEPS.items() if k != cfg.sampler) + ")")
     smp.add_argument("--eta", type=real(0.0, 1.0), metavar="E",
                      help=f"DDIM's noise scale in [0, 1]: 0 deterministic, 1 fresh noise at every step (default "
                           f"{cfg.eta:g})")
     smp.add_argument("--guidance", type=real(*GUIDANCE_RANGE), metavar="W",
                      help=f"classifier-free guidance scale on the text, 1 = off (default {cfg.guidance:g})")
+    smp.add_argument("--guidance-min-t", type=integer(0, MAX_STEPS - 1), metavar="T",
+                     help=f"guide by the text only at denoising timesteps >= T, one network pass per step below it "
+                          f"(0 = every step; default {cfg.guidance_min_t}; 0 with a --sampler switched to another)")
     smp.add_argument("--alpha", type=real(*ALPHA_RANGE), metavar="A",
                      help=f"strength of the environment adapters, 0 = ignore φ (default {cfg.alpha:g})")
     smp.add_argument("--foot-lock", type=real(0.0, 1.0), metavar="S",

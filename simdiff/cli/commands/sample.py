@@ -44,6 +44,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--alpha", type=real(*ALPHA_RANGE), help="adapter strength α (0 = backbone only)")
     smp.add_argument("--env-guidance", type=real(*ENV_GUIDANCE_RANGE), help="environment guidance s_e (1 = off; continuous φ only)")
     smp.add_argument("--edit-t", type=integer(0, MAX_STEPS - 1), help="last timestep (0..999) at which φ off Earth's gravity follows Earth")
+    smp.add_argument("--guidance-min-t", type=integer(0, MAX_STEPS - 1),
+                     help="text guidance only at timesteps >= this (0..999; 0 = every step)")
     smp.add_argument("--foot-lock", type=real(0.0, 1.0), help="foot cleanup strength in [0, 1] (0 = off)")
     p.add_argument("--unbatched-cfg", action="store_true", help="run CFG as two forwards (MDM's way) instead of one")
     p.add_argument("--seed", type=SEED, default=0, help="noise seed (default 0)")

@@ -42,6 +42,8 @@ class ModelSpec:
         alpha: adapter strength where the experiment does not sweep it (None: the model's ``sampling.json``).
         steps: DDIM steps; ddpm_steps: DDPM steps (None: the model's, else 50 and 1000).
         guidance: classifier-free guidance scale (None: the model's ``sampling.json``).
+        guidance_min_t: the lowest timestep guided by the text (None: the model's ``sampling.json``; 0 with
+            ``steps`` 50: the 50-step path).
         env_guidance: environment guidance s_e of continuous SimDiff models (None: the model's ``sampling.json``;
             :mod:`simdiff.diffusion.guidance`). Every other sampling setting (η, ``edit_t``, foot cleanup) is the
             model's, so a row samples as ``simdiff generate`` does with that model.
@@ -56,6 +58,8 @@ class ModelSpec:
         samplers: this method's own samplers, a subset of the table's ``samplers`` (None: the
             table's); e.g. DDPM rows for MDM, PhysDiff and SimDiff only, where every method's
             DDPM row would cost a CPU hour more.
+        compare_to: the name of a method this one is compared with, row by row (same captions and seeds): the
+            report gives their paired differences (e.g. the shipped sampling against the 50-step path).
     """
 
     name: str
@@ -67,11 +71,13 @@ class ModelSpec:
     steps: int | None = None
     ddpm_steps: int | None = None
     guidance: float | None = None
+    guidance_min_t: int | None = None
     env_guidance: float | None = None
     physdiff: dict[str, Any] | None = None
     simulate: bool = False
     alphas: list[float | str] | None = None
     samplers: list[str] | None = None
+    compare_to: str | None = None
 
     def sampler_steps(self, sampler: str) -> int | None:
         """Steps of ``sampler`` for this method."""
@@ -424,6 +430,8 @@ def check(config: ExperimentConfig, origin: str | os.PathLike[str] = "config") -
             if extra or not spec.samplers:
                 raise SimdiffError(f"{origin}: model {spec.name!r} sampler {extra[0] if extra else '(none)'!r} is not "
                                    f"one of the table's samplers ({', '.join(config.samplers)})")
+        if spec.compare_to is not None and spec.compare_to not in [m.name for m in config.models if m is not spec]:
+            raise SimdiffError(f"{origin}: model {spec.name!r} compare_to {spec.compare_to!r} names no other model")
     for env in config.envs + config.env_control.combos:
         if len(env) != 3:
             raise SimdiffError(f"{origin}: environment {env!r} must be 3 numbers (g_z, w_x, w_y)")

@@ -74,8 +74,8 @@ def measure_ground_truth(runner: Runner) -> dict[str, Any]:
     return {"rules": rules}
 
 
-def measure_model(runner: Runner, spec: ModelSpec, category: str) -> dict[str, Any]:
-    """Every wording of ``category`` × seeds; per wording the verdicts of every seed."""
+def measure_model(runner: Runner, spec: ModelSpec) -> dict[str, Any]:
+    """Every wording × seeds; per wording its category and the verdicts of every seed."""
     from simdiff.motion.rigid import batch_joints_from_features
 
     o = runner.config.following
@@ -87,14 +87,14 @@ def measure_model(runner: Runner, spec: ModelSpec, category: str) -> dict[str, A
         return batch_joints_from_features(feats, [o.length] * o.seeds, fn.foot_lock)
 
     out = []
-    for p in (p for p in _prompts(runner) if p["category"] == category):
+    for p in _prompts(runner):
         joints = motions(p["text"])
         reference = motions(p["reference"]) if p.get("reference") else [None] * o.seeds
         seeds = []
         for j, ref in zip(joints, reference):
             verdicts = [run_check(j, check, ref) for check in p["checks"]]
             seeds.append({"passed": all(v.passed for v in verdicts), "readings": [v.reading for v in verdicts]})
-        out.append({"text": p["text"], "checks": p["checks"], "seeds": seeds})
+        out.append({"category": p["category"], "text": p["text"], "checks": p["checks"], "seeds": seeds})
     return {"wordings": out}
 
 
@@ -106,16 +106,13 @@ def plan(runner: Runner) -> list[RowPlan]:
     plans = [RowPlan("ground_truth", {"method": "ground truth", "category": "all"},
                      {"row": "following_gt", "rules": o.ground_truth, "detectors": thresholds(), **runner.data_inputs()}, 10.0,
                      measure_ground_truth)]
-    for spec in c.models:
+    n = sum(2 if p.get("reference") else 1 for p in prompts) * o.seeds
+    for spec in c.models:  # one row per model: every category's wordings
         base = runner.method_inputs(spec, "ddim", runner.alpha(spec) if runner.is_simdiff(spec) else None, EARTH)
-        for category in dict.fromkeys(p["category"] for p in prompts):
-            mine = [p for p in prompts if p["category"] == category]
-            n = sum(2 if p.get("reference") else 1 for p in mine) * o.seeds
-            inputs = {"row": "following", "prompts": mine, "seeds": o.seeds, "length": o.length, "seed": c.seed,
-                      "detectors": thresholds(), **base}
-            plans.append(RowPlan(safe(f"{spec.name}_{category}"), {"method": spec.name, "category": category}, inputs,
-                                 runner.motion_seconds(spec, "ddim", n),
-                                 lambda r, spec=spec, category=category: measure_model(r, spec, category)))
+        inputs = {"row": "following", "prompts": prompts, "seeds": o.seeds, "length": o.length, "seed": c.seed,
+                  "detectors": thresholds(), **base}
+        plans.append(RowPlan(safe(spec.name), {"method": spec.name}, inputs, runner.motion_seconds(spec, "ddim", n),
+                             lambda r, spec=spec: measure_model(r, spec)))
     return plans
 
 
@@ -149,7 +146,8 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     rows = report["rows"]
     gt = next((r for r in rows if r["method"] == "ground truth"), {"rules": []})
     models = [r for r in rows if r["method"] != "ground truth"]
-    categories = list(dict.fromkeys([r["category"] for r in gt["rules"]] + [r["category"] for r in models]))
+    categories = list(dict.fromkeys([r["category"] for r in gt["rules"]] +
+                                    [w["category"] for r in models for w in r["wordings"]]))
     methods = list(dict.fromkeys(r["method"] for r in models))
     lines = [(f"Wordings: the `{o.wordings}` set of `configs/eval_following.json` ({o.seeds} seeds each, {o.length} "
              f"frames, Earth, no wind); real clips: the {runner.config.split} split's originals whose captions match "
@@ -159,7 +157,7 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     for cat in categories:
         rules = [r for r in gt["rules"] if r["category"] == cat]
         real = _rate(sum(r["passed"] for r in rules), sum(r["n"] for r in rules))
-        cells = [_wording_rate([w for r in models if r["method"] == m and r["category"] == cat for w in r["wordings"]])
+        cells = [_wording_rate([w for r in models if r["method"] == m for w in r["wordings"] if w["category"] == cat])
                  for m in methods]
         lines.append(f"| {cat} | {real} | " + " | ".join(cells) + " |")
     lines += ["", "Real clips per detector (caption rule → check):", "", "| category | check | pass | failing (first) |",
@@ -174,6 +172,6 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
             for w in r["wordings"]:
                 k = sum(s["passed"] for s in w["seeds"])
                 readings = " / ".join("; ".join(s["readings"]) for s in w["seeds"][:2])
-                lines.append(f"| {r['category']} | {w['text']} | {', '.join(f'`{c}`' for c in w['checks'])} | "
+                lines.append(f"| {w['category']} | {w['text']} | {', '.join(f'`{c}`' for c in w['checks'])} | "
                              f"{k}/{len(w['seeds'])} | {readings} |")
     return lines

@@ -308,7 +308,8 @@ class Runner:
         env_guidance = spec.env_guidance if self.sim_mode(spec) == "continuous" else 1.0  # φ-blind: no φ to push
         eta = 0.0 if spec.physdiff is not None else None  # PhysDiff's projection sampler is deterministic DDIM
         return sampling_config(self.config.model_path(spec)).updated(
-            sampler=sampler, steps=spec.sampler_steps(sampler), guidance=spec.guidance, eta=eta,
+            sampler=sampler, steps=spec.sampler_steps(sampler), guidance=spec.guidance,
+            guidance_min_t=spec.guidance_min_t, eta=eta,
             env_guidance=env_guidance, alpha=spec.alpha if alpha is None else float(alpha))
 
     def alpha(self, spec: ModelSpec) -> float:  # the α of a method where the experiment does not sweep it

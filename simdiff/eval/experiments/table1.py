@@ -15,7 +15,7 @@ from typing import Any
 from simdiff.eval.experiments.rows import ground_truth_plan, method_plan
 from simdiff.eval.experiments.runner import RowPlan, Runner
 from simdiff.eval.experiments.report import speed_comparison
-from simdiff.eval.experiments.tables import method_figure, metrics_table
+from simdiff.eval.experiments.tables import method_figure, metrics_table, paired_differences
 
 TITLE = "Table 1 — MDM, PhysDiff and SimDiff with DDPM and DDIM"
 
@@ -67,9 +67,10 @@ def plan(runner: Runner) -> list[RowPlan]:
         for sampler in spec.own_samplers(c.samplers):
             if runner.is_simdiff(spec):
                 pairs = (sim_alphas if spec.alphas is None else alphas(runner, spec.alphas)) or [(runner.alpha(spec), "model")]
-                plans += [method_plan(runner, spec, sampler, a, alpha_choice=why) for a, why in pairs]
+                plans += [method_plan(runner, spec, sampler, a, alpha_choice=why, compare_to=spec.compare_to)
+                          for a, why in pairs]
             else:
-                plans.append(method_plan(runner, spec, sampler, None))
+                plans.append(method_plan(runner, spec, sampler, None, compare_to=spec.compare_to))
     return plans
 
 
@@ -91,7 +92,7 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     report["best_alpha"] = {"alpha": value, "source": source}
     figure = method_figure(report["rows"], runner.out / "table1.png")
     physdiff = [m for m in c.models if m.physdiff is not None]
-    lines = metrics_table(report["rows"])
+    lines = metrics_table(report["rows"]) + paired_differences(report["rows"])
     lines += ["", f"* best α: {value if value is not None else '—'} ({source})",
               f"* protocol (DDIM rows): {c.protocol.replications} replications × {runner.samples_per_replication(c.protocol)} "
               f"test motions (batches of {c.protocol.batch_size}, samples_limit {c.protocol.samples_limit}); MultiModality "

@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from simdiff.eval.experiments.report import FID_NOTE, INTERVAL_NOTE, OWN_FLOOR_NOTE, PHYS_ERR_NOTE, PHYSICS_METRICS, T2M_METRICS, mean_ci, save_figure, value
+from simdiff.eval.experiments.report import (FID_NOTE, INTERVAL_NOTE, METRIC_LABELS, OWN_FLOOR_NOTE, PHYS_ERR_NOTE,
+                                          PHYSICS_METRICS, T2M_METRICS, mean_ci, save_figure, value)
 from simdiff.eval.experiments.rows import phys_err, phys_err_ci
 
 
@@ -90,3 +91,30 @@ def method_figure(rows: list[dict[str, Any]], path: Path) -> Path:
     for ax in axes:
         ax.set_xticks(range(len(rows)), labels, fontsize=7, rotation=45, ha="right")
     return save_figure(fig, path)
+
+
+PAIRED_METRICS: tuple[str, ...] = ("r_precision_top3", "fid", "mm_dist", "diversity", "floating_to_gt", "sliding",
+                                   "skate_ratio")
+"""Metrics of the paired comparisons."""
+
+
+def paired_differences(rows: list[dict[str, Any]]) -> list[str]:
+    """Each protocol row of a method with ``compare_to`` minus that method's row of the same sampler and α, paired by
+    replication (same test captions, lengths and noise seeds): mean ± 95 % t-interval over replications."""
+    from simdiff.eval.stats import t_interval
+
+    lines = []
+    for r in rows:
+        ref = next((q for q in rows if r.get("compare_to") and q.get("method") == r["compare_to"]
+                    and q.get("sampler") == r.get("sampler") and q.get("alpha") == r.get("alpha")
+                    and "replications" in q), None)
+        if ref is None or "replications" not in r:
+            continue
+        pairs = list(zip(r["replications"], ref["replications"]))
+        cells = []
+        for key in PAIRED_METRICS:
+            mean, half = t_interval([a[key] - b[key] for a, b in pairs])
+            cells.append(f"{METRIC_LABELS[key]} {mean:+.3f} ± {half:.3f}")
+        lines.append(f"* {r['method']} − {ref['method']} ({len(pairs)} paired replications): " + "; ".join(cells))
+    return (["", "Paired differences (same captions and seeds; an interval that holds 0 is a difference within "
+             "noise):"] + lines) if lines else []
