@@ -413,6 +413,15 @@ def test_generate_edit_t_from_sampling_json_or_the_request(server, model_dir):
         assert status == 400 and message in out["error"], out
 
 
+def test_generate_guidance_min_t_from_the_request(server, model_dir):
+    walk = {"text": "a person walks", "seconds": 1.0, "seed": 3, "guidance": 2.0}
+    status, early, _ = call(server, "/api/generate", {**walk, "guidance_min_t": 999})
+    assert status == 200 and early["meta"]["sampling"]["guidance_min_t"] == 999
+    assert early["joints"] != call(server, "/api/generate", walk)[1]["joints"]  # unguided at every step below 999
+    status, out, _ = call(server, "/api/generate", {**walk, "guidance_min_t": -1})
+    assert status == 400 and "guidance_min_t must be in [0, 999], got -1" in out["error"], out
+
+
 def test_the_viewer_and_the_cli_give_the_same_joints(server, model_dir, tmp_path):
     """Same prompt, seed and φ, the model's sampling.json for both (non-round values, as the shipped model's):
     the viewer's joints are the CLI's (to the 0.1 mm the wire rounds to)."""

@@ -41,7 +41,8 @@ MAX_TIMELINE_SEGMENTS: int = 8
 """Most segments of one ``POST /api/timeline`` (one sample each); ``generate --timeline`` takes more."""
 
 
-SAMPLING_FIELDS: tuple[str, ...] = ("steps", "eta", "guidance", "alpha", "env_guidance", "edit_t", "foot_lock")
+SAMPLING_FIELDS: tuple[str, ...] = ("steps", "eta", "guidance", "guidance_min_t", "alpha", "env_guidance",
+                                    "edit_t", "foot_lock")
 """The :class:`~simdiff.diffusion.config.SamplingConfig` fields a request may set (None: the model's value)."""
 
 
@@ -57,7 +58,7 @@ class GenerateParams:
         seed: noise seed (≥ 0).
         simulate: simulated finish: re-track the motion in the simulator under φ; the answer shows the
             simulated motion and carries the generated one and the tracking result in ``meta``.
-        steps, eta, guidance, alpha, env_guidance, edit_t, foot_lock: the
+        steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock: the
             :class:`~simdiff.diffusion.config.SamplingConfig` fields, or None for the model's ``sampling.json``
             value, as ``simdiff generate``.
         pin_start, pin_end: None, or the number of a motion shown (an answer's ``motion``) whose first (last)
@@ -77,6 +78,7 @@ class GenerateParams:
     alpha: float | None = None
     env_guidance: float | None = None
     edit_t: int | None = None
+    guidance_min_t: int | None = None
     foot_lock: float | None = None
     pin_start: int | None = None
     pin_end: int | None = None
@@ -100,7 +102,7 @@ def limits() -> dict[str, Any]:
     return {
         "gravity": list(GRAVITY_RANGE), "wind": MAX_WIND, "alpha": list(ALPHA_RANGE), "seconds": MAX_SECONDS,
         "min_seconds": MIN_SECONDS, "fps": FPS, "steps": MAX_STEPS, "guidance": list(GUIDANCE_RANGE), "text": MAX_TEXT,
-        "env_guidance": list(ENV_GUIDANCE_RANGE), "edit_t": [0, 999], "replay_seconds": MAX_REPLAY_FRAMES / FPS,
+        "env_guidance": list(ENV_GUIDANCE_RANGE), "edit_t": [0, 999], "guidance_min_t": [0, 999], "replay_seconds": MAX_REPLAY_FRAMES / FPS,
         "timeline_segments": MAX_TIMELINE_SEGMENTS,
     }
 
@@ -189,7 +191,7 @@ def parse_seed(body: Mapping[str, Any]) -> int:
 def parse_sampling(body: Mapping[str, Any]) -> dict[str, Any]:
     """The :data:`SAMPLING_FIELDS` a request gives (None: the model's), each within its range."""
     sampling: dict[str, Any] = {}
-    for key, (low, high) in {"steps": (1, MAX_STEPS), "edit_t": (0, 999)}.items():
+    for key, (low, high) in {"steps": (1, MAX_STEPS), "edit_t": (0, 999), "guidance_min_t": (0, 999)}.items():
         value = _integer(body, key, None)
         if value is not None:
             _check_range(key, value, low, high)
@@ -217,7 +219,7 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, seconds, seed, simulate, steps, eta,
-            guidance, alpha, env_guidance, edit_t, foot_lock, pin_start, pin_end}``; everything but ``text`` is
+            guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock, pin_start, pin_end}``; everything but ``text`` is
             optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -267,7 +269,7 @@ class ReplayParams:
 
 def parse_replay(body: Any) -> ReplayParams:
     """Validate a ``POST /api/edit`` body ``{source, gravity, wind_x, wind_y, seed, text, steps, eta, guidance,
-    alpha, env_guidance, edit_t, foot_lock}`` (all but ``source`` optional); one line naming the bad value."""
+    guidance_min_t, alpha, env_guidance, edit_t, foot_lock}`` (all but ``source`` optional); one line naming the bad value."""
     check_fields(body, {"source", "gravity", "wind_x", "wind_y", "seed", "text", *SAMPLING_FIELDS})
     source = parse_motion(body, "source")
     if source is None:
@@ -291,7 +293,7 @@ class TimelineParams:
 
 def parse_timeline_request(body: Any) -> TimelineParams:
     """Validate a ``POST /api/timeline`` body ``{segments: [{text, seconds, gravity?, wind?: [x, y]}, ...], seed,
-    steps, eta, guidance, alpha, env_guidance, edit_t, foot_lock}``: the segments as ``generate --timeline``
+    steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock}``: the segments as ``generate --timeline``
     checks a file's (:func:`~simdiff.product.request.parse_timeline`, the same one-line messages), at most
     :data:`MAX_TIMELINE_SEGMENTS` of them."""
     check_fields(body, {"segments", "seed", *SAMPLING_FIELDS})
