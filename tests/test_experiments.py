@@ -604,3 +604,17 @@ def test_heldout_measures_all_and_unseen_captions(setup: dict[str, Path]) -> Non
     assert rows[("Ground truth", "unseen")]["distinct_captions"] == unseen
     md = (setup["root"] / "reports/heldout/report.md").read_text()
     assert f"| MDM | unseen | {unseen} ({unseen}) |" in md
+
+
+def test_paired_differences_pair_rows_by_replication() -> None:
+    from simdiff.eval.experiments.tables import PAIRED_METRICS, paired_differences
+
+    def row(method: str, r3: list[float], compare_to: str | None = None) -> dict:
+        reps = [{**{k: 1.0 for k in PAIRED_METRICS}, "r_precision_top3": v} for v in r3]
+        return {"method": method, "sampler": "ddim", "alpha": None, "replications": reps, "compare_to": compare_to}
+
+    rows = [row("fast", [0.5, 0.7, 0.9], compare_to="slow"), row("slow", [0.6, 0.8, 1.0]), row("other", [0.1, 0.1, 0.1])]
+    lines = paired_differences(rows)
+    assert len(lines) == 3 and lines[2].startswith("* fast − slow (3 paired replications): R@3↑ -0.100 ± 0.000")
+    assert "FID↓ +0.000" in lines[2]
+    assert paired_differences(rows[1:]) == []  # nothing to compare
