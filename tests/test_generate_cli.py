@@ -145,12 +145,13 @@ def test_help_lists_every_option_with_the_shipped_defaults() -> None:
     proc = subprocess.run([sys.executable, "-m", "simdiff", "generate", "--help"], capture_output=True, text=True)
     assert proc.returncode == 0
     options = ("-h", "--gravity", "--wind", "--compare", "--simulate", "--force", "--length", "--seed",
-               "--num-samples", "--sampler", "--steps", "--eta", "--guidance", "--alpha", "--foot-lock",
+               "--num-samples", "--sampler", "--steps", "--eta", "--guidance", "--guidance-min-t", "--alpha", "--foot-lock",
                "--env-guidance", "--edit-t", "--keyframes", "--timeline", "--out", "--format", "--quiet", "--model",
                "--device")
     usage = proc.stdout.split("\n\n")[0]
     assert set(re.findall(r"\[(-[-\w]+)", usage)) == set(options) - {"--quiet"} | {"-q"}
-    for default in ("(default 3)", "(default 0.925)", "(default 1.1)", "(default 950)", "(default 1)"):
+    for default in ("(default 3)", "(default 0.925)", "(default 1.1)", "(default 950)", "(default 1)", "(default 16;",
+                    "default 749;"):
         assert default in " ".join(proc.stdout.split()), default
 
 
