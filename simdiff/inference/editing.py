@@ -126,7 +126,8 @@ def keep_half(generator: MotionGenerator, joints: np.ndarray, config: SamplingCo
     skeleton, embedding = rest_offsets(joints), generator.encode_text([text])
     out = np.zeros_like(joints, dtype=np.float64)
     done = 0  # frames of ``out`` made so far
-    for k, (s, e) in enumerate(windows(len(joints))):
+    spans = windows(len(joints))
+    for k, (s, e) in enumerate(spans):
         keys = np.full((e - s, *joints.shape[1:]), np.nan)
         keys[:, kept] = joints[s:e, kept]
         keys[: done - s] = out[s:done]  # the overlap with the window before, whole body
@@ -137,7 +138,7 @@ def keep_half(generator: MotionGenerator, joints: np.ndarray, config: SamplingCo
         out[s:done] = (1.0 - fade) * out[s:done] + fade * part[: done - s]
         out[done:e] = part[done - s:]
         done = e
-    if len(joints) > len(keys):
+    if len(spans) > 1:
         out = rigidify(out, skeleton)  # the cross-fade mixes two fits: one skeleton again
     out = out.astype(np.float32)
     features = process_joints(out).features
