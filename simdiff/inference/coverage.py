@@ -153,6 +153,8 @@ def prompt_warnings(model_dir: str | os.PathLike[str], texts: Sequence[str], gen
     """The one-line warnings of the distinct ``texts`` far from the model's training captions (none without a
     table), encoded by ``generator``'s text encoder (a stand-in's own name, else the model config's)."""
     try:
+        if load_caption_index(model_dir) is None:  # no table: the generator's encoder is not even looked up
+            return []
         name = getattr(generator.text_encoder, "name", None) or generator.config.text_encoder
         checked = check_prompts(model_dir, texts, generator.encode_text, name) or []
     except SimdiffError as exc:  # a broken or foreign table must not cost the motion it was asked about
