@@ -137,3 +137,29 @@ def test_masked_batch_gives_each_sample_at_its_own_length(mask_frames: bool) -> 
     first = sample(net, cond=Condition(text=text[:1], frame_mask=torch.ones(1, 20, dtype=torch.bool),
                                                             env=env[:1], alpha=0.5), num_frames=20, x_init=x_init[:1], **kw)
     assert torch.allclose(batch[0], first[0], atol=1e-4)  # the longest sample has no padding either way
+
+
+def test_single_prompt_embeddings_are_cached_and_batches_encoded_whole(monkeypatch) -> None:
+    import simdiff.inference.generator as generator_module
+
+    class Counting(HashText):
+        def __init__(self) -> None:
+            self.seen: list[list[str]] = []
+
+        def encode(self, texts: list[str]) -> torch.Tensor:
+            self.seen.append(list(texts))
+            return super().encode(texts)
+
+    encoder = Counting()
+    config = tiny()
+    gen = MotionGenerator(build_network(config), config, encoder)
+    first = gen.encode_text(["a person walks"])
+    first.add_(1.0)  # a caller changing its copy does not change the cache
+    assert torch.equal(gen.encode_text(["a person walks"]), HashText().encode(["a person walks"]))
+    gen.encode_text(["a person walks", "a person jumps"])
+    gen.encode_text(["a person walks", "a person jumps"])
+    assert encoder.seen == [["a person walks"]] + [["a person walks", "a person jumps"]] * 2
+    monkeypatch.setattr(generator_module, "EMBEDDING_CACHE", 2)
+    for text in ["b", "c", "a person walks"]:
+        gen.encode_text([text])
+    assert encoder.seen[-3:] == [["b"], ["c"], ["a person walks"]]  # the oldest went first

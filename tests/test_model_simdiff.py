@@ -56,6 +56,21 @@ def test_alpha_zero_equals_backbone_after_adapters_are_trained() -> None:
         assert torch.equal(out[0], ref[0]) and torch.equal(out[2], ref[2]) and not torch.allclose(out[1], ref[1])
 
 
+def test_alpha_zero_skips_the_adapters() -> None:
+    net, _ = make()
+    calls: list[int] = []
+    for adapter in net.adapters:
+        adapter.register_forward_hook(lambda *_: calls.append(1))
+    x, t, c = inputs()
+    with torch.no_grad():
+        c.alpha = torch.zeros(3)
+        net(x, t, c)
+        assert not calls
+        c.alpha = torch.tensor([0.0, 1.0, 0.0])
+        net(x, t, c)
+    assert len(calls) == len(net.adapters)
+
+
 def test_adapter_formula_and_zero_init() -> None:
     a = MotionAdapter(8, 4)
     assert torch.count_nonzero(a.up.weight) == 0 and torch.count_nonzero(a.up.bias) == 0

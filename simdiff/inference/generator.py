@@ -22,6 +22,10 @@ from simdiff.model.config import ModelConfig
 from simdiff.motion.skeleton import MAX_FRAMES, MIN_GENERATE_FRAMES
 
 
+EMBEDDING_CACHE: int = 256
+"""Single prompts whose text embedding a generator keeps (oldest dropped first)."""
+
+
 @dataclass
 class Generation:
     """Sampled motions.
@@ -58,6 +62,7 @@ class MotionGenerator:
         self.network = network.to(self.device).eval().requires_grad_(False)
         self.config = config
         self.text_encoder = text_encoder
+        self._embedded: dict[str, Tensor] = {}  # one prompt at a time (generate, the viewer): its embedding
         n = config.backbone.nfeats
         self.mean = (mean if mean is not None else torch.zeros(n)).float().to(self.device)
         self.std = (std if std is not None else torch.ones(n)).float().to(self.device)
@@ -86,7 +91,14 @@ class MotionGenerator:
         """(B,) captions → (B, text_dim) on this device."""
         if self.text_encoder is None:
             raise SimdiffError("this generator was loaded without a text encoder")
-        return self.text_encoder.encode(list(texts)).float().to(self.device)  # type: ignore[attr-defined]
+        texts = list(texts)
+        if len(texts) != 1:  # batches are encoded whole: padding makes a caption's numbers depend on its batch
+            return self.text_encoder.encode(texts).float().to(self.device)  # type: ignore[attr-defined]
+        if texts[0] not in self._embedded:  # a viewer dragging sliders asks for one prompt again and again
+            if len(self._embedded) >= EMBEDDING_CACHE:
+                self._embedded.pop(next(iter(self._embedded)))
+            self._embedded[texts[0]] = self.text_encoder.encode(texts).float().to(self.device)  # type: ignore
+        return self._embedded[texts[0]].clone()
 
     @torch.no_grad()
     def generate(
