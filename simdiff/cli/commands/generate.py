@@ -49,8 +49,8 @@ examples:
   simdiff generate --timeline day.json
 
 --keyframes: frame 0 starts where the keyframes put the root and faces where their hips and shoulders face (at the
-origin facing +Z when not given); whole poses and root entries are met within 2 cm, joints given alone as far as the
-skeleton allows (a warning says when one is off by more).
+origin facing +Z when not given); every entry the skeleton can reach is met within 2 cm, joints given alone too
+(inverse kinematics on the motion's fixed bones); a warning says when one ends further away.
 
 a prompt (or timeline segment) far from every caption the model trained on gets a warning naming the nearest ones:
 the model has probably not learned that motion (the model folder's captions.safetensors; `simdiff train coverage`).
