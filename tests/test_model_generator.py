@@ -163,3 +163,8 @@ def test_single_prompt_embeddings_are_cached_and_batches_encoded_whole(monkeypat
     for text in ["b", "c", "a person walks"]:
         gen.encode_text([text])
     assert encoder.seen[-3:] == [["b"], ["c"], ["a person walks"]]  # the oldest went first
+    gen.text_encoder = HashText()  # another encoder: nothing cached from the first one is reused
+    assert torch.equal(gen.encode_text(["b"]), HashText().encode(["b"])) and encoder.seen[-1] == ["a person walks"]
+    monkeypatch.setattr(generator_module, "EMBEDDING_CACHE", 0)  # 0 turns the cache off
+    gen.encode_text(["z"])
+    assert "z" not in gen._embedded

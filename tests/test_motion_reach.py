@@ -50,6 +50,7 @@ def test_a_kept_upper_body_and_a_root_path_are_met(walk) -> None:
 def test_nothing_given_changes_nothing_and_shapes_are_checked(walk) -> None:
     motion, before = walk
     assert reach(motion, np.full_like(before, np.nan)) is motion
+    assert reach(motion, before) is motion  # everything given is already met: nothing to solve
     with pytest.raises(ValueError, match="targets must be"):
         reach(motion, np.zeros((3, 22, 3)))
 

@@ -61,8 +61,8 @@ class MotionGenerator:
         self.device = torch.device(device)
         self.network = network.to(self.device).eval().requires_grad_(False)
         self.config = config
-        self.text_encoder = text_encoder
         self._embedded: dict[str, Tensor] = {}  # one prompt at a time (generate, the viewer): its embedding
+        self.text_encoder = text_encoder
         n = config.backbone.nfeats
         self.mean = (mean if mean is not None else torch.zeros(n)).float().to(self.device)
         self.std = (std if std is not None else torch.ones(n)).float().to(self.device)
@@ -84,6 +84,16 @@ class MotionGenerator:
         save_pretrained(folder, self.network, self.config, {"normalizer.mean": self.mean, "normalizer.std": self.std})
 
     @property
+    def text_encoder(self) -> object | None:
+        """The text encoder (``encode(list[str]) -> (B, text_dim)``); setting another forgets the cached embeddings."""
+        return self._text_encoder
+
+    @text_encoder.setter
+    def text_encoder(self, encoder: object | None) -> None:
+        self._text_encoder = encoder
+        self._embedded.clear()
+
+    @property
     def is_simdiff(self) -> bool:
         return self.config.sim is not None
 
@@ -92,10 +102,10 @@ class MotionGenerator:
         if self.text_encoder is None:
             raise SimdiffError("this generator was loaded without a text encoder")
         texts = list(texts)
-        if len(texts) != 1:  # batches are encoded whole: padding makes a caption's numbers depend on its batch
+        if len(texts) != 1 or EMBEDDING_CACHE < 1:  # batches are encoded whole: padding makes a caption's numbers depend on its batch
             return self.text_encoder.encode(texts).float().to(self.device)  # type: ignore[attr-defined]
         if texts[0] not in self._embedded:  # a viewer dragging sliders asks for one prompt again and again
-            if len(self._embedded) >= EMBEDDING_CACHE:
+            while len(self._embedded) >= EMBEDDING_CACHE:
                 self._embedded.pop(next(iter(self._embedded)))
             self._embedded[texts[0]] = self.text_encoder.encode(texts).float().to(self.device)  # type: ignore
         return self._embedded[texts[0]].clone()

@@ -257,7 +257,7 @@ def meet_keyframes(joints: np.ndarray, keys: np.ndarray, skeleton: np.ndarray | 
     :data:`MIN_BODY_JOINTS` given joints; interpolated between the frames that give them), then each given pose's
     residual faded in and out over :data:`BLEND_FRAMES` (joints given alone likewise), then rotations fitted again on
     ``skeleton`` ((22, 3) rest offsets; default: that of the given poses, the motion's own when no whole pose is
-    given) and turned by inverse kinematics until every given coordinate is met (:func:`simdiff.motion.reach.reach`;
+    given) and turned by inverse kinematics onto every given coordinate within reach (:func:`simdiff.motion.reach.reach`;
     the fit alone left a wrist given without its pose 15 cm off). float32 (T, 22, 3)."""
     from simdiff.motion.reach import reach
     from simdiff.motion.rigid import fit, rest_offsets

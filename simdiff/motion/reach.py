@@ -1,8 +1,8 @@
 """Inverse kinematics on a rigid skeleton: bring the joints a user gave onto their targets, bones kept.
 
 :func:`simdiff.motion.rigid.fit` keeps bone directions, so a joint given without its whole pose (a wrist alone, a
-kept upper body above new legs) ends where its chain's lengths put it, centimetres off. :func:`reach` turns the
-fitted local rotations and moves the root, all frames at once, to minimise (in this order of weight)
+kept upper body above new legs) ends where its chain's lengths put it, centimetres off. :func:`reach` corrects the
+fitted rotations (as global rotations) and moves the root, all frames at once, to minimise (in this order of weight)
 
 * the distance of every given coordinate from its target;
 * how far the joints nobody gave move from where the fit put them (so planted feet stay planted);
@@ -34,6 +34,8 @@ ROOT_STEP_SCALE: float = 0.01
 """m per frame: the same for the root's correction."""
 ROTATION_SCALE: float = 1.0
 """rad: the rotation correction that costs one unit (keeps frames without targets well posed)."""
+MET: float = 0.0005
+"""m: when every given coordinate is already this close (whole poses the fit met), nothing is solved."""
 ITERATIONS: int = 100
 """L-BFGS iterations at most: enough for a lone wrist 15 cm off (0.7 mm left) and for a kept walk's legs under a new
 wave (3 mm), 0.5 s for 196 frames on 2 cores."""
@@ -64,7 +66,8 @@ def _ancestry() -> np.ndarray:
 
 def reach(motion: RigidMotion, targets: np.ndarray, iterations: int = ITERATIONS) -> RigidMotion:
     """``motion`` with its rotations and root corrected towards ``targets`` (T, 22, 3), NaN = free (any single
-    coordinate may be free, e.g. a root path's y). Unchanged when nothing is given."""
+    coordinate may be free, e.g. a root path's y). Unchanged when nothing is given or everything given is met
+    within :data:`MET`; a target out of the skeleton's reach ends as near as the weights allow."""
     targets = np.asarray(targets, dtype=np.float64)
     given_np = np.isfinite(targets)
     if targets.shape != motion.root.shape[:1] + (NUM_JOINTS, 3):
@@ -89,6 +92,8 @@ def reach(motion: RigidMotion, targets: np.ndarray, iterations: int = ITERATIONS
 
     with torch.no_grad():
         start = positions(glob0, root0)
+    if float(((start - goal) * given).abs().max()) < MET:
+        return motion
     # corrections of the global rotations: turning the pelvis leaves the spine's orientation alone, which made
     # L-BFGS converge in 100 iterations where local corrections needed over 1,000 (a kept walk's legs under a wave)
     turn = torch.zeros(glob0.shape[:2] + (3,), dtype=torch.float64, device=cpu, requires_grad=True)

@@ -64,8 +64,9 @@ def matrix_to_euler(matrix: np.ndarray, order: str, *, degrees: bool = True) -> 
     # closed form, not scipy's Rotation: importing scipy.spatial costs 0.4 s of a cold `generate --format bvh`
     i, j, k = (_AXES[a] for a in order.upper())
     sign = 1.0 if (j - i) % 3 == 1 else -1.0  # +1 for cyclic orders (XYZ, YZX, ZXY)
-    middle = np.arcsin(np.clip(sign * m[..., i, k], -1.0, 1.0))
-    locked = np.abs(m[..., i, k]) > 1.0 - 1e-12  # middle angle ±90°: the first and last axes coincide
+    cos_middle = np.hypot(m[..., i, i], m[..., i, j])
+    middle = np.arctan2(sign * m[..., i, k], cos_middle)  # atan2, not asin: full precision next to ±90°
+    locked = cos_middle < 1e-9  # middle angle ±90°: the first and last axes coincide
     first = np.where(locked, np.arctan2(sign * m[..., k, j], m[..., j, j]),
                      np.arctan2(-sign * m[..., j, k], m[..., k, k]))
     last = np.where(locked, 0.0, np.arctan2(-sign * m[..., i, j], m[..., i, i]))
