@@ -85,7 +85,10 @@ def test_one_2b_forward_per_step_plus_the_wind_and_edited_rows() -> None:
         assert sizes == [6, 4, 4, 4, 2]
         sizes.clear()
         GuidedDenoiser(counting, 2.5, env_scale=2.0, edit_t=500)(x, torch.full((3,), 300), cond())
-        assert sizes == [4, 4, 2, 1]  # s_e ≠ 1: one more pass over the edited row at φ_ref
+        assert sizes == [4, 4, 3]  # s_e ≠ 1: the edited row at φ_ref rides in its text passes' forward
+        sizes.clear()
+        GuidedDenoiser(counting, 2.5, env_scale=2.0, edit_t=500, min_t=400)(x, torch.full((3,), 300), cond())
+        assert sizes == [2, 2, 2]  # below min_t no text guidance: conditional rows only, the reference beside them
 
 
 def test_per_row_alpha_and_text_drop_are_kept() -> None:
