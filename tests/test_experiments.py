@@ -522,6 +522,7 @@ def test_editing_reports_replays_keyframes_and_a_timeline(setup: dict[str, Path]
               "split": "test" if i in test else "train"} for i in ids]
     (corpus / "manifest.json").write_text(json.dumps({"clips": clips}))
     options = {"replay_clips": 1, "gravity": [-1.6], "seeds": 1, "keyframe_clips": 1, "keyframe_frames": 30,
+               "keep": {"lower": "a person waves", "upper": "a person kicks"},
                "timeline": [{"text": "a person walks", "seconds": 1}, {"text": "a person jumps", "seconds": 0.5,
                                                                           "gravity": -1.6}]}
     try:
@@ -531,13 +532,15 @@ def test_editing_reports_replays_keyframes_and_a_timeline(setup: dict[str, Path]
     rows = {(r["part"], r.get("gravity", r.get("case"))): r for r in report["rows"]}
     assert set(rows) == {("replay", -9.81), ("replay", -1.6), ("keyframes", "in-between"),
                          ("keyframes", "continuation"), ("keyframes", "path"), ("keyframes", "pinned"),
-                         ("timeline", None)}
+                         ("keep", None), ("timeline", None)}
     assert rows[("replay", -9.81)]["changed_m"]["mean"] < 0.01  # Earth gives the clip back
     assert all(rows[("keyframes", c)]["worst_error_cm"] < 2.0 for c in ("in-between", "continuation", "path", "pinned"))
+    keep = rows[("keep", None)]["halves"]
+    assert set(keep) == {"lower", "upper"} and all(h["worst_error_cm"] < 2.0 for h in keep.values())
     timeline = rows[("timeline", None)]
     assert timeline["frames"] == 30 and len(timeline["seams"]) == 1
     md = (setup["root"] / "reports/editing/report.md").read_text()
-    assert "| SimDiff | -1.6 |" in md and "editing_timeline.png" in md
+    assert "| SimDiff | -1.6 |" in md and "editing_timeline.png" in md and "| SimDiff | upper | a person kicks |" in md
     assert (setup["root"] / "reports/editing/editing_replay.png").is_file()
 
 

@@ -197,6 +197,8 @@ class EditingOptions:
         replay_type, replay_clips: motion type and number of the split's clips re-played (those with a flight);
         gravity: the gravities they are re-played at (Earth is always added); seeds: seeds per clip;
         keyframe_type, keyframe_clips, keyframe_frames: the clips whose first frames make the keyframes;
+        keep: half (``lower`` or ``upper``) → the text ``simdiff edit --keep`` makes the other half of the same clips
+        for;
         timeline: segments ``{"text", "seconds", "gravity"?, "wind"?}`` as in ``generate --timeline``.
     """
 
@@ -207,6 +209,7 @@ class EditingOptions:
     keyframe_type: str = "walk"
     keyframe_clips: int = 4
     keyframe_frames: int = 100
+    keep: dict[str, str] = field(default_factory=dict)
     timeline: list[dict[str, Any]] = field(default_factory=list)
 
 

@@ -9,6 +9,10 @@
   first 20 frames), a root path (x/z every 20 frames) and a pinned pose (the middle one); per motion the largest
   distance of a written joint from its entry and the fastest joint within 5 frames of a given frame against the
   fastest of the same caption and seed without keyframes.
+* **Keep** (``simdiff edit --keep lower|upper --text``): the same clips with one half kept and the other made for
+  ``editing.keep``'s text; per motion the largest and mean distance of a kept joint from the input, and what the new
+  half does: the right wrist's share of frames above the head (legs kept, a wave asked) or the right ankle's lift
+  above its floor (upper body kept, a kick asked), each against the input's.
 * **Timeline** (``generate --timeline``): ``editing.timeline``'s segments as one motion; per segment its pelvis
   speed, travel, apex, airborne frames and gravity read, and the right wrist's share of frames above the head; per
   seam the fastest joint and the root's largest acceleration within 5 frames, against the whole motion's 99th
@@ -146,6 +150,46 @@ def measure_keyframes(runner: Runner, spec: ModelSpec, case: str, key: str) -> d
             "worst_error_cm": max(p["max_error_cm"] for p in per)}
 
 
+def _wrist_up(joints: np.ndarray) -> float:
+    """Share of frames with the right wrist above the head."""
+    return float((joints[:, 21, 1] > joints[:, 15, 1]).mean())
+
+
+def _ankle_lift(joints: np.ndarray) -> float:
+    """The right ankle's highest point above its floor (its 5th-percentile height), m."""
+    return float(joints[:, 8, 1].max() - np.percentile(joints[:, 8, 1], 5))
+
+
+def measure_keep(runner: Runner, spec: ModelSpec, key: str) -> dict[str, Any]:
+    from simdiff.inference.editing import keep_half
+    from simdiff.motion.skeleton import LOWER_BODY, UPPER_BODY
+
+    o = runner.config.editing
+    gen = runner.model(spec)
+    sampling = runner.sampling(spec, "ddim", runner.alpha(spec))
+    env = (-9.81, 0.0, 0.0) if gen.is_simdiff else None
+    per, shown = [], []
+    for i, clip in enumerate(_clips(runner, o.keyframe_type, o.keyframe_clips, min_frames=o.keyframe_frames)):
+        real = clip["joints"][: o.keyframe_frames]
+        for half, text in sorted(o.keep.items()):
+            joints = keep_half(gen, real, sampling, env, half, text, seed=runner.config.seed).joints
+            kept = list(LOWER_BODY if half == "lower" else UPPER_BODY)
+            error = 100 * np.linalg.norm(joints[:, kept] - real[:, kept], axis=-1)
+            measure = _wrist_up if half == "lower" else _ankle_lift
+            per.append({"clip": clip["id"], "half": half, "text": text, "max_error_cm": float(error.max()),
+                        "mean_error_cm": float(error.mean()), "new_half": measure(joints), "input": measure(real)})
+            if i == 0:
+                shown.append(joints)
+    save_npy(runner.rows_dir / f"{key}.motion.npy", np.stack(shown))
+    halves = {}
+    for half, text in sorted(o.keep.items()):
+        mine = [p for p in per if p["half"] == half]
+        halves[half] = {"text": text, "worst_error_cm": max(p["max_error_cm"] for p in mine),
+                        **{k: _interval([p[k] for p in mine]) for k in ("max_error_cm", "mean_error_cm", "new_half",
+                                                                         "input")}}
+    return {"clips": sorted({p["clip"] for p in per}), "motions": per, "halves": halves}
+
+
 def timeline_segments(timeline: list[dict[str, Any]]) -> tuple[Any, ...]:
     """The config's segments ``{"text", "seconds", "gravity"?, "wind"?}`` as
     :class:`~simdiff.inference.timeline.Segment` (φ checked against the trained range)."""
@@ -211,6 +255,13 @@ def plan(runner: Runner) -> list[RowPlan]:
             plans.append(RowPlan(key, {"method": spec.name, "part": "keyframes", "case": case}, inputs,
                                  runner.motion_seconds(spec, "ddim", 2 * o.keyframe_clips),
                                  lambda r, spec=spec, case=case, key=key: measure_keyframes(r, spec, case, key)))
+        if o.keep:
+            key = safe(f"{spec.name}_keep")
+            inputs = {"row": "editing_keep", "keep": o.keep, "type": o.keyframe_type, "clips": o.keyframe_clips,
+                      "frames": o.keyframe_frames, **base}
+            plans.append(RowPlan(key, {"method": spec.name, "part": "keep"}, inputs,
+                                 runner.motion_seconds(spec, "ddim", 2 * o.keyframe_clips * len(o.keep)),
+                                 lambda r, spec=spec, key=key: measure_keep(r, spec, key)))
         if o.timeline:
             key = safe(f"{spec.name}_timeline")
             inputs = {"row": "editing_timeline", "timeline": o.timeline, **base}
@@ -243,11 +294,14 @@ def _figures(runner: Runner, rows: list[dict[str, Any]]) -> list[Path]:
                          [f"input {clip['id']}"] + [f"re-played at g {r['gravity']:g}" for r in replay])
         paths.append(path)
     keyed = [r for r in rows if r["part"] == "keyframes" and motion(r) is not None]
-    if keyed:
+    kept = [(f"keep {half}: \"{h['text']}\"", m) for r in rows if r["part"] == "keep" and motion(r) is not None
+            for (half, h), m in zip(sorted(r["halves"].items()), motion(r))]
+    if keyed or kept:
         clip = _clips(runner, o.keyframe_type, 1, min_frames=o.keyframe_frames)[0]
         path = runner.out / "editing_keyframes.png"
-        render_filmstrip([clip["joints"][: o.keyframe_frames]] + [motion(r) for r in keyed], path,
-                         [f"real {clip['id']}: \"{clip['caption']}\""] + [r["case"] for r in keyed])
+        render_filmstrip([clip["joints"][: o.keyframe_frames]] + [motion(r) for r in keyed] + [m for _, m in kept],
+                         path, [f"real {clip['id']}: \"{clip['caption']}\""] + [r["case"] for r in keyed]
+                         + [label for label, _ in kept])
         paths.append(path)
     for r in rows:
         if r["part"] == "timeline" and motion(r) is not None:
@@ -280,6 +334,19 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     for r in (r for r in rows if r["part"] == "keyframes"):
         lines.append(f"| {r['method']} | {r['case']} | {_ci(r['max_error_cm'])} | {r['worst_error_cm']:.2f} | "
                      f"{_ci(r['fastest_near'], '.1f')} | {_ci(r['fastest'], '.1f')} | {_ci(r['fastest_free'], '.1f')} |")
+    for r in (r for r in rows if r["part"] == "keep"):
+        lines += ["", "Keep: `simdiff edit --keep` on the same clips, one half kept and the other made for the text. "
+                  "Kept error: distance of a kept joint from the input (cm; each motion's largest, its mean, and the "
+                  "worst); new half: the right wrist's share of frames above the head when the legs are kept, the "
+                  "right ankle's lift above its floor (m) when the upper body is kept, against the input's.", "",
+                  "| method | kept | text | kept error (cm) | mean (cm) | worst (cm) | new half | input |",
+                  "|---|---|---|---|---|---|---|---|"]
+        for half, h in sorted(r["halves"].items()):
+            fmt = ".0%" if half == "lower" else ".2f"
+            new, old = h["new_half"], h["input"]
+            lines.append(f"| {r['method']} | {half} | {h['text']} | {_ci(h['max_error_cm'])} | "
+                         f"{_ci(h['mean_error_cm'])} | {h['worst_error_cm']:.2f} | "
+                         f"{new['mean']:{fmt}} ± {new['ci95']:{fmt}} | {old['mean']:{fmt}} ± {old['ci95']:{fmt}} |")
     for r in (r for r in rows if r["part"] == "timeline"):
         lines += ["", f"Timeline ({r['method']}, {r['frames']} frames, {r['frames'] / FPS:g} s): per segment; the "
                   "whole motion's fastest joint {:.1f} m/s, root acceleration p99 {:.1f} m/s².".format(
