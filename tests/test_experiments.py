@@ -415,6 +415,49 @@ def test_env_response_scores_methods_against_the_simulator(setup: dict[str, Path
     assert (setup["root"] / "reports/env_response/env_response.png").is_file()
 
 
+class BallisticStandIn:
+    """A simulator whose rollout of any motion is a synthetic jump whose flight obeys the requested gravity."""
+
+    def __call__(self, motions, envs):
+        from simdiff.motion.synthetic import jump
+
+        for env in envs:
+            airtime = float(np.sqrt(8 * 0.4 / abs(env.gravity)))
+            yield jump(frames=int(airtime * 20) + 40, height=0.4, start=15, airtime=airtime), {"success": True}
+
+
+def test_env_response_checks_the_gravity_readout_on_real_jumps(setup: dict[str, Path]) -> None:
+    from simdiff.motion.synthetic import jump
+
+    corpus = setup["corpus"]
+    test = sorted((corpus / "test.txt").read_text().split())
+    saved = {i: np.load(corpus / "new_joints" / f"{i}.npy") for i in test[:2]}
+    for i in saved:  # two real "jumps" of the split with an Earth flight
+        np.save(corpus / "new_joints" / f"{i}.npy", jump(frames=60, height=0.3, start=15,
+                                                           airtime=float(np.sqrt(8 * 0.3 / 9.81))).astype(np.float32))
+    clips = [{"id": i, "motion_type": "jump" if i in saved else "walk", "mirror_of": None, "captions": ["x"],
+              "split": "test" if i in test else "train"}
+             for i in sorted(p.stem for p in (corpus / "new_joints").glob("*.npy"))]
+    (corpus / "manifest.json").write_text(json.dumps({"clips": clips}))
+    control = {"prompts": ["a person jumps"], "seeds": 1, "length": 24, "gravity": [-1.6], "wind": [], "combos": [],
+               "resamples": 20, "readout_clips": 3}
+    try:
+        report = run_experiment(write(setup, "env_response", name="env_readout", env_control=control,
+                                      models=[{"name": "MDM", "model": "backbone", **FAST}]),
+                                projector=BallisticStandIn(), progress=False, text_encoder=hash_text)
+    finally:
+        (corpus / "manifest.json").unlink()
+        for i, joints in saved.items():
+            np.save(corpus / "new_joints" / f"{i}.npy", joints)
+    check = next(r for r in report["rows"] if r.get("part") == "readout")
+    assert len(check["clips"]) == 2 and check["real"]["read"] == 2
+    assert check["real"]["median"] == pytest.approx(-9.81, rel=0.05)
+    assert [s["gravity"] for s in check["simulated"]] == [-9.81, -1.6]
+    assert all(s["read"] == 2 and s["within_10pct"] == 1.0 for s in check["simulated"])
+    md = (setup["root"] / "reports/env_readout/report.md").read_text()
+    assert "Readout check" in md and "| simulated | -1.6 | 2 / 2 |" in md
+
+
 def test_simulated_finish_rows_in_table1_and_fig4(setup: dict[str, Path]) -> None:
     sim = EchoProjector(fail_every=4)
     finish = {"name": "SimDiff + simulated finish", "model": "adapters_binary", "env_index": 1, "simulate": True, **FAST}

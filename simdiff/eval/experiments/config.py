@@ -161,6 +161,8 @@ class EnvControlOptions:
         alpha: adapter strength of the SimDiff rows (None: each model's ``sampling.json``).
         filmstrip_frames: frames per filmstrip row (0: no filmstrips).
         resamples: bootstrap resamples of the env_response intervals.
+        readout_clips: env_response's check of the gravity readout: this many of the split's real jumps with a
+            readable flight, read as they are and re-tracked by the simulator under each gravity (0: no check).
     """
 
     prompts: list[str] = field(default_factory=lambda: ["a person jumps", "a person jumps up in place",
@@ -173,6 +175,7 @@ class EnvControlOptions:
     alpha: float | None = None
     filmstrip_frames: int = 8
     resamples: int = 1000
+    readout_clips: int = 0
 
 
 @dataclass

@@ -21,13 +21,13 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.eval.experiments.clips import split_clips
 from simdiff.eval.experiments.config import ModelSpec
 from simdiff.eval.experiments.runner import RowPlan, Runner, safe
 from simdiff.eval.stats import t_interval
@@ -38,28 +38,6 @@ TITLE = "Editing and long motions — re-play under φ, keyframes, timelines"
 KEYFRAME_CASES: tuple[str, ...] = ("in-between", "continuation", "path", "pinned")
 NEAR_FRAMES: int = 5
 """Frames either side of a given frame (or a seam) in which joint speeds are compared."""
-
-
-def _clips(runner: Runner, kind: str, n: int, min_frames: int = 0, flight: bool = False) -> list[dict[str, Any]]:
-    """The first ``n`` original clips of motion type ``kind`` in the split (with ≥ ``min_frames`` frames, and a
-    readable flight when ``flight``): ``{"id", "caption", "joints"}``."""
-    from simdiff.motion.gravity_readout import read_gravity
-
-    corpus = Path(runner.config.corpus).expanduser()
-    manifest = json.loads((corpus / "manifest.json").read_text(encoding="utf-8"))
-    out = []
-    for c in manifest["clips"]:
-        if c.get("motion_type") != kind or c.get("mirror_of") or c.get("split") != runner.config.split:
-            continue
-        joints = np.load(corpus / "new_joints" / f"{c['id']}.npy", allow_pickle=False).astype(np.float64)
-        if len(joints) < min_frames or (flight and read_gravity(joints) is None):
-            continue
-        out.append({"id": c["id"], "caption": (c.get("captions") or [""])[0], "joints": joints})
-        if len(out) == n:
-            break
-    if not out:
-        raise SimdiffError(f"the {runner.config.split} split has no clips of motion type {kind!r} to edit")
-    return out
 
 
 def _interval(values: list[float]) -> dict[str, float]:
@@ -86,7 +64,7 @@ def measure_replay(runner: Runner, spec: ModelSpec, gravity: float, key: str) ->
     gen = runner.model(spec)
     sampling = runner.sampling(spec, "ddim", runner.alpha(spec))
     per = []
-    for i, clip in enumerate(_clips(runner, o.replay_type, o.replay_clips, flight=True)):
+    for i, clip in enumerate(split_clips(runner, o.replay_type, o.replay_clips, flight=True)):
         for s in range(o.seeds):
             edited = edit_motion(gen, clip["joints"], sampling, (gravity, 0.0, 0.0), seed=runner.config.seed + s)
             before, after = read_gravity(clip["joints"]), read_gravity(edited.joints)
@@ -131,7 +109,7 @@ def measure_keyframes(runner: Runner, spec: ModelSpec, case: str, key: str) -> d
     sampling = runner.sampling(spec, "ddim", runner.alpha(spec))
     env = (-9.81, 0.0, 0.0) if gen.is_simdiff else None
     per = []
-    for i, clip in enumerate(_clips(runner, o.keyframe_type, o.keyframe_clips, min_frames=o.keyframe_frames)):
+    for i, clip in enumerate(split_clips(runner, o.keyframe_type, o.keyframe_clips, min_frames=o.keyframe_frames)):
         real = clip["joints"][: o.keyframe_frames]
         keys = keyframes_of(real, case)
         text = gen.encode_text([clip["caption"]])
@@ -169,7 +147,7 @@ def measure_keep(runner: Runner, spec: ModelSpec, key: str) -> dict[str, Any]:
     sampling = runner.sampling(spec, "ddim", runner.alpha(spec))
     env = (-9.81, 0.0, 0.0) if gen.is_simdiff else None
     per, shown = [], []
-    for i, clip in enumerate(_clips(runner, o.keyframe_type, o.keyframe_clips, min_frames=o.keyframe_frames)):
+    for i, clip in enumerate(split_clips(runner, o.keyframe_type, o.keyframe_clips, min_frames=o.keyframe_frames)):
         real = clip["joints"][: o.keyframe_frames]
         for half, text in sorted(o.keep.items()):
             joints = keep_half(gen, real, sampling, env, half, text, seed=runner.config.seed).joints
@@ -288,7 +266,7 @@ def _figures(runner: Runner, rows: list[dict[str, Any]]) -> list[Path]:
     paths = []
     replay = [r for r in rows if r["part"] == "replay" and motion(r) is not None]
     if replay:
-        clip = _clips(runner, o.replay_type, 1, flight=True)[0]
+        clip = split_clips(runner, o.replay_type, 1, flight=True)[0]
         path = runner.out / "editing_replay.png"
         render_filmstrip([clip["joints"]] + [motion(r) for r in replay], path,
                          [f"input {clip['id']}"] + [f"re-played at g {r['gravity']:g}" for r in replay])
@@ -297,7 +275,7 @@ def _figures(runner: Runner, rows: list[dict[str, Any]]) -> list[Path]:
     kept = [(f"keep {half}: \"{h['text']}\"", m) for r in rows if r["part"] == "keep" and motion(r) is not None
             for (half, h), m in zip(sorted(r["halves"].items()), motion(r))]
     if keyed or kept:
-        clip = _clips(runner, o.keyframe_type, 1, min_frames=o.keyframe_frames)[0]
+        clip = split_clips(runner, o.keyframe_type, 1, min_frames=o.keyframe_frames)[0]
         path = runner.out / "editing_keyframes.png"
         render_filmstrip([clip["joints"][: o.keyframe_frames]] + [motion(r) for r in keyed] + [m for _, m in kept],
                          path, [f"real {clip['id']}: \"{clip['caption']}\""] + [r["case"] for r in keyed]

@@ -8,6 +8,10 @@ for that motion. :mod:`simdiff.eval.response` turns the pairs into sign agreemen
 (generated / simulated, bootstrap intervals over prompt × seed units) and, for combinations,
 the additivity error against the single-factor effects.
 
+A readout check (``env_control.readout_clips``) validates the gravity measure itself: the split's real jumps are
+read as they are (Earth) and re-tracked by the simulator under each gravity of the grid, whose rollouts must read
+the gravity they were made under.
+
 The same script scores MDM (env-blind: one generation reused for every φ, so it must score no
 response), SimDiff with binary adapters (φ does not reach them either: one generation of the
 'simulated' class for every φ), SimDiff (continuous φ adapters) and PhysDiff (projection under φ).
@@ -91,6 +95,41 @@ def measure(runner: Runner, spec: ModelSpec) -> dict[str, Any]:
             "units": len(units), "envs": envs}
 
 
+def _reading_summary(reads: list[dict[str, float] | None], gravity: float) -> dict[str, Any]:
+    """``{gravity, n, read, median, q25, q75, within_10pct, worst_fit_mm}`` of readings (None: no flight)."""
+    got = [r for r in reads if r is not None]
+    g = np.array([r["gravity"] for r in got])
+    out: dict[str, Any] = {"gravity": gravity, "n": len(reads), "read": len(got)}
+    if got:
+        out.update(median=float(np.median(g)), q25=float(np.percentile(g, 25)), q75=float(np.percentile(g, 75)),
+                   within_10pct=float(np.mean(np.abs(g - gravity) <= 0.1 * abs(gravity))),
+                   worst_fit_mm=float(max(1000 * r["rmse_m"] for r in got)))
+    return out
+
+
+def measure_readout(runner: Runner) -> dict[str, Any]:
+    """The gravity readout on the split's real jumps (Earth) and on the simulator's rollouts of them under each
+    gravity of the grid (rollouts that fell are left out)."""
+    from simdiff.eval.experiments.clips import split_clips
+    from simdiff.motion.gravity_readout import read_gravity
+    from simdiff.sim.env import Environment
+
+    clips = split_clips(runner, "jump", runner.config.env_control.readout_clips, flight=True)
+    gravities = sorted({float(e[0]) for e in grid(runner) if e[1] == 0 and e[2] == 0})
+    jobs = [(i, g) for g in gravities for i in range(len(clips))]
+    results = runner.sim([clips[i]["joints"] for i, _ in jobs], [Environment(g, 0.0, 0.0) for _, g in jobs])
+    reads: dict[float, list[dict[str, float] | None]] = {g: [] for g in gravities}
+    fell: dict[float, int] = {g: 0 for g in gravities}
+    for (_, g), (rollout, info) in zip(jobs, results):
+        if isinstance(info, str) or not _get(info, "success") or rollout is None or len(rollout) < 2:
+            fell[g] += 1
+            continue
+        reads[g].append(read_gravity(np.asarray(rollout)))
+    return {"clips": [c["id"] for c in clips], "real": _reading_summary([read_gravity(c["joints"]) for c in clips],
+                                                                          EARTH[0]),
+            "simulated": [{**_reading_summary(reads[g], g), "fell": fell[g]} for g in gravities]}
+
+
 def _get(info: Any, key: str, default: Any = None) -> Any:
     return info.get(key, default) if isinstance(info, dict) else getattr(info, key, default)
 
@@ -114,6 +153,12 @@ def plan(runner: Runner) -> list[RowPlan]:
         est = runner.motion_seconds(spec, "ddim", n * gens, o.length / FPS) + n * len(envs) * runner.projection_seconds(o.length / FPS)
         plans.append(RowPlan(safe(spec.name), {"method": spec.name, "alpha": alpha}, inputs, est,
                              lambda r, spec=spec: measure(r, spec)))
+    if o.readout_clips > 0:
+        inputs = {"row": "env_readout", "clips": o.readout_clips, "envs": envs, **runner.data_inputs(),
+                  "projector": {"residual_bound": c.projector.residual_bound}}
+        plans.append(RowPlan("readout", {"method": "readout check", "part": "readout"}, inputs,
+                             o.readout_clips * sum(e[1] == e[2] == 0 for e in envs) * runner.projection_seconds(),
+                             lambda r: measure_readout(r)))
     return plans
 
 
@@ -159,7 +204,8 @@ def figure(rows: list[dict[str, Any]], path: Any) -> Any:
 
 def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     c, o = runner.config, runner.config.env_control
-    rows = report["rows"]
+    checks = [r for r in report["rows"] if r.get("part") == "readout"]
+    rows = [r for r in report["rows"] if r.get("part") != "readout"]
     for r in rows:  # scored again from the stored effects: a scoring change needs no new rollouts
         r["scores"] = score(r["effects"], resamples=o.resamples, seed=c.seed)
         r["additivity"] = additivity(r["effects"], resamples=o.resamples, seed=c.seed)
@@ -202,5 +248,17 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
     for r in rows:
         for e in r.get("rollout_errors") or []:
             lines.append(f"* {r['method']} rollout error: {e}")
+    for r in checks:
+        lines += ["", f"Readout check (the measure's own error): {len(r['clips'])} of the split's real jumps with a "
+                  "readable flight, read as they are and re-tracked by the simulator under each gravity (flights "
+                  "follow gravity); g read is the centre of mass's parabola over the flights "
+                  "(:mod:`simdiff.motion.gravity_readout`).", "",
+                  "| motions | requested g | read / n | median g read [IQR] | within 10 % | worst fit (mm) |",
+                  "|---|---|---|---|---|---|"]
+        for name, s in [("real", r["real"])] + [("simulated", s) for s in r["simulated"]]:
+            body = (f"{s['median']:.2f} [{s['q25']:.2f}, {s['q75']:.2f}] | {s['within_10pct']:.0%} | "
+                    f"{s['worst_fit_mm']:.0f}") if s["read"] else "— | — | —"
+            fell = f" ({s['fell']} fell)" if s.get("fell") else ""
+            lines.append(f"| {name} | {s['gravity']:g} | {s['read']} / {s['n']}{fell} | {body} |")
     lines += ["", f"![generated vs simulated effects]({path.name})"]
     return lines
