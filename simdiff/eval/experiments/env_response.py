@@ -252,7 +252,7 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
         lines += ["", f"Readout check (the measure's own error): {len(r['clips'])} of the split's real jumps with a "
                   "readable flight, read as they are and re-tracked by the simulator under each gravity (flights "
                   "follow gravity); g read is the centre of mass's parabola over the flights "
-                  "(:mod:`simdiff.motion.gravity_readout`).", "",
+                  "(`simdiff.motion.gravity_readout`).", "",
                   "| motions | requested g | read / n | median g read [IQR] | within 10 % | worst fit (mm) |",
                   "|---|---|---|---|---|---|"]
         for name, s in [("real", r["real"])] + [("simulated", s) for s in r["simulated"]]:
