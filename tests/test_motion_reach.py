@@ -55,10 +55,15 @@ def test_nothing_given_changes_nothing_and_shapes_are_checked(walk) -> None:
         reach(motion, np.zeros((3, 22, 3)))
 
 
-def test_an_unreachable_target_gets_as_near_as_the_arm_allows(walk) -> None:
+@pytest.mark.parametrize(("frame", "joint"), [(40, 20), (0, 7)])
+def test_an_unreachable_target_is_neared_without_a_jump(walk, frame: int, joint: int) -> None:
     motion, before = walk
     keys = np.full_like(before, np.nan)
-    keys[40, 20] = before[40, 20] + [2.0, 0.0, 0.0]  # two metres from the body
+    keys[frame, joint] = before[frame, joint] + [2.0, 0.0, 3.0]  # metres from the body
     after = reach(motion, keys).joints
     assert np.isfinite(after).all() and np.ptp(bone_lengths(after), axis=0).max() < 1e-5
-    assert np.linalg.norm(after[40, 20] - keys[40, 20]) < np.linalg.norm(before[40, 20] - keys[40, 20]) - 0.3
+    assert np.linalg.norm(after[frame, joint] - keys[frame, joint]) < np.linalg.norm(before[frame, joint] - keys[frame, joint])
+    # neared, not met by teleporting: the pull stops growing beyond REACH. It still speeds the nearest joints up (18
+    # against 4.3 m/s for the ankle at frame 0); with a quadratic pull and no acceleration term it was 61 m/s
+    speed = np.linalg.norm(np.diff(after, axis=0), axis=-1) * 20
+    assert speed.max() < 5 * (np.linalg.norm(np.diff(before, axis=0), axis=-1) * 20).max()

@@ -4,7 +4,8 @@
 kept upper body above new legs) ends where its chain's lengths put it, centimetres off. :func:`reach` corrects the
 fitted rotations (as global rotations) and moves the root, all frames at once, to minimise (in this order of weight)
 
-* the distance of every given coordinate from its target;
+* the distance of every given coordinate from its target (growing only linearly beyond :data:`REACH`);
+* the acceleration the correction adds to the joints;
 * how far the joints nobody gave move from where the fit put them (so planted feet stay planted);
 * how fast the corrections change from frame to frame (so a lone keyframe bends its neighbours too, no speed spike);
 * the size of the rotation corrections.
@@ -23,6 +24,11 @@ from simdiff.motion.skeleton import FOOT_LEFT, FOOT_RIGHT, NUM_JOINTS, PARENTS
 
 TARGET_SCALE: float = 0.001
 """m: a given coordinate this far from its target costs as much as one :data:`HOLD_SCALE` of a free joint."""
+REACH: float = 0.05
+"""m: beyond this a target's pull stops growing (pseudo-Huber), so a target out of the body's reach is neared
+smoothly, not met by a one-frame jump (an ankle 3 m ahead of the body at frame 0 moved it at 37 m/s)."""
+ACCELERATION_SCALE: float = 0.02
+"""m per frame² (8 m/s²): the change a correction makes to a joint's acceleration that costs one unit."""
 HOLD_SCALE: float = 0.05
 """m: the free joints' movement from the fit that costs one unit."""
 FOOT_HOLD_SCALE: float = 0.005
@@ -104,7 +110,10 @@ def reach(motion: RigidMotion, targets: np.ndarray, iterations: int = ITERATIONS
     def loss() -> Tensor:
         optimiser.zero_grad()
         pos = positions(_rodrigues(turn) @ glob0, root0 + shift)
-        value = (((pos - goal) * given) / TARGET_SCALE).pow(2).sum()
+        miss = (((pos - goal) * given) / REACH).pow(2).sum(-1)  # (T, 22), in units of REACH²
+        value = (2.0 * (REACH / TARGET_SCALE) ** 2 * ((1.0 + miss).sqrt() - 1.0)).sum()
+        bend = torch.diff(pos - start, n=2, dim=0)  # what the correction adds to the joints' accelerations
+        value = value + (bend / ACCELERATION_SCALE).pow(2).sum()
         value = value + ((pos - start) * free).pow(2).sum()
         value = value + (torch.diff(turn, dim=0) / ROTATION_STEP_SCALE).pow(2).sum()
         value = value + (torch.diff(shift, dim=0) / ROOT_STEP_SCALE).pow(2).sum()
