@@ -194,3 +194,15 @@ def test_generate_warns_when_a_lone_joint_is_not_met(tiny_model: Path, tmp_path:
     record = json.loads((tmp_path / "o" / "generation.json").read_text())["keyframes"]
     err = capsys.readouterr().err
     assert (record["max_error_m"][0] > 0.02) == ("warning: a keyframe entry is" in err), err
+
+
+def test_generate_warns_when_keyframe_poses_sink_the_feet(tiny_model: Path, tmp_path: Path, capsys) -> None:
+    w = synthetic.walk(40)
+    keys = free(40)
+    keys[0], keys[-1] = 1.3 * w[0], 1.3 * w[-1]  # poses on a skeleton 1.3× the model's
+    np.save(tmp_path / "k.npy", keys)
+    assert main(["generate", "a person walks", "--keyframes", str(tmp_path / "k.npy"), "--steps", "2", "--model",
+                 str(tiny_model), "--format", "npy", "--out", str(tmp_path / "o"), "-q"]) == 0
+    lowest = json.loads((tmp_path / "o" / "generation.json").read_text())["samples"][0]["lowest_m"]
+    err = capsys.readouterr().err
+    assert lowest < -0.05 and "under the floor (keyframe poses on a skeleton larger" in err, err

@@ -59,6 +59,9 @@ the model has probably not learned that motion (the model folder's captions.safe
 
 KEYFRAME_TOLERANCE: float = 0.02
 """m: a keyframe entry further than this from the written motion gets a warning."""
+SINK_TOLERANCE: float = 0.05
+"""m: a keyframed motion whose lowest joint goes further than this under y = 0 gets a warning (keyframe poses 1.3×
+the model's size put the feet 14 cm under the floor between the keys)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -283,9 +286,14 @@ def _generate_into(args: argparse.Namespace, request: GenerationRequest, start: 
                   "(a frozen pose carried along); under a φ far from Earth or a strong --env-guidance the model "
                   "extrapolates", file=sys.stderr)
     keyframes = meta.get("keyframes")
+    for rec in meta["samples"] if keyframes else []:  # generated motions are put on the floor; keyed ones may sink
+        if rec["lowest_m"] < -SINK_TOLERANCE:
+            print(f"simdiff: warning: sample {rec['index']} goes {-100 * rec['lowest_m']:.0f} cm under the floor "
+                  "(keyframe poses on a skeleton larger than the model's do that between the keys: give them at "
+                  "the model's size)", file=sys.stderr)
     if keyframes and max(keyframes["max_error_m"]) > KEYFRAME_TOLERANCE:
         print(f"simdiff: warning: a keyframe entry is {100 * max(keyframes['max_error_m']):.1f} cm from the motion; "
-              "joints given without their whole pose are met only as far as the skeleton allows", file=sys.stderr)
+              "an entry out of the skeleton's reach, or contradicting another, is neared, not met", file=sys.stderr)
     for rec in meta["samples"] if args.simulate else []:
         sim = rec["simulated"]
         name = rec["files"].get("tracking", f"sample {rec['index']}").removesuffix("_tracking.json")
