@@ -203,7 +203,7 @@ def measure_timeline(runner: Runner, spec: ModelSpec, key: str) -> dict[str, Any
                       "travel_m": float(np.linalg.norm(piece[-1, 0, [0, 2]] - piece[0, 0, [0, 2]])),
                       "apex_m": float(piece[:, 0, 1].max()), "airborne": 0.0 if g is None else g["frames"],
                       "gravity_read": None if g is None else g["gravity"],
-                      "wrist_above_head": float((piece[:, 21, 1] > piece[:, 15, 1]).mean())})
+                      "wrist_above_head": _wrist_up(piece)})
     seams = [{"frame": a, "fastest": _fastest(joints, np.array([a])),
               "root_acc_max": float(acc[max(0, a - NEAR_FRAMES): a + NEAR_FRAMES].max())}
              for a, _ in spans(segments)[1:]]
@@ -313,10 +313,11 @@ def finish(runner: Runner, report: dict[str, Any]) -> list[str]:
         lines.append(f"| {r['method']} | {r['case']} | {_ci(r['max_error_cm'])} | {r['worst_error_cm']:.2f} | "
                      f"{_ci(r['fastest_near'], '.1f')} | {_ci(r['fastest'], '.1f')} | {_ci(r['fastest_free'], '.1f')} |")
     for r in (r for r in rows if r["part"] == "keep"):
-        lines += ["", "Keep: `simdiff edit --keep` on the same clips, one half kept and the other made for the text. "
-                  "Kept error: distance of a kept joint from the input (cm; each motion's largest, its mean, and the "
-                  "worst); new half: the right wrist's share of frames above the head when the legs are kept, the "
-                  "right ankle's lift above its floor (m) when the upper body is kept, against the input's.", "",
+        lines += ["", ("Keep: `simdiff edit --keep` on the same clips, one half kept and the other made for the text. "
+                       "Kept error: distance of a kept joint from the input (cm; each motion's largest, its mean, and "
+                       "the worst); new half: the right wrist's share of frames above the head when the legs are "
+                       "kept, the right ankle's lift above its floor (m) when the upper body is kept, against the "
+                       "input's."), "",
                   "| method | kept | text | kept error (cm) | mean (cm) | worst (cm) | new half | input |",
                   "|---|---|---|---|---|---|---|---|"]
         for half, h in sorted(r["halves"].items()):
