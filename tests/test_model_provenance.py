@@ -79,7 +79,7 @@ def test_augmented_folder_follows_its_source_corpus(tmp_path: Path) -> None:
     assert json.loads((only_cmu / SOURCE_CORPUS_NAME).read_text())["path"] == str(corpus.resolve())
     cmu = provenance_from_corpus(only_cmu, "adapters")
     assert cmu.weights_licence == "permissive (CMU)" and cmu.trained_on[0].data == "aug_cmu"
-    assert "simulated from corpus corpus" in cmu.trained_on[0].note
+    assert "augmented from corpus corpus" in cmu.trained_on[0].note
     assert provenance_from_corpus(with_nc, "adapters").weights_licence.startswith("non-commercial")
     shutil.rmtree(corpus)  # the source corpus is gone: the summary recorded at augmentation time stands in
     recorded = provenance_from_corpus(with_nc, "adapters").trained_on[0]

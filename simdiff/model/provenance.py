@@ -280,7 +280,7 @@ def provenance_from_corpus(corpus_dir: str | Path, what: str = "backbone", split
         if (corpus / "manifest.json").is_file():
             manifest_path = corpus / "manifest.json"
             part = summarize_manifest(_read_json(manifest_path), what, name, used, where=str(manifest_path))
-            part.note = (part.note + "; " if part.note else "") + f"simulated from corpus {corpus.name}"
+            part.note = (part.note + "; " if part.note else "") + f"augmented from corpus {corpus.name}"
             return Provenance([part])
     if record is not None and isinstance(record.get("summary"), dict):
         recorded = Provenance.from_dict({"trained_on": [record["summary"]]}, str(record_path)).trained_on[0]
