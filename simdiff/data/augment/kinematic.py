@@ -40,7 +40,7 @@ JUMP_TYPES: tuple[str, ...] = ("jump",)
 GAIT_TYPES: tuple[str, ...] = ("walk", "run")
 SOURCE_TOLERANCE: float = 0.25
 """A jump is re-timed only when its own flights read within 25 % of −9.81 (real jumps: median −9.3)."""
-MAX_FRAMES: int = 600
+MAX_ITEM_FRAMES: int = 600
 """Longest item kept (30 s at 20 fps; training crops it)."""
 
 
@@ -112,7 +112,7 @@ def make_reduced_gravity(corpus: str | Path, out: str | Path, config: KinematicC
         joints = load_source_joints(corpus, clip)
         gravities = [EARTH_GRAVITY, *draw_gravity(clip, config)]
         made = [transform(joints, types[clip], g) for g in gravities]
-        if any(m is None or len(m) > MAX_FRAMES for m in made):
+        if any(m is None or len(m) > MAX_ITEM_FRAMES for m in made):
             skipped.append(clip)
             continue
         caption = (corpus / "texts" / f"{clip}.txt").read_bytes()
