@@ -113,3 +113,23 @@ def test_cli_writes_the_folder_and_bad_input_is_one_line(tmp_path: Path, capsys:
     assert "0.5 is outside" in err and err.count("\n") == 1 and not (tmp_path / "p").exists()
     with pytest.raises(SimdiffError, match="gravity range must be"):
         KinematicConfig(gravity_range=(-1.0, -3.0))
+
+
+def test_an_interrupted_run_leaves_no_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import simdiff.data.augment.kinematic as kinematic
+
+    corpus = _corpus(tmp_path / "corpus")
+    calls = []
+
+    def stop_after_two(*args):
+        calls.append(args)
+        if len(calls) > 2:
+            raise KeyboardInterrupt
+        return transform(*args)
+
+    monkeypatch.setattr(kinematic, "transform", stop_after_two)
+    with pytest.raises(KeyboardInterrupt):
+        make_reduced_gravity(corpus, tmp_path / "new" / "out", KinematicConfig(conditions=1), progress=False)
+    assert not (tmp_path / "new").exists()
+    with pytest.raises(SimdiffError, match="not a corpus folder"):
+        make_reduced_gravity(tmp_path / "nothing", tmp_path / "o", KinematicConfig(), progress=False)

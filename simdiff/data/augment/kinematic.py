@@ -29,7 +29,7 @@ import numpy as np
 
 from simdiff.data.augment.classes import load_motion_types
 from simdiff.data.augment.pairs import load_source_joints, rollout_to_layout
-from simdiff.data.writer import check_apart, write_bytes, write_json, write_lines, write_npy
+from simdiff.data.writer import check_apart, cleaned_on_failure, write_bytes, write_json, write_lines, write_npy
 from simdiff.errors import SimdiffError
 from simdiff.motion.flight_retime import retime_flights
 from simdiff.motion.gravity_readout import read_gravity
@@ -99,6 +99,8 @@ def make_reduced_gravity(corpus: str | Path, out: str | Path, config: KinematicC
     from simdiff.model.provenance import SOURCE_CORPUS_NAME, source_record
 
     corpus, out = Path(corpus), Path(out)
+    if not corpus.is_dir():
+        raise SimdiffError(f"{corpus}: not a corpus folder")
     check_apart(corpus, out, "--corpus", "--out")
     types = load_motion_types(corpus)
     if types is None:
@@ -106,34 +108,35 @@ def make_reduced_gravity(corpus: str | Path, out: str | Path, config: KinematicC
     clips = [c for c in read_split(corpus / f"{config.split}.txt") if types.get(c) in JUMP_TYPES + GAIT_TYPES]
     if not clips:
         raise SimdiffError(f"{corpus}: split {config.split!r} has no clip of type {', '.join(JUMP_TYPES + GAIT_TYPES)}")
-    env: dict[str, dict[str, Any]] = {}
-    skipped: list[str] = []
-    for clip in tqdm(sorted(set(clips)), desc="reduced gravity", unit="clip", disable=not progress):
-        joints = load_source_joints(corpus, clip)
-        gravities = [EARTH_GRAVITY, *draw_gravity(clip, config)]
-        made = [transform(joints, types[clip], g) for g in gravities]
-        if any(m is None or len(m) > MAX_ITEM_FRAMES for m in made):
-            skipped.append(clip)
-            continue
-        caption = (corpus / "texts" / f"{clip}.txt").read_bytes()
-        for index, (g, motion) in enumerate(zip(gravities, made)):
-            item = f"{clip}_k{index:02d}"
-            features, back = rollout_to_layout(motion)
-            write_npy(out / "new_joint_vecs" / f"{item}.npy", features)
-            write_npy(out / "new_joints" / f"{item}.npy", back)
-            write_bytes(out / "texts" / f"{item}.txt", caption)
-            env[item] = {"env": [g, 0.0, 0.0], "env_index": index, "condition": index, "factor": "gravity",
-                         "source": clip, "made_by": "ballistic flights" if types[clip] in JUMP_TYPES else "froude"}
-    ids = sorted(env)
-    write_lines(out / "train.txt", ids)
-    write_lines(out / "all.txt", ids)
-    write_json(out / "env.json", env)
-    write_json(out / SOURCE_CORPUS_NAME, source_record(corpus, {r["source"] for r in env.values()}))
-    for name in ("Mean.npy", "Std.npy"):
-        write_bytes(out / name, (corpus / name).read_bytes())
-    summary = {"items": len(ids), "sources": len({r["source"] for r in env.values()}), "skipped": len(skipped),
-               "config": {"split": config.split, "conditions": config.conditions,
-                          "gravity_range": list(config.gravity_range), "seed": config.seed}}
-    write_json(out / "reduced_gravity.json", summary)
+    with cleaned_on_failure(out):  # a failed or interrupted run leaves no folder it created
+        env: dict[str, dict[str, Any]] = {}
+        skipped: list[str] = []
+        for clip in tqdm(sorted(set(clips)), desc="reduced gravity", unit="clip", disable=not progress):
+            joints = load_source_joints(corpus, clip)
+            gravities = [EARTH_GRAVITY, *draw_gravity(clip, config)]
+            made = [transform(joints, types[clip], g) for g in gravities]
+            if any(m is None or len(m) > MAX_ITEM_FRAMES for m in made):
+                skipped.append(clip)
+                continue
+            caption = (corpus / "texts" / f"{clip}.txt").read_bytes()
+            rule = "ballistic flights" if types[clip] in JUMP_TYPES else "froude"
+            for index, (g, motion) in enumerate(zip(gravities, made)):
+                item = f"{clip}_k{index:02d}"
+                features, back = rollout_to_layout(motion)
+                write_npy(out / "new_joint_vecs" / f"{item}.npy", features)
+                write_npy(out / "new_joints" / f"{item}.npy", back)
+                write_bytes(out / "texts" / f"{item}.txt", caption)
+                env[item] = {"env": [g, 0.0, 0.0], "env_index": index, "condition": index, "factor": "gravity",
+                             "source": clip, "made_by": rule}
+        ids = sorted(env)
+        write_lines(out / "train.txt", ids)
+        write_lines(out / "all.txt", ids)
+        write_json(out / "env.json", env)
+        write_json(out / SOURCE_CORPUS_NAME, source_record(corpus, {r["source"] for r in env.values()}))
+        for name in ("Mean.npy", "Std.npy"):
+            write_bytes(out / name, (corpus / name).read_bytes())
+        summary = {"items": len(ids), "sources": len({r["source"] for r in env.values()}), "skipped": len(skipped),
+                   "config": {"split": config.split, "conditions": config.conditions,
+                              "gravity_range": list(config.gravity_range), "seed": config.seed}}
+        write_json(out / "reduced_gravity.json", summary)
     return summary
-
