@@ -22,23 +22,11 @@ import numpy as np
 from simdiff.errors import SimdiffError
 from simdiff.motion.flight import check_joints
 from simdiff.motion.gravity_readout import centre_of_mass, flight_fits
+from simdiff.motion.io.resample import frames_at
 from simdiff.motion.skeleton import FPS
 
 MAX_FLIGHT_S: float = 6.0
 """Longest re-timed flight (s): a take-off at 2.5 m/s under g −1 flies 5 s."""
-
-
-def _fit(t: np.ndarray, y: np.ndarray, degree: int) -> np.ndarray:
-    """Least-squares polynomial coefficients (highest power first) of (N,) ``y`` over (N,) ``t``."""
-    return np.polyfit(t, y, degree)
-
-
-def _sample(frames: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """(N, ...) linear interpolation of (F, ...) ``frames`` at fractional indices ``at`` (N,)."""
-    i0 = np.clip(np.floor(at).astype(int), 0, len(frames) - 1)
-    i1 = np.minimum(i0 + 1, len(frames) - 1)
-    w = (at - i0).reshape(-1, *([1] * (frames.ndim - 1)))
-    return (1.0 - w) * frames[i0] + w * frames[i1]
 
 
 def retime_flights(joints: np.ndarray, gravity: float, fps: float = FPS) -> np.ndarray:
@@ -62,8 +50,8 @@ def retime_flights(joints: np.ndarray, gravity: float, fps: float = FPS) -> np.n
         a, b = fit.start, fit.end
         pieces.append(j[done:a] + shift)
         t0 = np.arange(b - a) / fps
-        vy = float(np.polyval(np.polyder(_fit(t0, com[a:b, 1], 2)), 0.0))  # take-off vertical speed, m/s
-        h_speed = np.array([_fit(t0, com[a:b, k], 1)[0] for k in (0, 2)])  # horizontal speed, m/s
+        vy = float(np.polyfit(t0, com[a:b, 1], 2)[1])  # take-off vertical speed, m/s
+        h_speed = np.array([np.polyfit(t0, com[a:b, k], 1)[0] for k in (0, 2)])  # horizontal speed, m/s
         rise = com[b - 1, 1] - com[a, 1]  # landing height above the take-off's
         disc = vy * vy + 2.0 * gravity * rise
         # the later root of vy D + g D²/2 = rise; a landing out of reach (stronger g) is met at the apex
@@ -73,7 +61,7 @@ def retime_flights(joints: np.ndarray, gravity: float, fps: float = FPS) -> np.n
                                f"(0 to {MAX_FLIGHT_S} s allowed)")
         t = np.arange(max(int(round(duration * fps)), 1) + 1) / fps  # the frame clock keeps the curvature exact
         u = t / t[-1]
-        offsets = _sample(j[a:b] - com[a:b, None, :], u * (b - a - 1))  # the pose around the COM, by phase
+        offsets = frames_at(j[a:b] - com[a:b, None, :], u * (b - a - 1))  # the pose around the COM, by phase
         path = np.repeat(com[a][None], len(t), axis=0)
         path[:, 1] += vy * t + gravity * t * t / 2.0
         path[:, [0, 2]] += t[:, None] * h_speed

@@ -32,6 +32,7 @@ import numpy as np
 
 from simdiff.errors import SimdiffError
 from simdiff.motion.flight import runs
+from simdiff.motion.io.resample import frames_at
 
 
 @dataclass(frozen=True)
@@ -186,11 +187,7 @@ def aligned_source(joints: np.ndarray, ref_frames: np.ndarray, control_hz: float
     t_out = np.arange(n_out) / fps
     step_t = np.arange(len(ref_t)) / control_hz
     src_t = np.interp(t_out, step_t, ref_t)
-    x = np.clip(src_t * fps, 0, joints.shape[0] - 1)
-    i0 = np.floor(x).astype(int)
-    i1 = np.minimum(i0 + 1, joints.shape[0] - 1)
-    a = (x - i0)[:, None, None]
-    return ((1 - a) * joints[i0] + a * joints[i1]).astype(np.float32)
+    return frames_at(joints, np.clip(src_t * fps, 0, joints.shape[0] - 1)).astype(np.float32)
 
 
 def source_time(ref_frames: np.ndarray, control_hz: float, fps: float, n_out: int) -> np.ndarray:

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.motion.io.resample import frames_at
 from simdiff.sim.env import EARTH_GRAVITY
 
 
@@ -90,11 +91,7 @@ def stretch(joints: np.ndarray, scale: float) -> np.ndarray:
         raise SimdiffError(f"stretch scale must be >= 1, got {scale}")
     T = j.shape[0]
     n = int(round((T - 1) * scale)) + 1
-    x = np.minimum(np.arange(n) / scale, T - 1)
-    i0 = np.floor(x).astype(int)
-    i1 = np.minimum(i0 + 1, T - 1)
-    a = (x - i0)[:, None, None]
-    return ((1.0 - a) * j[i0] + a * j[i1]).astype(np.float32)
+    return frames_at(j, np.minimum(np.arange(n) / scale, T - 1)).astype(np.float32)
 
 
 def better(first: tuple[str, float], second: tuple[str, float]) -> bool:

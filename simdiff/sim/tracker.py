@@ -14,6 +14,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from simdiff.errors import SimdiffError
+from simdiff.motion.io.resample import frames_at
 from simdiff.motion.quaternion import cross3, quat_error, wxyz_to_xyzw
 
 from simdiff.sim.retarget.config import Reference
@@ -286,11 +287,7 @@ class PDTracker:
         ]
         K = reference.num_frames
         t = np.clip(np.arange(K) + self.cfg.lead, 0, K - 1)
-        i0 = np.floor(t).astype(int)
-        i1 = np.minimum(i0 + 1, K - 1)
-        a = (t - i0)[:, None]
-        q = reference.qpos[:, 7:]
-        self.q_target = (1 - a) * q[i0] + a * q[i1]
+        self.q_target = frames_at(reference.qpos[:, 7:], t)
         off = np.zeros_like(self.q_target)
         if self.cfg.feedforward:
             off += reference.tau_ff

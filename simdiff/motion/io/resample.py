@@ -22,6 +22,15 @@ def _rational_ratio(src_fps: float, dst_fps: float) -> tuple[int, int] | None:
     return ratio.numerator, ratio.denominator
 
 
+def frames_at(frames: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """(N, ...) float64 ``frames`` (F, ...) linearly interpolated at fractional frame indices ``at`` (N,) in [0, F − 1]."""
+    f = np.asarray(frames, dtype=np.float64)
+    i0 = np.clip(np.floor(at).astype(int), 0, len(f) - 1)
+    i1 = np.minimum(i0 + 1, len(f) - 1)
+    w = (at - i0).reshape(-1, *([1] * (f.ndim - 1)))
+    return (1.0 - w) * f[i0] + w * f[i1]
+
+
 def resample(positions: np.ndarray, src_fps: float, dst_fps: float = 20.0) -> np.ndarray:
     """Resample a motion along its first (time) axis from ``src_fps`` to ``dst_fps``.
 
