@@ -13,7 +13,7 @@ REPO = Path(__file__).resolve().parents[1]
 def test_speed_benchmark_prints_and_writes_every_ratio(tmp_path: Path) -> None:
     from simdiff.serve.testing import write_tiny_model
 
-    model = write_tiny_model(tmp_path / "model")  # 3 runs per side: one cold-start ratio alone read 0.97 once in a CI run
+    model = write_tiny_model(tmp_path / "model")  # 3 runs per side: one cold start alone once read 0.97 in CI
     (model / "sampling.json").write_text('{"steps": 4, "guidance": 2.0, "guidance_min_t": 500}')
     out = tmp_path / "speed.json"
     cmd = [sys.executable, str(REPO / "benchmarks" / "bench_speed.py"), "--model", str(model), "--repeats", "3",

@@ -23,7 +23,7 @@ def _rational_ratio(src_fps: float, dst_fps: float) -> tuple[int, int] | None:
 
 
 def frames_at(frames: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """(N, ...) float64 ``frames`` (F, ...) linearly interpolated at fractional frame indices ``at`` (N,) in [0, F − 1]."""
+    """(N, ...) float64: ``frames`` (F, ...) linearly interpolated at fractional indices ``at`` (N,) in [0, F − 1]."""
     f = np.asarray(frames, dtype=np.float64)
     i0 = np.clip(np.floor(at).astype(int), 0, len(f) - 1)
     i1 = np.minimum(i0 + 1, len(f) - 1)
