@@ -17,8 +17,8 @@ from simdiff.inference.default import DEFAULT_MODEL_DIR, sampling_config
 
 def test_the_shipped_model_samples_as_documented() -> None:
     assert sampling_config(DEFAULT_MODEL_DIR) == SamplingConfig(
-        sampler="ddim", steps=16, eta=1.0, guidance=3.0, guidance_min_t=749, alpha=0.925, env_guidance=1.1,
-        edit_t=950, foot_lock=1.0)
+        sampler="ddim", steps=16, eta=1.0, guidance=3.0, guidance_min_t=749, alpha=0.925, env_guidance=1.3,
+        edit_t=950, foot_lock=1.0, flight_passes=3)
     stored = json.loads((DEFAULT_MODEL_DIR / "sampling.json").read_text())
     assert stored == sampling_config(DEFAULT_MODEL_DIR).to_dict()
 
@@ -37,6 +37,7 @@ def test_the_shipped_model_samples_as_documented() -> None:
     ({"guidance_min_t": -1}, "--guidance-min-t must be a whole number in 0..999, got -1"),
     ({"edit_t": True}, "--edit-t must be a whole number in 0..999, got True"),
     ({"foot_lock": 1.5}, r"--foot-lock must be in \[0, 1\], got 1.5"),
+    ({"flight_passes": 11}, "--flight-passes must be a whole number in 0..10, got 11"),
 ])
 def test_bad_values_are_one_line_naming_the_option(kwargs: dict, message: str) -> None:
     with pytest.raises(SimdiffError, match=message) as info:

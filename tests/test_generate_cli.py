@@ -146,11 +146,11 @@ def test_help_lists_every_option_with_the_shipped_defaults() -> None:
     assert proc.returncode == 0
     options = ("-h", "--gravity", "--wind", "--compare", "--simulate", "--force", "--length", "--seed",
                "--num-samples", "--sampler", "--steps", "--eta", "--guidance", "--guidance-min-t", "--alpha", "--foot-lock",
-               "--env-guidance", "--edit-t", "--keyframes", "--timeline", "--out", "--format", "--quiet", "--model",
-               "--device")
+               "--env-guidance", "--edit-t", "--flight-passes", "--keyframes", "--timeline", "--out", "--format",
+               "--quiet", "--model", "--device")
     usage = proc.stdout.split("\n\n")[0]
     assert set(re.findall(r"\[(-[-\w]+)", usage)) == set(options) - {"--quiet"} | {"-q"}
-    for default in ("(default 3)", "(default 0.925)", "(default 1.1)", "(default 950)", "(default 1)", "(default 16;",
+    for default in ("(default 3)", "(default 0.925)", "(default 1.3)", "(default 950)", "(default 1)", "(default 16;",
                     "default 749;"):
         assert default in " ".join(proc.stdout.split()), default
 

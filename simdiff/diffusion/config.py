@@ -27,6 +27,8 @@ ENV_GUIDANCE_RANGE: tuple[float, float] = (0.0, 10.0)
 """Environment guidance scales accepted (1: off)."""
 MAX_SEED: int = 2**32 - 1
 """Largest ``--seed`` a command accepts (numpy's seed range)."""
+MAX_FLIGHT_PASSES: int = 10
+"""Most flight-guidance passes per denoising step (three bring every flight within 1 cm of its parabola)."""
 
 
 @dataclass(frozen=True)
@@ -45,6 +47,8 @@ class SamplingConfig:
         edit_t: the last timestep (0..999) at which a motion under another gravity than Earth's still follows its
             Earth motion (continuous-φ models; :mod:`simdiff.diffusion.guidance`).
         foot_lock: strength in [0, 1] of the foot cleanup applied to the final sample (0: off).
+        flight_passes: flight guidance, 0..10 passes per denoising step at and below ``edit_t`` that bend every
+            flight of x̂₀ onto a parabola of the requested gravity (0: off; :mod:`simdiff.inference.flight_guidance`).
     """
 
     sampler: str = "ddim"
@@ -56,6 +60,7 @@ class SamplingConfig:
     env_guidance: float = 1.0
     edit_t: int = 950
     foot_lock: float = 0.0
+    flight_passes: int = 0
 
     def __post_init__(self) -> None:
         if self.sampler not in SAMPLERS:
@@ -72,6 +77,7 @@ class SamplingConfig:
         set_(self, "guidance_min_t", _whole("--guidance-min-t", self.guidance_min_t, 0, 999))
         set_(self, "edit_t", _whole("--edit-t", self.edit_t, 0, 999))
         set_(self, "foot_lock", _number("--foot-lock", self.foot_lock, 0.0, 1.0))
+        set_(self, "flight_passes", _whole("--flight-passes", self.flight_passes, 0, MAX_FLIGHT_PASSES))
 
     def updated(self, **given: Any) -> "SamplingConfig":
         """A copy with the options in ``given`` that are not None (checked). Switching the sampler without giving

@@ -14,6 +14,7 @@ import torch
 from torch import Tensor, nn
 
 from simdiff.diffusion.config import SamplingConfig
+from simdiff.diffusion.guidance import REFERENCE_ENV
 from simdiff.diffusion.sampling import X0Hook, sample
 from simdiff.errors import NonFiniteResult, SimdiffError
 from simdiff.model.checkpoint import load_pretrained, save_pretrained
@@ -138,7 +139,8 @@ class MotionGenerator:
             seed: noise seed in 0..2⁶³−1 (None: nondeterministic).
             batched_cfg: the conditional and unconditional passes as one batched forward.
             text_embeddings: (B, text_dim) precomputed text vectors instead of encoding ``texts``.
-            x0_hook, hook_timesteps: replace x̂₀ at chosen t (PhysDiff projection).
+            x0_hook, hook_timesteps: replace x̂₀ at chosen t (PhysDiff projection); with ``config.flight_passes``
+                the flight guidance follows it (:mod:`simdiff.inference.flight_guidance`).
             progress: optional iterable wrapper of the timesteps (e.g. ``tqdm``).
         """
         b = len(texts) if text_embeddings is None else int(text_embeddings.shape[0])
@@ -163,6 +165,12 @@ class MotionGenerator:
         mask = (torch.arange(frames)[None] < lens[:, None]).to(self.device)
         cond = Condition(text=text, frame_mask=mask, alpha=config.alpha, **self._env(b, env, env_index))
         generator = None if seed is None else torch.Generator(device=self.device).manual_seed(int(seed))
+        if config.flight_passes:
+            from simdiff.inference.flight_guidance import with_flight_guidance
+
+            gravity = cond.env[:, 0].tolist() if cond.env is not None else [REFERENCE_ENV[0]] * b
+            x0_hook = with_flight_guidance(x0_hook, hook_timesteps, config, gravity, self.mean, self.std)
+            hook_timesteps = None
         x = sample(self.network, config, cond, frames, nfeats=self.config.backbone.nfeats, batched_cfg=batched_cfg,
                    generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps, progress=progress)
         features = (x * self.std + self.mean) * mask[..., None]

@@ -2,7 +2,8 @@
 
 The motion's HumanML3D features are noised to the sampler's ``edit_t`` and denoised twice with the same noise: under
 φ (the adapters, as :mod:`simdiff.diffusion.guidance` runs a generated motion off Earth) and under Earth without wind
-(the backbone). Their difference, the model's answer to φ for this motion, is added to the motion itself: at Earth
+(the backbone), each with the sampling's flight guidance (:mod:`simdiff.inference.flight_guidance`) at its own
+gravity. Their difference, the model's answer to φ for this motion, is added to the motion itself: at Earth
 without wind the motion comes back unchanged, and only what φ changes changes. A motion longer than the network's
 196 frames runs in overlapping windows whose differences are cross-faded.
 """
@@ -21,6 +22,7 @@ from simdiff.diffusion.config import SamplingConfig
 from simdiff.diffusion.guidance import REFERENCE_ENV, GuidedDenoiser
 from simdiff.diffusion.sampling import make_scheduler
 from simdiff.errors import SimdiffError
+from simdiff.inference.flight_guidance import FlightGuide
 from simdiff.motion.skeleton import MAX_FRAMES
 
 if TYPE_CHECKING:
@@ -100,8 +102,9 @@ def _denoise_from(generator: MotionGenerator, x0: Tensor, config: SamplingConfig
     # edit_t 999 here: the motion itself is the Earth sample that the steps above edit_t follow in generate
     model = GuidedDenoiser(generator.network, config.guidance if text is not None else 1.0,
                            env_scale=config.env_guidance, edit_t=999, min_t=config.guidance_min_t)
+    guide = FlightGuide(env[:, 0].tolist(), generator.mean, generator.std, config.flight_passes)
     for t in steps if progress is None else progress(steps):
-        x0_hat = model(x, torch.full((1,), t, dtype=torch.long, device=x.device), cond)
+        x0_hat = guide(model(x, torch.full((1,), t, dtype=torch.long, device=x.device), cond), t, x)
         x = scheduler.step(x0_hat, t, x, generator=gen).prev_sample
     return x
 

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from simdiff.diffusion.config import MAX_FLIGHT_PASSES
 from simdiff.errors import SimdiffError
 from simdiff.inference.timeline import Segment
 from simdiff.motion.skeleton import FPS, MAX_FRAMES, MIN_GENERATE_FRAMES
@@ -42,7 +43,7 @@ MAX_TIMELINE_SEGMENTS: int = 8
 
 
 SAMPLING_FIELDS: tuple[str, ...] = ("steps", "eta", "guidance", "guidance_min_t", "alpha", "env_guidance",
-                                    "edit_t", "foot_lock")
+                                    "edit_t", "foot_lock", "flight_passes")
 """The :class:`~simdiff.diffusion.config.SamplingConfig` fields a request may set (None: the model's value)."""
 
 
@@ -58,7 +59,7 @@ class GenerateParams:
         seed: noise seed (≥ 0).
         simulate: simulated finish: re-track the motion in the simulator under φ; the answer shows the
             simulated motion and carries the generated one and the tracking result in ``meta``.
-        steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock: the
+        steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock, flight_passes: the
             :class:`~simdiff.diffusion.config.SamplingConfig` fields, or None for the model's ``sampling.json``
             value, as ``simdiff generate``.
         pin_start, pin_end: None, or the number of a motion shown (an answer's ``motion``) whose first (last)
@@ -80,6 +81,7 @@ class GenerateParams:
     edit_t: int | None = None
     guidance_min_t: int | None = None
     foot_lock: float | None = None
+    flight_passes: int | None = None
     pin_start: int | None = None
     pin_end: int | None = None
 
@@ -191,7 +193,8 @@ def parse_seed(body: Mapping[str, Any]) -> int:
 def parse_sampling(body: Mapping[str, Any]) -> dict[str, Any]:
     """The :data:`SAMPLING_FIELDS` a request gives (None: the model's), each within its range."""
     sampling: dict[str, Any] = {}
-    for key, (low, high) in {"steps": (1, MAX_STEPS), "edit_t": (0, 999), "guidance_min_t": (0, 999)}.items():
+    for key, (low, high) in {"steps": (1, MAX_STEPS), "edit_t": (0, 999), "guidance_min_t": (0, 999),
+                               "flight_passes": (0, MAX_FLIGHT_PASSES)}.items():
         value = _integer(body, key, None)
         if value is not None:
             _check_range(key, value, low, high)
@@ -219,7 +222,7 @@ def parse_generate(body: Any) -> GenerateParams:
 
     Args:
         body: the decoded JSON object ``{text, gravity, wind_x, wind_y, seconds, seed, simulate, steps, eta,
-            guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock, pin_start, pin_end}``; everything but ``text`` is
+            guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock, flight_passes, pin_start, pin_end}``; everything but ``text`` is
             optional.
     Raises:
         SimdiffError: one line naming the bad field and value.
@@ -269,7 +272,7 @@ class ReplayParams:
 
 def parse_replay(body: Any) -> ReplayParams:
     """Validate a ``POST /api/edit`` body ``{source, gravity, wind_x, wind_y, seed, text, steps, eta, guidance,
-    guidance_min_t, alpha, env_guidance, edit_t, foot_lock}`` (all but ``source`` optional); one line naming the bad value."""
+    guidance_min_t, alpha, env_guidance, edit_t, foot_lock, flight_passes}`` (all but ``source`` optional); one line naming the bad value."""
     check_fields(body, {"source", "gravity", "wind_x", "wind_y", "seed", "text", *SAMPLING_FIELDS})
     source = parse_motion(body, "source")
     if source is None:
@@ -293,7 +296,7 @@ class TimelineParams:
 
 def parse_timeline_request(body: Any) -> TimelineParams:
     """Validate a ``POST /api/timeline`` body ``{segments: [{text, seconds, gravity?, wind?: [x, y]}, ...], seed,
-    steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock}``: the segments as ``generate --timeline``
+    steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock, flight_passes}``: the segments as ``generate --timeline``
     checks a file's (:func:`~simdiff.product.request.parse_timeline`, the same one-line messages), at most
     :data:`MAX_TIMELINE_SEGMENTS` of them."""
     check_fields(body, {"segments", "seed", *SAMPLING_FIELDS})

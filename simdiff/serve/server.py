@@ -4,8 +4,8 @@ Routes:
     ``GET /`` and ``GET /static/<file>``: the page (html, js, css shipped in the package; three.js in ``vendor/three``).
     ``GET /api/info``: model status, listed files, slider ranges and limits, skeleton.
     ``POST /api/generate`` (``application/json``): ``{text, gravity, wind_x, wind_y, seconds, seed, simulate}``, the
-    optional sampling settings ``steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock`` (left
-    out: the model's ``sampling.json`` values, as ``simdiff generate``) and ``pin_start``, ``pin_end``: a motion's number
+    optional sampling settings ``steps, eta, guidance, guidance_min_t, alpha, env_guidance, edit_t, foot_lock,
+    flight_passes`` (left out: the model's ``sampling.json`` values, as ``simdiff generate``) and ``pin_start``, ``pin_end``: a motion's number
     whose first (last) pose it starts (ends) in (``meta.keyframe_error_cm``) → ``{joints, fps, parents, meta, motion, body}``.
     ``POST /api/edit`` (JSON): ``{source, gravity, wind_x, wind_y, seed, text}``: motion ``source`` re-played under φ as
     ``simdiff edit`` → same; ``POST /api/timeline`` (JSON): ``{segments: [{text, seconds, gravity?, wind?: [x, y]}],

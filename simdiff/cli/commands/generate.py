@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from simdiff.cli.options import SEED, integer, real
-from simdiff.diffusion.config import (ALPHA_RANGE, ENV_GUIDANCE_RANGE, GUIDANCE_RANGE, MAX_STEPS, SAMPLER_STEPS,
-                                      SAMPLERS, SamplingConfig)
+from simdiff.diffusion.config import (ALPHA_RANGE, ENV_GUIDANCE_RANGE, GUIDANCE_RANGE, MAX_FLIGHT_PASSES, MAX_STEPS,
+                                      SAMPLER_STEPS, SAMPLERS, SamplingConfig)
 from simdiff.inference.default import DEFAULT_MODEL_DIR, SAMPLING_NAME, sampling_config
 from simdiff.motion.skeleton import FPS, MAX_FRAMES, MIN_GENERATE_FRAMES
 from simdiff.product.request import MAX_SAMPLES
@@ -127,6 +127,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--edit-t", type=integer(0, MAX_STEPS - 1), metavar="T",
                      help="under another gravity than Earth's, the motion follows its Earth motion (same seed) down "
                           f"to denoising timestep T (0-999), then continues under φ (default {cfg.edit_t})")
+    smp.add_argument("--flight-passes", type=integer(0, MAX_FLIGHT_PASSES), metavar="N",
+                     help="flight guidance: N passes per denoising step that bend every flight onto a parabola of the "
+                          f"requested gravity, 0 = off (default {cfg.flight_passes})")
     out = p.add_argument_group("output")
     out.add_argument("--out", type=Path, metavar="DIR",
                      help="output folder, files in it are replaced (default ./out/<prompt>, or <prompt>-2, -3, ... "

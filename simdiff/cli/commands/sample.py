@@ -7,8 +7,8 @@ from dataclasses import fields
 from pathlib import Path
 
 from simdiff.cli.options import SEED, integer, real
-from simdiff.diffusion.config import (ALPHA_RANGE, ENV_GUIDANCE_RANGE, GUIDANCE_RANGE, MAX_STEPS, SAMPLERS,
-                                      SamplingConfig)
+from simdiff.diffusion.config import (ALPHA_RANGE, ENV_GUIDANCE_RANGE, GUIDANCE_RANGE, MAX_FLIGHT_PASSES, MAX_STEPS,
+                                      SAMPLERS, SamplingConfig)
 from simdiff.motion.skeleton import MAX_FRAMES, MIN_GENERATE_FRAMES
 from simdiff.sim.env import MAX_FORCED_WIND
 
@@ -47,6 +47,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     smp.add_argument("--guidance-min-t", type=integer(0, MAX_STEPS - 1),
                      help="text guidance only at timesteps >= this (0..999; 0 = every step)")
     smp.add_argument("--foot-lock", type=real(0.0, 1.0), help="foot cleanup strength in [0, 1] (0 = off)")
+    smp.add_argument("--flight-passes", type=integer(0, MAX_FLIGHT_PASSES),
+                     help="flight guidance passes per step (0 = off): flights bent onto parabolas of the gravity")
     p.add_argument("--unbatched-cfg", action="store_true", help="run CFG as two forwards (MDM's way) instead of one")
     p.add_argument("--seed", type=SEED, default=0, help="noise seed (default 0)")
     p.add_argument("--batch", type=integer(1, MAX_MOTIONS), default=1, help=f"samples per caption (default 1; at most {MAX_MOTIONS} motions per run)")

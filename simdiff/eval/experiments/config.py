@@ -45,8 +45,10 @@ class ModelSpec:
         guidance_min_t: the lowest timestep guided by the text (None: the model's ``sampling.json``; 0 with
             ``steps`` 50: the 50-step path).
         env_guidance: environment guidance s_e of continuous SimDiff models (None: the model's ``sampling.json``;
-            :mod:`simdiff.diffusion.guidance`). Every other sampling setting (η, ``edit_t``, foot cleanup) is the
-            model's, so a row samples as ``simdiff generate`` does with that model.
+            :mod:`simdiff.diffusion.guidance`).
+        flight_passes: flight guidance of continuous SimDiff models (None: the model's ``sampling.json``; 0: off;
+            :mod:`simdiff.inference.flight_guidance`); φ-blind methods sample without it. Every other sampling
+            setting (η, ``edit_t``, foot cleanup) is the model's, so a row samples as ``simdiff generate`` does.
         physdiff: :class:`simdiff.baselines.physdiff.PhysDiffConfig` fields → PhysDiff sampling
             (the row's sampler, steps and φ are filled in by the experiment).
         simulate: simulated finish: each final sample is re-tracked under its φ (Earth for
@@ -73,6 +75,7 @@ class ModelSpec:
     guidance: float | None = None
     guidance_min_t: int | None = None
     env_guidance: float | None = None
+    flight_passes: int | None = None
     physdiff: dict[str, Any] | None = None
     simulate: bool = False
     alphas: list[float | str] | None = None

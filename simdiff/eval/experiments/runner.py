@@ -305,12 +305,14 @@ class Runner:
     def sampling(self, spec: ModelSpec, sampler: str, alpha: float | None = None) -> SamplingConfig:
         """The model folder's ``sampling.json`` with the row's sampler, α and the method's overrides."""
         from simdiff.inference.default import sampling_config
-        env_guidance = spec.env_guidance if self.sim_mode(spec) == "continuous" else 1.0  # φ-blind: no φ to push
+        continuous = self.sim_mode(spec) == "continuous"
+        env_guidance = spec.env_guidance if continuous else 1.0  # φ-blind: no φ to push
+        flight_passes = spec.flight_passes if continuous else 0  # φ-blind methods are sampled without SimDiff's guidance
         eta = 0.0 if spec.physdiff is not None else None  # PhysDiff's projection sampler is deterministic DDIM
         return sampling_config(self.config.model_path(spec)).updated(
             sampler=sampler, steps=spec.sampler_steps(sampler), guidance=spec.guidance,
             guidance_min_t=spec.guidance_min_t, eta=eta,
-            env_guidance=env_guidance, alpha=spec.alpha if alpha is None else float(alpha))
+            env_guidance=env_guidance, flight_passes=flight_passes, alpha=spec.alpha if alpha is None else float(alpha))
 
     def alpha(self, spec: ModelSpec) -> float:  # the α of a method where the experiment does not sweep it
         return self.sampling(spec, "ddim").alpha
