@@ -92,7 +92,7 @@ def test_with_flight_guidance_runs_the_given_hook_at_its_timesteps_then_the_guid
         return feats[None].clone()
 
     config = SamplingConfig(flight_passes=3, edit_t=950)
-    combined = with_flight_guidance(hook, [500], config, [-3.7], mean, std)
+    combined = with_flight_guidance(hook, [500], config, [-3.7], mean, std, [feats.shape[0]])
     x = torch.zeros_like(feats)[None]
     assert torch.equal(combined(x, 999, x), x) and seen == []  # above edit_t and not a hook step
     out = combined(x, 500, x)
@@ -138,3 +138,14 @@ def test_no_foot_is_pushed_below_the_floor_and_no_flight_is_made_up() -> None:
     assert len(flights(moved)) == len(flights(joints)) == 1
     lowest = heights_over_ground(moved).min(axis=1)
     assert lowest.min() >= min(heights_over_ground(joints).min(), 0.0) - 1e-9
+
+
+def test_padding_after_a_row_s_length_is_left_alone_and_does_not_change_its_flights() -> None:
+    feats = jump_features()
+    n = feats.shape[0]
+    mean, std = torch.zeros(263), torch.ones(263)
+    padded = torch.cat([feats, torch.full((40, 263), 5.0)])[None]  # garbage frames after the motion
+    alone = FlightGuide([-1.6], mean, std, passes=3)(feats[None], 0, feats[None])
+    out = FlightGuide([-1.6], mean, std, passes=3, lengths=[n])(padded, 0, padded)
+    assert torch.equal(out[0, n:], padded[0, n:])
+    assert torch.allclose(out[0, :n], alone[0], atol=1e-6)

@@ -72,23 +72,29 @@ class FlightGuide:
         passes: corrections per call, each on the decoding of the last; flights found on the moved motion can
             differ from the first decoding's, so one pass is not enough.
         max_t: the highest timestep guided (the sampling's ``edit_t``: above it a row follows its Earth sample).
+        lengths: (B,) frames of each row's motion (None: all frames); the padding after them is left alone.
     """
 
     def __init__(self, gravity: Sequence[float] | np.ndarray, mean: Tensor, std: Tensor, passes: int,
-                 max_t: int = 999) -> None:
+                 max_t: int = 999, lengths: Sequence[int] | None = None) -> None:
         self.gravity = np.asarray(gravity, dtype=np.float64).reshape(-1)
         self.mean, self.std = mean, std
         self.passes = int(passes)
         self.max_t = int(max_t)
+        self.lengths = None if lengths is None else [int(n) for n in lengths]
 
     def __call__(self, x0: Tensor, t: int, x_t: Tensor) -> Tensor:
         """x̂₀ (B, T, F) normalised → x̂₀ with its flights on parabolas of the rows' gravity."""
         if t > self.max_t or self.passes <= 0:
             return x0
         features = x0 * self.std + self.mean
+        frames = features.shape[1]
+        lengths = self.lengths or [frames] * features.shape[0]
         for _ in range(self.passes):
             joints = features_to_joints(features.detach().double()).cpu().numpy()
-            moves = np.stack([flight_correction(j, g) for j, g in zip(joints, self.gravity)])
+            moves = np.zeros((features.shape[0], frames))
+            for row, (j, g, n) in enumerate(zip(joints, self.gravity, lengths)):
+                moves[row, :n] = flight_correction(j[:n], g)
             if not moves.any():
                 break
             features = features.clone()
@@ -100,10 +106,11 @@ class FlightGuide:
 
 
 def with_flight_guidance(hook: X0Hook | None, hook_timesteps: Iterable[int] | None, config: SamplingConfig,
-                         gravity: Sequence[float], mean: Tensor, std: Tensor) -> X0Hook:
+                         gravity: Sequence[float], mean: Tensor, std: Tensor, lengths: Sequence[int]) -> X0Hook:
     """One hook for every timestep: ``hook`` at ``hook_timesteps`` (all when None), then the flight guidance of
-    ``config.flight_passes`` passes at and below ``config.edit_t`` for rows of ``gravity`` (B,) m/s²."""
-    guide = FlightGuide(gravity, mean, std, config.flight_passes, config.edit_t)
+    ``config.flight_passes`` passes at and below ``config.edit_t`` for rows of ``gravity`` (B,) m/s² and
+    ``lengths`` (B,) frames."""
+    guide = FlightGuide(gravity, mean, std, config.flight_passes, config.edit_t, lengths)
     if hook is None:
         return guide
     hooked = None if hook_timesteps is None else {int(t) for t in hook_timesteps}

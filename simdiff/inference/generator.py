@@ -169,7 +169,8 @@ class MotionGenerator:
             from simdiff.inference.flight_guidance import with_flight_guidance
 
             gravity = cond.env[:, 0].tolist() if cond.env is not None else [REFERENCE_ENV[0]] * b
-            x0_hook = with_flight_guidance(x0_hook, hook_timesteps, config, gravity, self.mean, self.std)
+            x0_hook = with_flight_guidance(x0_hook, hook_timesteps, config, gravity, self.mean, self.std,
+                                           lens.tolist())
             hook_timesteps = None
         x = sample(self.network, config, cond, frames, nfeats=self.config.backbone.nfeats, batched_cfg=batched_cfg,
                    generator=generator, x0_hook=x0_hook, hook_timesteps=hook_timesteps, progress=progress)
