@@ -52,9 +52,8 @@ def test_the_correction_puts_the_flight_on_a_parabola_of_the_gravity(gravity: fl
     move = moved[:, 0, 1] - joints[:, 0, 1]
     # take-off and landing kept: nothing moves far from the flight, and nothing jumps at its edges
     assert np.all(move[:10] == 0) and np.all(move[-10:] == 0)
-    airtime = float(np.sqrt(8 * 0.4 / 9.81))
-    speed = np.abs(np.diff(moved[:, 0, 1])) * 20.0  # m/s at 20 fps
-    assert speed.max() < 1.5 * max(np.abs(np.diff(joints[:, 0, 1])).max() * 20.0, abs(gravity) * airtime / 2.0)
+    # the stance is never lifted, so a flight bent far takes off with a step: bounded by a take-off speed
+    assert np.abs(np.diff(moved[:, 0, 1])).max() * 20.0 < 6.0
 
 
 def test_a_motion_without_a_readable_flight_is_left_exactly_as_it_is() -> None:
@@ -128,16 +127,35 @@ def test_sampling_json_takes_the_pass_count() -> None:
     assert SamplingConfig.from_dict({"flight_passes": 3}).flight_passes == 3
 
 
-def test_no_foot_is_pushed_below_the_floor_and_no_flight_is_made_up() -> None:
+@pytest.mark.parametrize("gravity", [-1.6, -20.0])
+def test_no_foot_is_pushed_below_the_floor_and_no_flight_is_made_up(gravity: float) -> None:
     from simdiff.motion.flight import flights, heights_over_ground
 
     joints = earth_jump().astype(np.float64)
     moved = joints
     for _ in range(3):
-        moved = raised(moved, flight_correction(moved, -20.0))
-    assert len(flights(moved)) == len(flights(joints)) == 1
+        moved = raised(moved, flight_correction(moved, gravity))
+    (s0, e0), = flights(joints)
+    (s1, e1), = flights(moved)
+    assert s1 >= s0 - 3 and e1 <= e0 + 1  # the network's flight keeps its frames (edges within 5 cm may join)
     lowest = heights_over_ground(moved).min(axis=1)
     assert lowest.min() >= min(heights_over_ground(joints).min(), 0.0) - 1e-9
+
+
+def test_two_hops_keep_their_landing_and_each_its_own_parabola() -> None:
+    from simdiff.motion.flight import flights
+
+    airtime = float(np.sqrt(8 * 0.4 / 9.81))
+    hops = jump(frames=90, height=0.4, start=20, airtime=airtime).astype(np.float64)
+    hops[..., 1] += jump(frames=90, height=0.4, start=34, airtime=airtime)[..., 1] - jump(frames=90, height=0.0)[..., 1]
+    moved = hops
+    for _ in range(3):
+        moved = raised(moved, flight_correction(moved, -3.7))
+    assert len(flights(moved)) == len(flights(hops)) == 2
+    from simdiff.motion.gravity_readout import flight_fits
+
+    for fit in flight_fits(moved):
+        assert abs(fit.gravity / -3.7 - 1) < 0.05
 
 
 def test_padding_after_a_row_s_length_is_left_alone_and_does_not_change_its_flights() -> None:
@@ -149,3 +167,12 @@ def test_padding_after_a_row_s_length_is_left_alone_and_does_not_change_its_flig
     out = FlightGuide([-1.6], mean, std, passes=3, lengths=[n])(padded, 0, padded)
     assert torch.equal(out[0, n:], padded[0, n:])
     assert torch.allclose(out[0, :n], alone[0], atol=1e-6)
+
+
+def test_a_categorical_model_refuses_flight_guidance_in_one_line() -> None:
+    from simdiff.train.testing import tiny_generator
+
+    gen = tiny_generator()
+    gen.config.sim.mode = "categorical"  # φ as a category: no gravity to bend the flights to
+    with pytest.raises(SimdiffError, match="flight-passes"):
+        gen.generate(["a jump"], 20, SamplingConfig(steps=2, guidance=1.0, flight_passes=3), env_index=1, seed=0)

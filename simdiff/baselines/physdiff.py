@@ -173,7 +173,7 @@ def physdiff_generate(generator: Any, texts: Sequence[str], lengths: int | Seque
         generator: a :class:`simdiff.inference.generator.MotionGenerator` (backbone or SimDiff).
         texts, lengths: as ``MotionGenerator.generate``.
         config: see :class:`PhysDiffConfig`; its sampler, steps and guidance replace ``sampling``'s (η 0, no foot
-            lock: the projection is the only post-process).
+            lock and no flight guidance: the projection is the only physics step).
         projector: injected projector (tests); default the MuJoCo tracker.
         sampling: the generator's other settings (α, environment guidance, ``edit_t``).
         env, env_index: φ or the environment category, as ``MotionGenerator.generate``.
@@ -189,7 +189,7 @@ def physdiff_generate(generator: Any, texts: Sequence[str], lengths: int | Seque
     hook = ProjectionHook(normalizer, lens, Environment(*config.env).validate(), proj, config.refloor)
     try:
         run = replace(sampling, sampler=config.sampler, steps=config.steps or SAMPLER_STEPS[config.sampler], eta=0.0,
-                      guidance=config.guidance, foot_lock=0.0)
+                      guidance=config.guidance, foot_lock=0.0, flight_passes=0)
         generation = generator.generate(texts, lens, run, env=env, env_index=env_index, seed=seed, x0_hook=hook,
                                         hook_timesteps=at)
     finally:

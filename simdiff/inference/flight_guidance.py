@@ -24,7 +24,7 @@ from torch import Tensor
 from simdiff.diffusion.config import SamplingConfig
 from simdiff.diffusion.sampling import X0Hook
 from simdiff.motion.features import SLICES, features_to_joints
-from simdiff.motion.flight import heights_over_ground
+from simdiff.motion.flight import LIFT_EDGE, heights_over_ground
 from simdiff.motion.gravity_readout import centre_of_mass, flight_fits
 from simdiff.motion.skeleton import FPS, NUM_JOINTS
 
@@ -37,30 +37,35 @@ HEIGHT_CHANNELS: list[int] = [SLICES["root_y"].start] + [SLICES["ric"].start + 3
 
 def flight_correction(joints: np.ndarray, gravity: float) -> np.ndarray:
     """(T,) m: the height change that puts every readable flight of ``joints`` (T, 22, 3) on a parabola of
-    curvature ``gravity`` (m/s²), faded out over :data:`FADE_FRAMES` either side and never taking a foot below its
-    ground level; zero without a readable flight."""
+    curvature ``gravity`` (m/s²), faded out over :data:`FADE_FRAMES` either side; a faded frame is never lifted
+    off the floor (its lowest foot stays within :data:`~simdiff.motion.flight.LIFT_EDGE`) and no frame takes a
+    foot below it; zero without a readable flight."""
     frames = joints.shape[0]
     height = centre_of_mass(joints)[:, 1]
-    total, weight = np.zeros(frames), np.zeros(frames)
+    fitted = np.zeros(frames)
+    inside = np.zeros(frames, dtype=bool)
+    faded, ramps = np.zeros(frames), np.zeros(frames)
     for fit in flight_fits(joints):
         s, e = fit.start, fit.end
         t = np.arange(e - s) / FPS
         free = height[s:e] - gravity * t**2 / 2.0
         line = np.stack([t, np.ones_like(t)], axis=1)
         coef, *_ = np.linalg.lstsq(line, free, rcond=None)
-        move = np.zeros(frames)
-        move[s:e] = line @ coef - free
+        fitted[s:e] = line @ coef - free
+        inside[s:e] = True
         for k in range(1, FADE_FRAMES + 1):
             ramp = 1.0 - k / (FADE_FRAMES + 1)
-            if s - k >= 0:
-                move[s - k] = move[s] * ramp
-            if e - 1 + k < frames:
-                move[e - 1 + k] = move[e - 1] * ramp
-        total += move
-        weight[max(s - FADE_FRAMES, 0):min(e + FADE_FRAMES, frames)] += 1.0
+            for frame, edge in ((s - k, fitted[s]), (e - 1 + k, fitted[e - 1])):
+                if 0 <= frame < frames:
+                    faded[frame] += ramp * edge
+                    ramps[frame] += ramp
+    lowest = heights_over_ground(joints).min(axis=1)
+    # fades of neighbouring flights blend by their ramps; a flight's own frames take its own parabola
+    fade = np.where(inside, 0.0, faded / np.maximum(ramps, 1.0))
+    # a lifted stance frame would lengthen the flight the network chose (and lift planted feet)
+    fade = np.minimum(fade, np.maximum(LIFT_EDGE - lowest, 0.0))
     # no foot pushed below the floor: that would move the floor the flights are found from (and is no flight)
-    room = np.maximum(heights_over_ground(joints).min(axis=1), 0.0)
-    return np.maximum(total / np.maximum(weight, 1.0), -room)
+    return np.maximum(np.where(inside, fitted, fade), -np.maximum(lowest, 0.0))
 
 
 class FlightGuide:
