@@ -165,12 +165,12 @@ class MotionGenerator:
         mask = (torch.arange(frames)[None] < lens[:, None]).to(self.device)
         cond = Condition(text=text, frame_mask=mask, alpha=config.alpha, **self._env(b, env, env_index))
         generator = None if seed is None else torch.Generator(device=self.device).manual_seed(int(seed))
-        if config.flight_passes and cond.env_index is not None:
-            raise SimdiffError("--flight-passes needs the gravity as a number (a continuous SimDiff model or a "
-                               "backbone); this model takes an environment category (set it to 0)")
         if config.flight_passes:
             from simdiff.inference.flight_guidance import with_flight_guidance
 
+            if cond.env_index is not None:
+                raise SimdiffError("--flight-passes needs the gravity as a number (a continuous SimDiff model or a "
+                                   "backbone); this model takes an environment category (set it to 0)")
             gravity = cond.env[:, 0].tolist() if cond.env is not None else [REFERENCE_ENV[0]] * b
             x0_hook = with_flight_guidance(x0_hook, hook_timesteps, config, gravity, self.mean, self.std,
                                            lens.tolist())
